@@ -1,0 +1,199 @@
+// The path tracer every lab shares: the primitive loops (closest hit, shadow test), the path
+// loop with next-event estimation, and the per-pixel estimator.
+//
+// Lab 01 students write the regions between BEGIN/END SOLUTION; the skeleton generator
+// (grading/skeletons.py) turns this file into labs/01-serial/skeleton/path_tracer.h.
+#pragma once
+
+#include <cfloat>
+
+#include "rng.h"
+#include "scene.h"
+
+// The nearest surface a ray meets: which primitive and how far.
+struct Hit {
+    float t = FLT_MAX;  // distance along the ray; FLT_MAX when nothing was hit
+    int sphere = -1;    // index of the sphere hit, or -1
+    int triangle = -1;  // index of the triangle hit, or -1
+
+    RT_HD bool found() const { return sphere >= 0 || triangle >= 0; }
+};
+
+// What shading needs to know about a hit point.
+struct SurfacePoint {
+    Vec3 position;  // world-space hit point
+    Vec3 normal;    // unit geometric normal: outward for spheres, the front side for triangles
+    int material;   // index into the material table
+};
+
+RT_HD inline SurfacePoint surface_at(const SceneView& scene, const Ray& ray, const Hit& hit) {
+    const Vec3 p = ray.at(hit.t);
+    if (hit.sphere >= 0) {
+        const Sphere& s = scene.spheres[hit.sphere];
+        return {p, (p - s.center) * (1.0f / s.radius), s.material};
+    }
+    const Triangle& tri = scene.triangles[hit.triangle];
+    return {p, tri.normal, tri.material};
+}
+
+// Closest hit by brute force over every primitive: the scenes of this course are small.
+RT_HD inline Hit closest_hit(const SceneView& scene, const Ray& ray) {
+    Hit hit;
+    // BEGIN SOLUTION
+    for (int i = 0; i < scene.num_spheres; ++i) {
+        const float t = intersect_sphere(ray, scene.spheres[i], hit.t);
+        if (t < hit.t) {
+            hit.t = t;
+            hit.sphere = i;
+        }
+    }
+    const RayShear shear(ray.direction);
+    for (int i = 0; i < scene.num_triangles; ++i) {
+        const float t = intersect_triangle(ray, shear, scene.triangles[i], hit.t);
+        if (t < hit.t) {
+            hit.t = t;
+            hit.sphere = -1;
+            hit.triangle = i;
+        }
+    }
+    // SKELETON
+    //> // TODO(lab01): this finds spheres only. Loop over the triangles too (build one
+    //> // RayShear per ray, then intersect_triangle), keeping the nearest hit.
+    //> for (int i = 0; i < scene.num_spheres; ++i) {
+    //>     const float t = intersect_sphere(ray, scene.spheres[i], hit.t);
+    //>     if (t < hit.t) {
+    //>         hit.t = t;
+    //>         hit.sphere = i;
+    //>     }
+    //> }
+    // END SOLUTION
+    return hit;
+}
+
+// Whether anything blocks the ray before distance t_max. Stops at the first blocker:
+// a shadow ray needs any hit, not the closest. Glass blocks too (no caustics).
+RT_HD inline bool occluded(const SceneView& scene, const Ray& ray, float t_max) {
+    // BEGIN SOLUTION
+    for (int i = 0; i < scene.num_spheres; ++i) {
+        if (intersect_sphere(ray, scene.spheres[i], t_max) < t_max) return true;
+    }
+    const RayShear shear(ray.direction);
+    for (int i = 0; i < scene.num_triangles; ++i) {
+        if (intersect_triangle(ray, shear, scene.triangles[i], t_max) < t_max) return true;
+    }
+    return false;
+    // SKELETON
+    //> // TODO(lab01): return true when any sphere or triangle lies on the ray before t_max.
+    //> (void)scene;
+    //> (void)ray;
+    //> (void)t_max;
+    //> return false;
+    // END SOLUTION
+}
+
+// Radiance the point light sends to a diffuse surface point through its BRDF:
+// rho/pi * I * cos(theta) / d^2 when the segment to the light is clear.
+RT_HD inline Vec3 direct_light(const SceneView& scene, Vec3 origin, Vec3 facing_normal,
+                               Vec3 albedo) {
+    // BEGIN SOLUTION
+    const Vec3 to_light = scene.light.position - origin;
+    const float distance2 = length_squared(to_light);
+    const float distance = sqrtf(distance2);
+    const Vec3 wi = to_light * (1.0f / distance);
+    const float cos_theta = dot(facing_normal, wi);
+    if (cos_theta <= 0.0f) return Vec3(0.0f);  // light behind the surface
+    if (occluded(scene, {origin, wi}, distance)) return Vec3(0.0f);
+    return albedo * scene.light.intensity * (cos_theta / (kPi * distance2));
+    // SKELETON
+    //> // TODO(lab01): cast a shadow ray to the light; if it is clear, return
+    //> // albedo/pi * intensity * cos(theta) / distance^2. Until then: no light at all.
+    //> (void)scene;
+    //> (void)origin;
+    //> (void)facing_normal;
+    //> (void)albedo;
+    //> return Vec3(0.0f);
+    // END SOLUTION
+}
+
+// Radiance arriving along a camera ray, estimated by one random path of at most
+// max_bounces surface interactions, with next-event estimation at each diffuse one.
+// A path ends when it escapes (picking up the background) or its budget is spent.
+RT_HD inline Vec3 trace_path(const SceneView& scene, Ray ray, const SampleStream& rng,
+                             int max_bounces) {
+    Vec3 radiance(0.0f);
+    Vec3 throughput(1.0f);
+    // BEGIN SOLUTION
+    for (int bounce = 0; bounce < max_bounces; ++bounce) {
+        const Hit hit = closest_hit(scene, ray);
+        if (!hit.found()) {
+            radiance += throughput * scene.background;
+            break;
+        }
+        const SurfacePoint surface = surface_at(scene, ray, hit);
+        const Material& material = scene.materials[surface.material];
+        const bool entering = dot(ray.direction, surface.normal) < 0.0f;
+        const Vec3 facing = entering ? surface.normal : -surface.normal;  // toward the ray
+        const Vec3 above = offset_ray_origin(surface.position, facing, hit.t);
+        const bool last = bounce + 1 == max_bounces;
+
+        if (material.type == MaterialType::Diffuse) {
+            if (scene.has_light) {
+                radiance += throughput * direct_light(scene, above, facing, material.albedo);
+            }
+            if (last) break;
+            throughput *= material.albedo;
+            ray = {above, sample_cosine_hemisphere(facing, rng.at(bounce_dimension(bounce, 0)),
+                                                   rng.at(bounce_dimension(bounce, 1)))};
+        } else if (material.type == MaterialType::Mirror) {
+            if (last) break;
+            throughput *= material.albedo;
+            ray = {above, reflect(ray.direction, facing)};
+        } else {  // glass: reflect or refract, chosen with the Fresnel reflectance
+            if (last) break;
+            const float eta = entering ? 1.0f / material.ior : material.ior;
+            float cos_t;
+            const float reflectance = fresnel_dielectric(-dot(ray.direction, facing), eta, cos_t);
+            if (rng.at(bounce_dimension(bounce, 0)) < reflectance) {
+                ray = {above, reflect(ray.direction, facing)};
+            } else {
+                const Vec3 below = offset_ray_origin(surface.position, -facing, hit.t);
+                ray = {below, refract(ray.direction, facing, eta, cos_t)};
+            }
+        }
+    }
+    // SKELETON
+    //> // TODO(lab01): the path loop. For each bounce: find the closest hit (escaped rays
+    //> // pick up the background), add next-event estimation at diffuse surfaces, then
+    //> // continue the path (cosine-sampled, mirrored or refracted) with a new ray.
+    //> // Until then: flat colour of the first surface seen, no lighting.
+    //> (void)max_bounces;
+    //> (void)rng;
+    //> const Hit hit = closest_hit(scene, ray);
+    //> if (!hit.found()) return scene.background;
+    //> radiance = scene.materials[surface_at(scene, ray, hit).material].albedo;
+    // END SOLUTION
+    return radiance;
+}
+
+// The estimate of one pixel: the mean of spp paths through uniformly jittered points of the
+// pixel (a box filter). Pixel index and sample number key the random numbers.
+RT_HD inline Vec3 render_pixel(const SceneView& scene, const Camera& camera,
+                               const RenderSettings& settings, int x, int y) {
+    const uint64_t pixel = static_cast<uint64_t>(y) * settings.width + x;
+    Vec3 sum(0.0f);
+    // BEGIN SOLUTION
+    for (int s = 0; s < settings.spp; ++s) {
+        const SampleStream rng(settings.seed, pixel, s);
+        const Ray ray = camera.ray_through(x + rng.at(kDimPixelX), y + rng.at(kDimPixelY));
+        sum += trace_path(scene, ray, rng, settings.bounces);
+    }
+    return sum * (1.0f / settings.spp);
+    // SKELETON
+    //> // TODO(lab01): average settings.spp paths, each through a random point of the pixel
+    //> // (SampleStream(settings.seed, pixel, s), dimensions kDimPixelX/kDimPixelY).
+    //> // Until then: one path through the pixel's corner.
+    //> const SampleStream rng(settings.seed, pixel, 0);
+    //> sum = trace_path(scene, camera.ray_through(x, y), rng, settings.bounces);
+    //> return sum;
+    // END SOLUTION
+}

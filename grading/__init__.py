@@ -1,0 +1,1 @@
+"""Autograder helpers: PFM I/O (pfm), statistical image comparison (compare), heatmaps."""

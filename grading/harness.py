@@ -1,0 +1,121 @@
+"""The per-lab test harness: build lab binaries, run them, load their images, time them.
+
+Every lab binary takes the same command line (shared/DESIGN.md), so one harness serves all
+labs, the pytest suites and the grader alike.
+"""
+from __future__ import annotations
+
+import dataclasses
+import json
+import os
+import pathlib
+import subprocess
+import tempfile
+import time
+from typing import Callable, Sequence
+
+import numpy as np
+
+from grading.pfm import read_pfm
+
+ROOT = pathlib.Path(__file__).resolve().parent.parent
+SCENES = ROOT / "common" / "scenes"
+GOLDEN = ROOT / "reference" / "golden"
+
+_built: set[str] = set()
+
+
+def build(*targets: str) -> list[pathlib.Path]:
+    """Run `make TARGET...` once per process; return the binaries' paths."""
+    wanted = [t for t in targets if t not in _built]
+    if wanted:
+        subprocess.run(["make", "-s", "-C", str(ROOT), *wanted], check=True,
+                       stdout=subprocess.DEVNULL)
+        _built.update(wanted)
+    return [ROOT / t for t in targets]
+
+
+def available_cores() -> int:
+    """Cores this process may run on (what thresholds scale with)."""
+    return len(os.sched_getaffinity(0))
+
+
+@dataclasses.dataclass
+class Run:
+    """One finished run of a lab binary."""
+    returncode: int
+    stdout: str
+    stderr: str
+    json: dict | None       # the --json summary, when the run succeeded
+    image: np.ndarray | None  # (H, W, 3) float32 linear radiance, top row first
+
+
+def run_lab(binary: pathlib.Path | str, scene: pathlib.Path | str | None = None, *,
+            width: int | None = None, height: int | None = None, spp: int | None = None,
+            bounces: int | None = None, seed: int | None = None, threads: int | None = None,
+            extra: Sequence[str] = (), launcher: Sequence[str] = (), timeout: float = 600,
+            check: bool = True) -> Run:
+    """Render with a lab binary; returns its summary and PFM image.
+
+    `launcher` prefixes the command (e.g. mpirun ...). With check=True a non-zero exit
+    raises with the binary's stderr in the message.
+    """
+    with tempfile.TemporaryDirectory() as tmp:
+        pfm = pathlib.Path(tmp) / "image.pfm"
+        cmd = [*launcher, str(binary), "--quiet", "--json", "--pfm", str(pfm)]
+        for flag, value in (("--scene", scene), ("--width", width), ("--height", height),
+                            ("--spp", spp), ("--bounces", bounces), ("--seed", seed),
+                            ("--threads", threads)):
+            if value is not None:
+                cmd += [flag, str(value)]
+        cmd += list(extra)
+        p = subprocess.run(cmd, capture_output=True, text=True, timeout=timeout)
+        if check and p.returncode != 0:
+            raise RuntimeError(f"{' '.join(cmd)} exited {p.returncode}: {p.stderr.strip()}")
+        summary = json.loads(p.stdout.strip().splitlines()[-1]) if p.returncode == 0 else None
+        image = read_pfm(pfm) if p.returncode == 0 and pfm.exists() else None
+        return Run(p.returncode, p.stdout, p.stderr, summary, image)
+
+
+@dataclasses.dataclass
+class Golden:
+    """Converged reference data for one scene (made by tools/make_golden.py)."""
+    scene: pathlib.Path
+    mean: np.ndarray      # converged image
+    variance: np.ndarray  # per-pixel variance of a single path
+    meta: dict            # settings it was made with: width, height, bounces, golden_spp...
+
+
+def golden(name: str) -> Golden:
+    folder = GOLDEN / name
+    meta = json.loads((folder / "meta.json").read_text())
+    return Golden(ROOT / meta["scene"], read_pfm(folder / "golden.pfm"),
+                  read_pfm(folder / "variance.pfm"), meta)
+
+
+def best_of(fn: Callable[[], float], n: int) -> float:
+    """The smallest of n measurements: the least disturbed by everything else running."""
+    return min(fn() for _ in range(n))
+
+
+def render_seconds(binary, **kwargs) -> float:
+    """Render time the binary reports itself (render only, per DESIGN.md)."""
+    return run_lab(binary, **kwargs).json["seconds"]
+
+
+def interleaved_speedup(baseline: Callable[[], float], candidate: Callable[[], float],
+                        n: int = 3) -> tuple[float, float, float]:
+    """(speedup, best baseline seconds, best candidate seconds), measured alternately in one
+    run so that a machine slowing down or speeding up affects both sides alike."""
+    base, cand = [], []
+    for _ in range(n):
+        base.append(baseline())
+        cand.append(candidate())
+    return min(base) / min(cand), min(base), min(cand)
+
+
+def wall_seconds(cmd: Sequence[str]) -> float:
+    """Wall-clock time of a whole command (for launchers whose startup counts)."""
+    start = time.perf_counter()
+    subprocess.run(cmd, check=True, capture_output=True)
+    return time.perf_counter() - start

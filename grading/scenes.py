@@ -1,0 +1,102 @@
+"""Scenes made in code for checks whose answer is known in closed form, and scene scaling."""
+from __future__ import annotations
+
+import json
+import math
+import pathlib
+
+from grading.harness import SCENES
+
+
+def write_scene(path: pathlib.Path, scene: dict) -> pathlib.Path:
+    path.write_text(json.dumps(scene, indent=1))
+    return path
+
+
+def sphere_interior(albedo: float, radius: float, intensity: float) -> dict:
+    """Camera and point light at the centre of a diffuse sphere, seen from inside.
+
+    Every wall point is at distance R with the light along its normal, so next-event
+    estimation gives L1 = albedo/pi * I / R^2 there with zero variance, and the wall, being
+    uniformly bright, sends each point an irradiance of pi * L. Hence the radiance after B
+    interactions is exactly L1 * (1 + albedo + ... + albedo^(B-1)), at every pixel.
+    """
+    return {
+        "camera": {"position": [0, 0, 0], "look_at": [0, 0, -1], "up": [0, 1, 0], "vfov": 60},
+        "light": {"position": [0, 0, 0], "intensity": [intensity] * 3},
+        "materials": {"wall": {"type": "diffuse", "albedo": [albedo] * 3}},
+        "spheres": [{"center": [0, 0, 0], "radius": radius, "material": "wall"}],
+    }
+
+
+def sphere_interior_radiance(albedo: float, radius: float, intensity: float, bounces: int) -> float:
+    direct = albedo / math.pi * intensity / radius**2
+    return direct * sum(albedo**k for k in range(bounces))
+
+
+def lit_plane(albedo: float, height: float, intensity: float, vfov: float) -> dict:
+    """A camera above a large diffuse floor, looking straight down, light beside the camera.
+
+    With one bounce the radiance at floor point p is albedo/pi * I * cos(theta) / d^2: smooth,
+    known everywhere, so each pixel's expected value is an integral over the pixel.
+    """
+    half = 1000.0
+    return {
+        "camera": {"position": [0, height, 0], "look_at": [0, 0, 0], "up": [0, 0, -1],
+                   "vfov": vfov},
+        "light": {"position": [0.3 * height, height, 0.1 * height], "intensity": [intensity] * 3},
+        "materials": {"floor": {"type": "diffuse", "albedo": [albedo] * 3}},
+        "quads": [{"vertices": [[-half, 0, -half], [-half, 0, half], [half, 0, half],
+                                [half, 0, -half]], "material": "floor"}],
+    }
+
+
+def lit_plane_expected(scene: dict, width: int, height: int, subsamples: int = 8):
+    """Per-pixel expected radiance of lit_plane (one bounce), by a midpoint rule over
+    subsamples^2 points of each pixel: the integrand is smooth, so this is accurate to ~1e-5."""
+    import numpy as np
+    cam = scene["camera"]
+    h = cam["position"][1]
+    light = np.array(scene["light"]["position"])
+    intensity = scene["light"]["intensity"][0]
+    albedo = scene["materials"]["floor"]["albedo"][0]
+    half_h = math.tan(math.radians(cam["vfov"]) / 2)
+    half_w = half_h * width / height
+    # Camera frame looking down -y with up = -z: right = forward x up = (-y) x (-z) = +x.
+    offs = (np.arange(subsamples) + 0.5) / subsamples
+    xs = (np.arange(width)[:, None] + offs[None, :]).ravel()   # pixel-space x samples
+    ys = (np.arange(height)[:, None] + offs[None, :]).ravel()
+    u = -half_w + 2 * half_w * xs / width                       # along +x
+    v = half_h - 2 * half_h * ys / height                       # along up = -z
+    px = u[None, :] * h                                          # floor hit: t*(dir) with dir.y=-1
+    pz = -v[:, None] * h
+    px, pz = np.broadcast_arrays(px, pz)
+    to_light = np.stack([light[0] - px, np.full_like(px, light[1]), light[2] - pz], axis=-1)
+    d2 = (to_light**2).sum(-1)
+    cos = to_light[..., 1] / np.sqrt(d2)
+    radiance = albedo / math.pi * intensity * cos / d2
+    per_pixel = radiance.reshape(height, subsamples, width, subsamples).mean(axis=(1, 3))
+    return per_pixel
+
+
+def scaled(scene: dict, factor: float) -> dict:
+    """The same scene with every length multiplied by `factor` and the light's intensity by
+    factor^2, so that the image should not change at all."""
+    s = json.loads(json.dumps(scene))
+    mul = lambda p: [c * factor for c in p]  # noqa: E731
+    s["camera"]["position"] = mul(s["camera"]["position"])
+    s["camera"]["look_at"] = mul(s["camera"]["look_at"])
+    if "light" in s:
+        s["light"]["position"] = mul(s["light"]["position"])
+        s["light"]["intensity"] = [c * factor**2 for c in s["light"]["intensity"]]
+    for sp in s.get("spheres", []):
+        sp["center"] = mul(sp["center"])
+        sp["radius"] *= factor
+    for kind in ("triangles", "quads"):
+        for prim in s.get(kind, []):
+            prim["vertices"] = [mul(v) for v in prim["vertices"]]
+    return s
+
+
+def load(name: str) -> dict:
+    return json.loads((SCENES / f"{name}.json").read_text())

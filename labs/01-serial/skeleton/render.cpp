@@ -1,0 +1,24 @@
+// GENERATED from labs/01-serial/solution/render.cpp by tools/skeletons.py: edit this file freely,
+// it is yours. (Instructors: edit the solution and run `make skeletons`.)
+// Lab 01: the serial renderer, the baseline every speedup in this course is measured against.
+// The loop nest of Algorithm 1: pixels here; samples in render_pixel, bounces in trace_path,
+// primitives in closest_hit (all in path_tracer.h).
+#include "lab.h"
+#include "path_tracer.h"
+#include "timer.h"
+
+const char* const kLabName = "01-serial";
+
+RenderStats render(const RenderJob& job, Image& image) {
+    const SceneView scene = job.scene.view();
+    const RenderSettings& settings = job.settings;
+    const Timer timer;
+    // TODO(lab01): render every pixel of the image. Until then: only the left half.
+    for (int y = 0; y < settings.height; ++y) {
+        for (int x = 0; x < settings.width / 2; ++x) {
+            image.at(x, y) = render_pixel(scene, job.camera, settings, x, y);
+        }
+        job.progress.rows_done();
+    }
+    return {timer.seconds(), cpu_model_name() + ", 1 thread"};
+}

@@ -1,0 +1,600 @@
+// Strict scene loading: valid files load as written (quads as two triangles), and every
+// mistake is an InputError naming the file, the line and column of the offending token, and
+// what was expected.
+//
+// Error cases mark the offending token with '@' in the text: the test computes the expected
+// "line L, column C" from the marker's place, then removes it before parsing.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include "errors.h"
+#include "scene_loader.h"
+
+namespace {
+
+const char* const kName = "case.json";
+
+struct Marked {
+    std::string text;      // without the marker
+    std::string position;  // "line L, column C" of the marker
+};
+
+Marked unmark(const std::string& marked, char marker = '@') {
+    const size_t at = marked.find(marker);
+    EXPECT_NE(at, std::string::npos) << "test bug: no marker";
+    EXPECT_EQ(marked.find(marker, at + 1), std::string::npos) << "test bug: two markers";
+    int line = 1, column = 1;
+    for (size_t i = 0; i < at; ++i) {
+        if (marked[i] == '\n') {
+            ++line;
+            column = 1;
+        } else {
+            ++column;
+        }
+    }
+    std::string text = marked;
+    text.erase(at, 1);
+    return {text, "line " + std::to_string(line) + ", column " + std::to_string(column)};
+}
+
+// The message of the InputError that parsing throws, or "" (with a failure) if none.
+std::string error_of(const std::string& text) {
+    try {
+        parse_scene(text, kName);
+    } catch (const InputError& e) {
+        return e.what();
+    } catch (const std::exception& e) {
+        ADD_FAILURE() << "threw something other than InputError: " << e.what();
+        return "";
+    }
+    ADD_FAILURE() << "parsed without error:\n" << text;
+    return "";
+}
+
+// Parses `marked`, expects an InputError at the marker naming the file and every word.
+void expect_error(const std::string& marked, const std::vector<std::string>& words) {
+    const Marked m = unmark(marked);
+    const std::string message = error_of(m.text);
+    if (message.empty()) return;
+    EXPECT_NE(message.find(kName), std::string::npos) << "no file name in: " << message;
+    EXPECT_NE(message.find(m.position), std::string::npos)
+        << "expected " << m.position << " in: " << message;
+    for (const std::string& w : words)
+        EXPECT_NE(message.find(w), std::string::npos) << "no '" << w << "' in: " << message;
+    EXPECT_EQ(message.find('\n'), std::string::npos) << "not one line: " << message;
+}
+
+// A valid scene with a hole for one more top-level member and a sphere's fields.
+std::string scene_with(const std::string& sphere_fields, const std::string& extra = "") {
+    return "{\n"
+           "  \"camera\": { \"position\": [0, 0, 5], \"look_at\": [0, 0, 0] },\n"
+           "  \"materials\": {\n"
+           "    \"white\": { \"type\": \"diffuse\", \"albedo\": [0.5, 0.5, 0.5] }\n"
+           "  },\n" +
+           extra +
+           "  \"spheres\": [\n"
+           "    { " +
+           sphere_fields +
+           " }\n"
+           "  ]\n"
+           "}\n";
+}
+
+const std::string kGoodSphere = "\"center\": [0, 0, 0], \"radius\": 1, \"material\": \"white\"";
+
+}  // namespace
+
+// ---- valid scenes ------------------------------------------------------------------------
+
+TEST(SceneLoader, CornellLoads) {
+    const Scene s = load_scene(std::string(RT_SOURCE_DIR) + "/common/scenes/cornell.json");
+    EXPECT_EQ(s.spheres.size(), 1u);
+    EXPECT_EQ(s.triangles.size(), 10u);  // five quads, two triangles each
+    EXPECT_EQ(s.materials.size(), 4u);
+    EXPECT_EQ(s.material_names.size(), s.materials.size());
+    EXPECT_TRUE(s.has_light);
+    // The light is inside the unit box and shines; the camera looks in through the open side.
+    for (float c : {s.light.position.x, s.light.position.y}) {
+        EXPECT_GT(c, 0.0f);
+        EXPECT_LT(c, 1.0f);
+    }
+    EXPECT_GT(s.light.intensity.x, 0.0f);
+    EXPECT_GT(s.camera.position.z, 0.0f);
+    EXPECT_GT(s.camera.vfov_degrees, 0.0f);
+    EXPECT_GT(s.spheres[0].radius, 0.0f);
+    // The design's baseline: 600x600, 512 spp, 4 bounces.
+    EXPECT_EQ(s.render.width, 600);
+    EXPECT_EQ(s.render.height, 600);
+    EXPECT_EQ(s.render.spp, 512);
+    EXPECT_EQ(s.render.bounces, 4);
+    for (const Triangle& t : s.triangles) {
+        EXPECT_NEAR(length(t.normal), 1.0f, 1e-6f);
+        ASSERT_GE(t.material, 0);
+        ASSERT_LT(t.material, static_cast<int>(s.materials.size()));
+    }
+    // The sphere uses "ball".
+    EXPECT_EQ(s.material_names[s.spheres[0].material], "ball");
+    EXPECT_EQ(s.materials[s.spheres[0].material].type, MaterialType::Diffuse);
+    // Every wall faces into the box, towards its centre (0.5, 0.5, -0.5).
+    for (const Triangle& t : s.triangles) {
+        const Vec3 to_centre = Vec3(0.5f, 0.5f, -0.5f) - t.v0;
+        EXPECT_GT(dot(t.normal, to_centre), 0.0f);
+    }
+}
+
+TEST(SceneLoader, EveryShippedSceneLoads) {
+    const std::string dir = std::string(RT_SOURCE_DIR) + "/common/scenes";
+    int count = 0;
+    for (const auto& entry : std::filesystem::directory_iterator(dir)) {
+        if (entry.path().extension() != ".json") continue;
+        ++count;
+        EXPECT_NO_THROW(load_scene(entry.path().string())) << entry.path();
+    }
+    EXPECT_GE(count, 1);
+}
+
+TEST(SceneLoader, MissingFileIsAnInputErrorNamingIt) {
+    const std::string path = std::string(RT_SOURCE_DIR) + "/no/such/scene.json";
+    try {
+        load_scene(path);
+        FAIL() << "no error";
+    } catch (const InputError& e) {
+        EXPECT_NE(std::string(e.what()).find(path), std::string::npos) << e.what();
+    }
+}
+
+TEST(SceneLoader, MinimalSceneGetsDefaults) {
+    const Scene s = parse_scene(R"({"camera": {"position": [0, 0, 5], "look_at": [0, 0, 0]},
+        "materials": {"m": {"type": "diffuse", "albedo": [0.1, 0.2, 0.3]}}})",
+                                "min");
+    EXPECT_EQ(s.name, "min");
+    EXPECT_FALSE(s.has_light);
+    EXPECT_TRUE(is_black(s.background));
+    EXPECT_TRUE(s.spheres.empty());
+    EXPECT_TRUE(s.triangles.empty());
+    EXPECT_EQ(s.render.width, 600);
+    EXPECT_EQ(s.render.height, 600);
+    EXPECT_EQ(s.render.spp, 512);
+    EXPECT_EQ(s.render.bounces, 4);
+    EXPECT_EQ(s.render.seed, 0u);
+    EXPECT_FLOAT_EQ(s.camera.up.y, 1.0f);
+    EXPECT_FLOAT_EQ(s.camera.vfov_degrees, 55.0f);
+    ASSERT_EQ(s.materials.size(), 1u);
+    EXPECT_EQ(s.materials[0].type, MaterialType::Diffuse);
+    EXPECT_FLOAT_EQ(s.materials[0].albedo.z, 0.3f);
+}
+
+TEST(SceneLoader, EverythingAsWritten) {
+    const Scene s = parse_scene(R"({
+  "camera": { "position": [1, 2, 3], "look_at": [0, 0, 0], "up": [0, 0, 1], "vfov": 40 },
+  "background": [0.1, 0.2, 0.3],
+  "light": { "position": [4, 5, 6], "intensity": [7, 8, 9] },
+  "materials": {
+    "glass": { "type": "glass", "ior": 1.5 },
+    "white": { "type": "diffuse", "albedo": [0.73, 0.73, 0.73] },
+    "steel": { "type": "mirror",  "albedo": [0.9, 0.8, 0.7] }
+  },
+  "spheres":   [ { "center": [0.5, 0.2, -0.25], "radius": 0.2, "material": "steel" },
+                 { "center": [1, 1, 1], "radius": 3e-4, "material": "glass" } ],
+  "triangles": [ { "vertices": [[0,0,0], [1,0,0], [1,0,-1]], "material": "white" } ],
+  "quads":     [ { "vertices": [[0,0,0], [0,1,0], [0,1,-1], [0,0,-1]], "material": "glass" } ],
+  "render":    { "width": 320, "height": 240, "spp": 16, "bounces": 7, "seed": 99 }
+})",
+                                kName);
+    EXPECT_FLOAT_EQ(s.camera.up.z, 1.0f);
+    EXPECT_FLOAT_EQ(s.camera.vfov_degrees, 40.0f);
+    EXPECT_FLOAT_EQ(s.background.y, 0.2f);
+    EXPECT_TRUE(s.has_light);
+    EXPECT_FLOAT_EQ(s.light.position.z, 6.0f);
+    EXPECT_FLOAT_EQ(s.light.intensity.x, 7.0f);
+    ASSERT_EQ(s.materials.size(), 3u);
+    auto material = [&](const std::string& name) -> const Material& {
+        for (size_t i = 0; i < s.material_names.size(); ++i)
+            if (s.material_names[i] == name) return s.materials[i];
+        ADD_FAILURE() << "no material " << name;
+        return s.materials[0];
+    };
+    EXPECT_EQ(material("glass").type, MaterialType::Glass);
+    EXPECT_FLOAT_EQ(material("glass").ior, 1.5f);
+    EXPECT_EQ(material("steel").type, MaterialType::Mirror);
+    EXPECT_FLOAT_EQ(material("steel").albedo.z, 0.7f);
+    EXPECT_EQ(material("white").type, MaterialType::Diffuse);
+    ASSERT_EQ(s.spheres.size(), 2u);
+    EXPECT_EQ(s.material_names[s.spheres[0].material], "steel");
+    EXPECT_EQ(s.material_names[s.spheres[1].material], "glass");
+    EXPECT_FLOAT_EQ(s.spheres[1].radius, 3e-4f);
+    // One triangle plus a quad as two: (v0 v1 v2) and (v0 v2 v3), same material.
+    ASSERT_EQ(s.triangles.size(), 3u);
+    EXPECT_EQ(s.material_names[s.triangles[0].material], "white");
+    const Triangle& q0 = s.triangles[1];
+    const Triangle& q1 = s.triangles[2];
+    EXPECT_EQ(s.material_names[q0.material], "glass");
+    EXPECT_EQ(q1.material, q0.material);
+    EXPECT_FLOAT_EQ(q0.v1.y, 1.0f);
+    EXPECT_FLOAT_EQ(q0.v2.z, -1.0f);
+    EXPECT_FLOAT_EQ(q1.v1.z, -1.0f);  // v2 of the quad
+    EXPECT_FLOAT_EQ(q1.v1.y, 1.0f);
+    EXPECT_FLOAT_EQ(q1.v2.y, 0.0f);   // v3 of the quad
+    EXPECT_FLOAT_EQ(q1.v2.z, -1.0f);
+    EXPECT_FLOAT_EQ(q0.normal.x, q1.normal.x);  // a planar quad: both halves face one way
+    EXPECT_FLOAT_EQ(std::fabs(q0.normal.x), 1.0f);
+    EXPECT_EQ(s.render.width, 320);
+    EXPECT_EQ(s.render.height, 240);
+    EXPECT_EQ(s.render.spp, 16);
+    EXPECT_EQ(s.render.bounces, 7);
+    EXPECT_EQ(s.render.seed, 99u);
+}
+
+TEST(SceneLoader, ViewMirrorsTheArrays) {
+    const Scene s = load_scene(std::string(RT_SOURCE_DIR) + "/common/scenes/cornell.json");
+    const SceneView v = s.view();
+    EXPECT_EQ(v.spheres, s.spheres.data());
+    EXPECT_EQ(v.num_spheres, 1);
+    EXPECT_EQ(v.triangles, s.triangles.data());
+    EXPECT_EQ(v.num_triangles, 10);
+    EXPECT_EQ(v.num_materials, 4);
+    EXPECT_EQ(v.materials, s.materials.data());
+    EXPECT_TRUE(v.has_light);
+    EXPECT_EQ(v.light.intensity.z, s.light.intensity.z);
+    EXPECT_EQ(v.light.position.x, s.light.position.x);
+    EXPECT_EQ(v.background.x, s.background.x);
+}
+
+// ---- JSON syntax ---------------------------------------------------------------------------
+
+TEST(SceneLoaderErrors, TrailingComma) {
+    expect_error("{\n  \"camera\": { \"position\": [0, 0, 5], \"look_at\": [0, 0, 0] },\n@}\n",
+                 {"invalid JSON", "expected"});
+}
+
+TEST(SceneLoaderErrors, MissingCommaBetweenMembers) {
+    expect_error(
+        "{\n"
+        "  \"camera\": { \"position\": [0, 0, 5], \"look_at\": [0, 0, 0] }\n"
+        "  @\"materials\": {}\n"
+        "}\n",
+        {"invalid JSON", "expected"});
+}
+
+TEST(SceneLoaderErrors, MissingCommaInArray) {
+    expect_error("{\n  \"camera\": { \"position\": [0, 0 @5], \"look_at\": [0, 0, 0] }\n}\n",
+                 {"invalid JSON", "expected"});
+}
+
+// Lexical errors are reported at the first character that cannot continue the token.
+TEST(SceneLoaderErrors, BadLiteral) {
+    expect_error("{\n  \"background\": n@ope\n}\n", {"invalid JSON"});
+    expect_error("{\n  \"background\": [0, 0, @.5]\n}\n", {"invalid JSON"});
+}
+
+TEST(SceneLoaderErrors, UnterminatedString) {
+    expect_error("{\n  \"camera\": { \"position\": [0, 0, 5], \"look_at\": [0, 0, 0] },\n"
+                 "  \"materials: {}@\n}\n",
+                 {"invalid JSON"});
+}
+
+TEST(SceneLoaderErrors, EmptyText) {
+    expect_error("@", {"invalid JSON"});
+    expect_error("\n\n  @", {"invalid JSON"});
+}
+
+TEST(SceneLoaderErrors, TrailingGarbageAfterTheObject) {
+    expect_error(scene_with(kGoodSphere) + "@x\n", {"invalid JSON"});
+}
+
+// ---- structure -----------------------------------------------------------------------------
+
+TEST(SceneLoaderErrors, UnknownTopLevelKey) {
+    expect_error(scene_with(kGoodSphere, "  @\"lights\": [],\n"),
+                 {"unknown key", "\"lights\"", "\"light\"", "expected"});
+}
+
+TEST(SceneLoaderErrors, RootNotAnObject) {
+    expect_error("\n  @[1, 2, 3]\n", {"expected an object"});
+}
+
+TEST(SceneLoaderErrors, UnknownKeyInsideMaterial) {
+    expect_error(
+        "{\n"
+        "  \"camera\": { \"position\": [0, 0, 5], \"look_at\": [0, 0, 0] },\n"
+        "  \"materials\": {\n"
+        "    \"white\": { \"type\": \"diffuse\",\n"
+        "               @\"colour\": [0.5, 0.5, 0.5] }\n"
+        "  }\n"
+        "}\n",
+        {"unknown key", "\"colour\"", "\"albedo\""});
+}
+
+TEST(SceneLoaderErrors, KeyOfAnotherMaterialType) {
+    // "ior" belongs to glass, not to a diffuse material.
+    expect_error(
+        "{\n"
+        "  \"camera\": { \"position\": [0, 0, 5], \"look_at\": [0, 0, 0] },\n"
+        "  \"materials\": {\n"
+        "    \"white\": { \"type\": \"diffuse\", \"albedo\": [0.5, 0.5, 0.5], @\"ior\": 1.5 }\n"
+        "  }\n"
+        "}\n",
+        {"unknown key", "\"ior\""});
+}
+
+TEST(SceneLoaderErrors, UnknownMaterialType) {
+    expect_error(
+        "{\n"
+        "  \"camera\": { \"position\": [0, 0, 5], \"look_at\": [0, 0, 0] },\n"
+        "  \"materials\": {\n"
+        "    \"white\": { \"type\": @\"lambert\", \"albedo\": [0.5, 0.5, 0.5] }\n"
+        "  }\n"
+        "}\n",
+        {"unknown material type", "lambert", "\"diffuse\"", "\"glass\""});
+}
+
+TEST(SceneLoaderErrors, MaterialTypeNotAString) {
+    expect_error(
+        "{\n"
+        "  \"camera\": { \"position\": [0, 0, 5], \"look_at\": [0, 0, 0] },\n"
+        "  \"materials\": {\n"
+        "    \"white\": { \"type\": @3, \"albedo\": [0.5, 0.5, 0.5] }\n"
+        "  }\n"
+        "}\n",
+        {"material type", "expected"});
+}
+
+TEST(SceneLoaderErrors, UndefinedMaterialName) {
+    expect_error(scene_with("\"center\": [0, 0, 0], \"radius\": 1, \"material\": @\"chrome\""),
+                 {"unknown material", "chrome", "materials"});
+}
+
+TEST(SceneLoaderErrors, MaterialNameNotAString) {
+    expect_error(scene_with("\"center\": [0, 0, 0], \"radius\": 1, \"material\": @0"),
+                 {"expected a material name", "number"});
+}
+
+TEST(SceneLoaderErrors, DuplicateKey) {
+    expect_error(
+        "{\n"
+        "  \"camera\": { \"position\": [0, 0, 5], \"look_at\": [0, 0, 0] },\n"
+        "  \"materials\": {\n"
+        "    \"white\": { \"type\": \"diffuse\", \"albedo\": [0.5, 0.5, 0.5] }\n"
+        "  },\n"
+        "  @\"camera\": { \"position\": [0, 0, 9], \"look_at\": [0, 0, 0] }\n"
+        "}\n",
+        {"duplicate key", "\"camera\""});
+    expect_error(scene_with("\"center\": [0, 0, 0], \"radius\": 1,\n      @\"radius\": 2, "
+                            "\"material\": \"white\""),
+                 {"duplicate key", "\"radius\""});
+}
+
+TEST(SceneLoaderErrors, MissingCamera) {
+    expect_error(
+        "\n"
+        "@{\n"
+        "  \"materials\": {\n"
+        "    \"white\": { \"type\": \"diffuse\", \"albedo\": [0.5, 0.5, 0.5] }\n"
+        "  }\n"
+        "}\n",
+        {"missing required key", "\"camera\""});
+}
+
+TEST(SceneLoaderErrors, MissingRequiredInsideAnObject) {
+    // Reported at the object that lacks the key.
+    expect_error(
+        "{\n"
+        "  \"camera\": { \"position\": [0, 0, 5], \"look_at\": [0, 0, 0] },\n"
+        "  \"materials\": { \"w\": { \"type\": \"diffuse\", \"albedo\": [0.5, 0.5, 0.5] } },\n"
+        "  \"spheres\": [\n"
+        "    { \"center\": [0, 0, 0], \"radius\": 1, \"material\": \"w\" },\n"
+        "    @{ \"center\": [0, 0, 0], \"material\": \"w\" }\n"
+        "  ]\n"
+        "}\n",
+        {"missing required key", "\"radius\"", "/spheres/1"});
+    expect_error(
+        "{\n"
+        "  \"camera\": { \"position\": [0, 0, 5], \"look_at\": [0, 0, 0] },\n"
+        "  \"materials\": { \"w\": @{ \"albedo\": [0.5, 0.5, 0.5] } }\n"
+        "}\n",
+        {"missing required key", "\"type\""});
+    expect_error(
+        "{ \"camera\": @{ \"look_at\": [0, 0, 0] },\n"
+        "  \"materials\": { \"w\": { \"type\": \"diffuse\", \"albedo\": [0.5, 0.5, 0.5] } }\n"
+        "}\n",
+        {"missing required key", "\"position\""});
+    expect_error(
+        "{ \"camera\": { \"position\": [0, 0, 5], \"look_at\": [0, 0, 0] },\n"
+        "  \"materials\": @{ }\n"
+        "}\n",
+        {"expected an object of named materials"});
+}
+
+// ---- types ---------------------------------------------------------------------------------
+
+TEST(SceneLoaderErrors, StringWhereNumberExpected) {
+    expect_error(scene_with("\"center\": [0, 0, 0], \"radius\": @\"big\", \"material\": \"white\""),
+                 {"expected a number", "string", "radius"});
+}
+
+TEST(SceneLoaderErrors, StringInsideAVector) {
+    expect_error(scene_with("\"center\": [0, @\"0\", 0], \"radius\": 1, \"material\": \"white\""),
+                 {"expected a number", "center"});
+}
+
+TEST(SceneLoaderErrors, ArrayOfTwoWhereThreeExpected) {
+    expect_error(scene_with("\"center\": @[0, 0], \"radius\": 1, \"material\": \"white\""),
+                 {"expected an array of 3 numbers", "an array of 2", "center"});
+}
+
+TEST(SceneLoaderErrors, ArrayOfFourWhereThreeExpected) {
+    expect_error(
+        "{\n"
+        "  \"camera\": { \"position\": @[0, 0, 5, 1], \"look_at\": [0, 0, 0] },\n"
+        "  \"materials\": { \"w\": { \"type\": \"diffuse\", \"albedo\": [0.5, 0.5, 0.5] } }\n"
+        "}\n",
+        {"expected an array of 3 numbers", "an array of 4"});
+}
+
+TEST(SceneLoaderErrors, NumberTooLargeForFloat) {
+    expect_error(scene_with("\"center\": [0, 0, @1e39], \"radius\": 1, \"material\": \"white\""),
+                 {"float range"});
+}
+
+TEST(SceneLoaderErrors, QuadWithThreeVertices) {
+    expect_error(scene_with(kGoodSphere,
+                            "  \"quads\": [ { \"vertices\": @[[0,0,0], [1,0,0], [1,1,0]],\n"
+                            "                 \"material\": \"white\" } ],\n"),
+                 {"expected an array of 4 points", "an array of 3"});
+}
+
+TEST(SceneLoaderErrors, SpheresNotAnArray) {
+    expect_error(
+        "{\n"
+        "  \"camera\": { \"position\": [0, 0, 5], \"look_at\": [0, 0, 0] },\n"
+        "  \"materials\": { \"w\": { \"type\": \"diffuse\", \"albedo\": [0.5, 0.5, 0.5] } },\n"
+        "  \"spheres\": @{ \"center\": [0, 0, 0], \"radius\": 1, \"material\": \"w\" }\n"
+        "}\n",
+        {"expected an array", "an object"});
+}
+
+// ---- values --------------------------------------------------------------------------------
+
+TEST(SceneLoaderErrors, NegativeRadius) {
+    expect_error(scene_with("\"center\": [0, 0, 0], \"radius\": @-1, \"material\": \"white\""),
+                 {"expected a radius > 0", "radius"});
+    expect_error(scene_with("\"center\": [0, 0, 0], \"radius\": @-1e-3, \"material\": \"white\""),
+                 {"expected a radius > 0"});
+}
+
+TEST(SceneLoaderErrors, ZeroRadius) {
+    expect_error(scene_with("\"center\": [0, 0, 0], \"radius\": @0, \"material\": \"white\""),
+                 {"expected a radius > 0"});
+    expect_error(scene_with("\"center\": [0, 0, 0], \"radius\":\n        @0.0, \"material\": \"white\""),
+                 {"expected a radius > 0"});
+}
+
+TEST(SceneLoaderErrors, AlbedoAboveOne) {
+    // The offending value is the array (or, better still, its component 1.2); accept either.
+    const std::string marked =
+        "{\n"
+        "  \"camera\": { \"position\": [0, 0, 5], \"look_at\": [0, 0, 0] },\n"
+        "  \"materials\": {\n"
+        "    \"white\": { \"type\": \"diffuse\", \"albedo\": @[0.5, #1.2, 0.5] }\n"
+        "  }\n"
+        "}\n";
+    std::string array_marked = marked, component_marked = marked;
+    array_marked.erase(array_marked.find('#'), 1);
+    component_marked.erase(component_marked.find('@'), 1);
+    const Marked a = unmark(array_marked);
+    const Marked c = unmark(component_marked, '#');
+    const std::string message = error_of(a.text);
+    EXPECT_NE(message.find(kName), std::string::npos) << message;
+    EXPECT_TRUE(message.find(a.position) != std::string::npos ||
+                message.find(c.position) != std::string::npos)
+        << "expected " << a.position << " or " << c.position << " in: " << message;
+    EXPECT_NE(message.find("albedo"), std::string::npos) << message;
+    EXPECT_NE(message.find("[0, 1]"), std::string::npos) << message;
+}
+
+TEST(SceneLoaderErrors, NegativeAlbedoAndIntensity) {
+    expect_error(
+        "{\n"
+        "  \"camera\": { \"position\": [0, 0, 5], \"look_at\": [0, 0, 0] },\n"
+        "  \"materials\": {\n"
+        "    \"white\": { \"type\": \"mirror\", \"albedo\": @[0.5, -0.1, 0.5] }\n"
+        "  }\n"
+        "}\n",
+        {"expected components >= 0"});
+    expect_error(scene_with(kGoodSphere,
+                            "  \"light\": { \"position\": [0, 9, 0], \"intensity\": @[1, 1, -1] },\n"),
+                 {"expected components >= 0"});
+}
+
+TEST(SceneLoaderErrors, IorOutOfRange) {
+    expect_error(
+        "{\n"
+        "  \"camera\": { \"position\": [0, 0, 5], \"look_at\": [0, 0, 0] },\n"
+        "  \"materials\": { \"g\": { \"type\": \"glass\", \"ior\": @0.5 } }\n"
+        "}\n",
+        {"index of refraction"});
+}
+
+TEST(SceneLoaderErrors, VfovOutOfRange) {
+    for (const char* bad : {"0", "180", "-30", "360", "1e9"}) {
+        expect_error(
+            std::string("{\n"
+                        "  \"camera\": { \"position\": [0, 0, 5], \"look_at\": [0, 0, 0],\n"
+                        "              \"vfov\": @") +
+                bad +
+                " },\n"
+                "  \"materials\": { \"w\": { \"type\": \"diffuse\", \"albedo\": [0.5, 0.5, 0.5] } }\n"
+                "}\n",
+            {"field of view", "(0, 180)"});
+    }
+    expect_error(
+        "{\n"
+        "  \"camera\": { \"position\": [0, 0, 5], \"look_at\": [0, 0, 0], \"vfov\": @\"wide\" },\n"
+        "  \"materials\": { \"w\": { \"type\": \"diffuse\", \"albedo\": [0.5, 0.5, 0.5] } }\n"
+        "}\n",
+        {"expected a number", "string"});
+}
+
+TEST(SceneLoaderErrors, CameraLookingAtItself) {
+    expect_error(
+        "{\n"
+        "  \"camera\": { \"position\": [1, 2, 3], \"look_at\": @[1, 2, 3] },\n"
+        "  \"materials\": { \"w\": { \"type\": \"diffuse\", \"albedo\": [0.5, 0.5, 0.5] } }\n"
+        "}\n",
+        {"look_at", "different from the camera position"});
+    expect_error(
+        "{\n"
+        "  \"camera\": { \"position\": [0, 5, 0], \"look_at\": [0, 0, 0], \"up\": @[0, 2, 0] },\n"
+        "  \"materials\": { \"w\": { \"type\": \"diffuse\", \"albedo\": [0.5, 0.5, 0.5] } }\n"
+        "}\n",
+        {"up", "not parallel"});
+}
+
+TEST(SceneLoaderErrors, RenderWidthZeroOrAbsurd) {
+    for (const char* bad : {"0", "-5", "16385", "100000", "1e9"}) {
+        expect_error(scene_with(kGoodSphere, std::string("  \"render\": { \"height\": 100,\n"
+                                                         "              \"width\": @") +
+                                                 bad + " },\n"),
+                     {"width", "expected an integer"});
+    }
+    expect_error(scene_with(kGoodSphere, "  \"render\": { \"width\": @600.5 },\n"),
+                 {"width", "expected an integer", "a number"});
+    expect_error(scene_with(kGoodSphere, "  \"render\": { \"width\": @\"600\" },\n"),
+                 {"width", "expected an integer", "a string"});
+    expect_error(scene_with(kGoodSphere, "  \"render\": { \"spp\": @0 },\n"), {"spp", "1.."});
+    expect_error(scene_with(kGoodSphere, "  \"render\": { \"bounces\": @0 },\n"), {"bounces"});
+    expect_error(scene_with(kGoodSphere, "  \"render\": { \"height\": @16385 },\n"),
+                 {"height", "16384"});
+    expect_error(scene_with(kGoodSphere, "  \"render\": { \"spp\": 3, @\"samples\": 3 },\n"),
+                 {"unknown key", "\"samples\"", "\"spp\""});
+}
+
+TEST(SceneLoaderErrors, RenderLimitsAreInclusive) {
+    const Scene s = parse_scene(
+        scene_with(kGoodSphere, "  \"render\": { \"width\": 16384, \"height\": 1, \"bounces\": 64 },\n"),
+        kName);
+    EXPECT_EQ(s.render.width, 16384);
+    EXPECT_EQ(s.render.height, 1);
+    EXPECT_EQ(s.render.bounces, 64);
+}
+
+// Keys with the characters a JSON pointer escapes ('/' and '~') must still be located.
+TEST(SceneLoaderErrors, UnknownKeyWithSlashIsLocated) {
+    expect_error(scene_with(kGoodSphere, "  @\"light/position\": [0, 1, 0],\n"),
+                 {"unknown key", "\"light/position\""});
+}
+
+TEST(SceneLoaderErrors, MaterialNameWithSlashIsLocated) {
+    expect_error(
+        "{\n"
+        "  \"camera\": { \"position\": [0, 0, 5], \"look_at\": [0, 0, 0] },\n"
+        "  \"materials\": {\n"
+        "    \"red/matte\": { \"type\": @\"paint\" }\n"
+        "  }\n"
+        "}\n",
+        {"unknown material type"});
+}
