@@ -21,7 +21,8 @@ COMMON_SRC := common/scene_loader.cpp common/image.cpp common/cli.cpp common/pro
 COMMON_OBJ := $(COMMON_SRC:%.cpp=$(BUILD)/%.o)
 MAIN_OBJ   := $(BUILD)/common/main.o
 
-.PHONY: all help deps labs test test-unit test-labs skeletons check-skeletons golden bench \
+PHONY_EXTRA := print-build-command
+.PHONY: all help deps labs $(PHONY_EXTRA) test test-unit test-labs skeletons check-skeletons golden bench tradeoff \
         clean
 .DEFAULT_GOAL := help
 
@@ -30,7 +31,8 @@ help:
 	@echo "make lab01-ref    build the lab-01 reference solution into ./lab01-ref"
 	@echo "make deps         install what is missing (JSON library, OpenMPI, pytest, numpy)"
 	@echo "make test         build everything and run every test"
-	@echo "make bench        time the lab-01 reference on the Cornell baseline"
+	@echo "make bench        time the lab-01 reference on the Cornell baseline (minutes)"
+	@echo "make tradeoff     error against time: RMSE vs spp for the lab-01 reference"
 	@echo "make golden       regenerate the golden images in reference/ (minutes)"
 	@echo "make skeletons    regenerate the skeletons from the solutions"
 	@echo "make clean        remove build products"
@@ -83,7 +85,14 @@ golden: lab01-ref
 	$(PYTHON) tools/make_golden.py
 
 bench: lab01-ref
-	$(PYTHON) tools/bench_serial.py
+	$(PYTHON) tools/bench_serial.py baseline
+
+tradeoff: lab01-ref
+	$(PYTHON) tools/bench_serial.py tradeoff
+
+# The exact compiler command lab binaries are built with (the mutation tests reuse it).
+print-build-command:
+	@echo $(CXX) $(CXXFLAGS)
 
 clean:
 	rm -rf $(BUILD) $(LAB_BINARIES) .pytest_cache

@@ -74,6 +74,22 @@ def check_lit_plane(binary) -> CheckResult:
                        f" (allowed 3e-3, 2e-2)")
 
 
+def check_glass_slab(binary) -> CheckResult:
+    """Closed form: Fresnel reflectance of a glass pane at normal incidence."""
+    scene = scenes.glass_slab(ior=1.5, albedo=0.8, intensity=4.0)
+    worst = 0.0
+    with tempfile.TemporaryDirectory() as tmp:
+        path = scenes.write_scene(pathlib.Path(tmp) / "slab.json", scene)
+        for b in (2, 4):
+            # 32x32 pixels x 256 paths, each reflecting with probability ~4%: the mean has a
+            # relative standard error of about 1%, so 5% is a five-sigma bound.
+            image = run_lab(binary, path, width=32, height=32, spp=256, bounces=b, seed=5).image
+            want = scenes.glass_slab_radiance(scene, b)
+            worst = max(worst, abs(float(image.mean()) / want - 1.0))
+    return CheckResult("analytic glass pane (Fresnel)", worst < 0.05,
+                       f"largest relative error of the mean {worst:.2%} (allowed 5%)")
+
+
 SCALE_FACTORS = (1e-4, 1e-2, 1e3, 1e5)
 
 
@@ -119,6 +135,7 @@ def correctness_checks(binary) -> list[CheckResult]:
     return [
         check_sphere_interior(binary),
         check_lit_plane(binary),
+        check_glass_slab(binary),
         check_golden(binary, "cornell"),
         check_golden(binary, "showcase"),
         check_scale_invariance(binary),

@@ -331,7 +331,8 @@ class Report:
         if self.worst_block is not None:
             w = self.worst_block
             L.append(f"  worst block: {w.block_size}x{w.block_size} at x={w.x0}, y={w.y0},"
-                     f" channel {CHANNEL_NAMES[w.channel] if w.channel < 3 else w.channel}, z {_fmt_z(w.z)}")
+                     f" channel {CHANNEL_NAMES[w.channel] if w.channel < 3 else w.channel}, z {_fmt_z(w.z)}"
+                     f" (limit +-{self.critical_z:.2f})")
         if self.n_failed:
             shown = len(self.failures)
             L.append(f"  failing tests: {self.n_failed}"
@@ -342,6 +343,7 @@ class Report:
                 rel_s = f"{rel * 100:+8.1f}%" if rel is not None else f"{'-':>9}"
                 ch = CHANNEL_NAMES[f.channel] if f.channel < 3 else str(f.channel)
                 L.append(f"    {f.where():<40} {ch:>2} {_fmt_z(f.z):>9} {f.mean_diff:>+11.4g} {rel_s}")
+        if not self.passed:
             L.extend("  " + h for h in self._hints())
         if self.heatmap_path:
             L.append(f"  heatmap of per-block |z| (blue 0, white at the limit, red >= 2x the limit;"
@@ -350,6 +352,9 @@ class Report:
 
     def _hints(self) -> list[str]:
         hints = []
+        if self.nan_count or self.inf_count:
+            hints.append("hint: NaN/Inf usually come from 0/0 or x/0: a zero pdf, normalising a"
+                         " zero-length vector, or sqrt/log of a negative number.")
         global_fail = [f for f in self.failures if f.block_size == 0]
         if global_fail:
             direction = "bright" if global_fail[0].z > 0 else "dark"
@@ -420,7 +425,11 @@ def _check_inputs(image, golden, variance, test_spp, golden_spp, alpha, block_si
         raise InputError("variance image contains negative values")
     n = _positive("test_spp", test_spp)
     big_n = _positive("golden_spp", golden_spp)
-    if not (isinstance(alpha, (int, float)) and 0.0 < alpha < 1.0):
+    try:
+        alpha_ok = 0.0 < float(alpha) < 1.0
+    except (TypeError, ValueError):
+        alpha_ok = False
+    if not alpha_ok:
         raise InputError(f"alpha must be in (0, 1), got {alpha!r}")
     sizes = []
     for b in block_sizes:
@@ -679,12 +688,17 @@ def main(argv: Sequence[str] | None = None) -> int:
         except ValueError:
             raise InputError(f"--blocks: expected comma-separated integers, got {args.blocks!r}") from None
         heatmap_path = None if args.no_heatmap else (args.heatmap or _default_heatmap_path(args.image))
-        report = compare_files(args.image, args.golden, args.spp, alpha=args.alpha,
-                               block_sizes=blocks, heatmap_path=heatmap_path)
+        try:
+            report = compare_files(args.image, args.golden, args.spp, alpha=args.alpha,
+                                   block_sizes=blocks, heatmap_path=heatmap_path)
+        except OSError as e:  # the heatmap could not be written: still give the verdict
+            print(f"warning: cannot write the heatmap {heatmap_path}: {e}", file=sys.stderr)
+            report = compare_files(args.image, args.golden, args.spp, alpha=args.alpha,
+                                   block_sizes=blocks)
     except (InputError, PFMError) as e:
         print(f"error: {e}", file=sys.stderr)
         return 2
-    except OSError as e:  # e.g. the heatmap cannot be written
+    except OSError as e:
         print(f"error: {e}", file=sys.stderr)
         return 2
     print(report.table())

@@ -79,6 +79,42 @@ def lit_plane_expected(scene: dict, width: int, height: int, subsamples: int = 8
     return per_pixel
 
 
+def glass_slab(ior: float, albedo: float, intensity: float) -> dict:
+    """A camera looking straight at a thick glass pane, a lit diffuse wall behind the camera.
+
+    The pane sends the camera only what it reflects of the wall. With a narrow field of view
+    every ray meets the pane at normal incidence, reflectance R = ((n-1)/(n+1))^2, so with two
+    interactions (pane, wall) the pixel's expected radiance is R * L_wall; with four, light
+    that refracts in, reflects off the back face and refracts out adds R (1-R)^2 L_wall.
+    """
+    big = 50.0
+    def quad(z):
+        return [[-big, -big, z], [big, -big, z], [big, big, z], [-big, big, z]]
+    return {
+        "camera": {"position": [0, 0, 0], "look_at": [0, 0, -1], "up": [0, 1, 0], "vfov": 0.5},
+        "light": {"position": [0, 0.3, 0.5], "intensity": [intensity] * 3},
+        "materials": {"glass": {"type": "glass", "ior": ior},
+                      "wall": {"type": "diffuse", "albedo": [albedo] * 3}},
+        "quads": [{"vertices": quad(-1.0), "material": "glass"},
+                  {"vertices": quad(-1.1), "material": "glass"},
+                  {"vertices": quad(1.0), "material": "wall"}],
+    }
+
+
+def glass_slab_radiance(scene: dict, bounces: int) -> float:
+    ior = scene["materials"]["glass"]["ior"]
+    albedo = scene["materials"]["wall"]["albedo"][0]
+    intensity = scene["light"]["intensity"][0]
+    light = scene["light"]["position"]
+    # The reflected ray meets the wall (z = 1) at the origin's mirror image: (0, 0, 1).
+    to_light = [light[0], light[1], light[2] - 1.0]
+    d2 = sum(c * c for c in to_light)
+    cos = abs(to_light[2]) / math.sqrt(d2)
+    wall = albedo / math.pi * intensity * cos / d2
+    r = ((ior - 1) / (ior + 1)) ** 2
+    return wall * (r + (r * (1 - r) ** 2 if bounces >= 4 else 0.0))
+
+
 def scaled(scene: dict, factor: float) -> dict:
     """The same scene with every length multiplied by `factor` and the light's intensity by
     factor^2, so that the image should not change at all."""

@@ -11,11 +11,12 @@ from grading.harness import ROOT, run_lab
 @pytest.mark.parametrize("check", [
     checks.check_sphere_interior,
     checks.check_lit_plane,
+    checks.check_glass_slab,
     lambda b: checks.check_golden(b, "cornell"),
     lambda b: checks.check_golden(b, "showcase"),
     checks.check_scale_invariance,
     checks.check_reproducible,
-], ids=["sphere-interior", "lit-plane", "golden-cornell", "golden-showcase", "scale",
+], ids=["sphere-interior", "lit-plane", "glass-pane", "golden-cornell", "golden-showcase", "scale",
         "reproducible"])
 def test_reference_passes(lab01_ref, check, tmp_path):
     result = check(lab01_ref)

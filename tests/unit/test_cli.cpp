@@ -1,7 +1,11 @@
 // The shared command line: defaults, overrides, and InputErrors that name the flag.
 #include <gtest/gtest.h>
 
+#include <cstdio>
+#include <cstdlib>
+#include <fstream>
 #include <initializer_list>
+#include <iterator>
 #include <string>
 #include <vector>
 
@@ -118,7 +122,20 @@ TEST(Cli, MissingValue) {
 
 TEST(Cli, HelpPrintsUsageAndExitsZero) {
     GTEST_FLAG_SET(death_test_style, "threadsafe");
-    EXPECT_EXIT(parse({"--help"}), ::testing::ExitedWithCode(0), "");
+    const std::string out = ::testing::TempDir() + "rt-unit-help.txt";
+    std::remove(out.c_str());
+    // The child sends its stdout to a file, so the usage text can be checked here.
+    EXPECT_EXIT(
+        {
+            if (!std::freopen(out.c_str(), "w", stdout)) std::exit(3);
+            parse({"--help"});
+        },
+        ::testing::ExitedWithCode(0), "");
+    std::ifstream in(out);
+    const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    EXPECT_NE(text.find("usage: labXX"), std::string::npos) << text;
+    EXPECT_NE(text.find("--spp"), std::string::npos) << text;
+    std::remove(out.c_str());
 }
 
 TEST(Cli, SettingsForAppliesOverridesOnly) {

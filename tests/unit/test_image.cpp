@@ -86,7 +86,7 @@ TEST(Image, EncodeSrgb8) {
     EXPECT_EQ(encode_srgb8(0.0f), 0);
     EXPECT_EQ(encode_srgb8(1.0f), 255);
     EXPECT_EQ(encode_srgb8(0.5f), 188);           // the familiar sRGB mid-grey code
-    EXPECT_EQ(encode_srgb8(0.0031308f * 0.5f), 1);  // linear segment: 12.92 * x * 255 = 5.2
+    EXPECT_EQ(encode_srgb8(0.0031308f * 0.5f), 5);  // linear segment: 12.92 * x * 255 = 5.16
     EXPECT_EQ(encode_srgb8(0.18f), 118);
     // Clamping.
     EXPECT_EQ(encode_srgb8(-1.0f), 0);
@@ -173,9 +173,15 @@ TEST(Image, PpmRoundTripWithinOneCode) {
 TEST(Image, AtomicFileUnwritablePathThrowsAtConstruction) {
     expect_input_error([] { AtomicFile f("/nonexistent/dir/x.pfm"); }, "/nonexistent/dir/x.pfm");
     expect_input_error([] { write_pfm("/nonexistent/dir/x.pfm", Image(1, 1)); }, "x.pfm");
+}
+
+// An existing directory is an unusable output path: it must fail when the file is opened
+// (before the render), not at commit (after it).
+TEST(Image, AtomicFileTargetIsADirectoryFailsAtConstruction) {
     TempDir dir;
-    // A directory where the file should be.
-    expect_input_error([&] { AtomicFile f(dir.file("") + "/"); }, "");
+    fs::create_directory(dir.path() / "out.ppm");
+    expect_input_error([&] { AtomicFile f(dir.file("out.ppm")); }, "out.ppm");
+    EXPECT_EQ(dir.entries(), 1);  // only the directory, no temporary left behind
 }
 
 TEST(Image, AtomicFileReadOnlyDirectory) {

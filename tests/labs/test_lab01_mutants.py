@@ -1,0 +1,119 @@
+"""Mutation tests: the checks must catch deliberately broken solutions.
+
+Each mutant is the lab-01 reference with one plausible student bug. It is built from a copy
+of the solution and common/ headers with one edit, then run through the correctness checks
+(grading/checks.py). A mutant must fail the checks named for it: that documents which bug
+each check catches, and proves that no check is one that cannot fail. Run with `-s` to see
+the full matrix.
+"""
+import concurrent.futures
+import pathlib
+import shlex
+import shutil
+import subprocess
+
+import pytest
+
+from grading import checks
+from grading.harness import ROOT, build
+
+CHECKS = {
+    "interior": checks.check_sphere_interior,
+    "plane": checks.check_lit_plane,
+    "glass": checks.check_glass_slab,
+    "cornell": lambda b: checks.check_golden(b, "cornell"),
+    "showcase": lambda b: checks.check_golden(b, "showcase"),
+    "scale": checks.check_scale_invariance,
+}
+
+# name: (file under common/ or the solution dir, original text, mutated text, checks that
+# must catch it)
+MUTANTS = {
+    "no cosine in NEE": ("path_tracer.h", "(cos_theta / (kPi * distance2))",
+                         "(1.0f / (kPi * distance2))", ["plane", "cornell"]),
+    "BRDF without 1/pi": ("path_tracer.h", "(cos_theta / (kPi * distance2))",
+                          "(cos_theta / distance2)", ["interior", "plane", "cornell"]),
+    "light falls off as 1/d": ("path_tracer.h", "(cos_theta / (kPi * distance2))",
+                               "(cos_theta / (kPi * distance))", ["interior", "plane"]),
+    "shadow rays ignore spheres": (
+        "path_tracer.h",
+        "if (intersect_sphere(ray, scene.spheres[i], t_max) < t_max) return true;",
+        "continue;", ["cornell"]),
+    "shadow rays ignore triangles": (
+        "path_tracer.h",
+        "if (intersect_triangle(ray, shear, scene.triangles[i], t_max) < t_max) return true;",
+        "continue;", ["showcase"]),
+    "no pixel jitter": ("path_tracer.h",
+                        "camera.ray_through(x + rng.at(kDimPixelX), y + rng.at(kDimPixelY))",
+                        "camera.ray_through(x + 0.5f, y + 0.5f)", ["cornell"]),
+    "every sample reuses sample 0": ("path_tracer.h", "SampleStream rng(settings.seed, pixel, s)",
+                                     "SampleStream rng(settings.seed, pixel, 0)", ["cornell"]),
+    "one bounce too few": ("path_tracer.h", "for (int bounce = 0; bounce < max_bounces; ++bounce)",
+                           "for (int bounce = 0; bounce < max_bounces - 1; ++bounce)",
+                           ["interior", "plane", "cornell"]),
+    "throughput ignores albedo": ("path_tracer.h",
+                                  "if (last) break;\n            throughput *= material.albedo;\n"
+                                  "            ray = {above, sample_cosine",
+                                  "if (last) break;\n            ray = {above, sample_cosine",
+                                  ["interior", "cornell"]),
+    "uniform sampling weighted as cosine": (
+        "material.h", "const float r = sqrtf(u1);", "const float r = sqrtf(1.0f - u1 * u1);",
+        ["cornell"]),
+    "glass never reflects": ("path_tracer.h", "if (rng.at(bounce_dimension(bounce, 0)) < reflectance)",
+                             "if (reflectance < 0.0f)", ["glass"]),
+    "sphere: far root only": ("sphere.h", "if (t_near > 0.0f && t_near < t_max) return t_near;",
+                              "", ["cornell", "showcase"]),
+    "fixed epsilon offset": ("ray.h", "return p + n * (scale * kRelativeOffset);",
+                             "return p + n * (0.0f * scale + 1e-4f);", ["scale"]),
+    "no offset at all": ("ray.h", "return p + n * (scale * kRelativeOffset);",
+                         "return p + n * (0.0f * scale);", ["cornell"]),
+}
+
+
+def build_command() -> list[str]:
+    out = subprocess.run(["make", "-s", "-C", str(ROOT), "print-build-command"],
+                         capture_output=True, text=True, check=True).stdout
+    flags = [f for f in shlex.split(out) if not f.startswith(("-DRT_SOURCE_DIR", "-MMD", "-MP"))]
+    return flags + [f'-DRT_SOURCE_DIR="{ROOT}"']
+
+
+def build_mutant(name: str, workdir: pathlib.Path) -> pathlib.Path:
+    file, old, new, _ = MUTANTS[name]
+    src = workdir / "src"
+    shutil.copytree(ROOT / "common", src, ignore=shutil.ignore_patterns("scenes", "*.cpp"))
+    shutil.copy(ROOT / "labs" / "01-serial" / "solution" / "render.cpp", src)
+    target = src / file
+    text = target.read_text()
+    assert text.count(old) >= 1, f"mutant '{name}': text to mutate not found in {file}"
+    target.write_text(text.replace(old, new, 1))
+    objects = [ROOT / "build" / "common" / f"{o}.o"
+               for o in ("scene_loader", "image", "cli", "progress", "lab_main", "main")]
+    binary = workdir / "lab"
+    subprocess.run([*build_command(), "-w", f"-I{src}", str(src / "render.cpp"),
+                    *map(str, objects), "-o", str(binary)], check=True, capture_output=True)
+    return binary
+
+
+@pytest.fixture(scope="module")
+def mutant_results(tmp_path_factory, lab01_ref):
+    build("lab01-ref")
+
+    def evaluate(name):
+        binary = build_mutant(name, tmp_path_factory.mktemp("mutant"))
+        return name, {check: CHECKS[check](binary) for check in CHECKS}
+
+    with concurrent.futures.ThreadPoolExecutor(2) as pool:
+        results = dict(pool.map(evaluate, MUTANTS))
+    print("\nmutant".ljust(40) + "".join(c.rjust(10) for c in CHECKS))
+    for name, by_check in results.items():
+        print(name.ljust(39) + "".join(
+            ("caught" if not r.passed else "-").rjust(10) for r in by_check.values()))
+    return results
+
+
+@pytest.mark.parametrize("name", sorted(MUTANTS))
+def test_mutant_is_caught(mutant_results, name):
+    expected = MUTANTS[name][3]
+    missed = [c for c in expected if mutant_results[name][c].passed]
+    assert not missed, f"'{name}' slipped past: " + "; ".join(
+        str(mutant_results[name][c]) for c in missed)

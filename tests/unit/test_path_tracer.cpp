@@ -1,0 +1,394 @@
+// The path tracer on tiny scenes built in code, where the answer is known exactly: direct
+// light from a point source, shadows (glass included), escaping rays, mirrors, the white
+// furnace, and a deterministic, seed-dependent render_pixel.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <string>
+
+#include "path_tracer.h"
+#include "scene_loader.h"
+
+namespace {
+
+// A scene under construction; view() is what the tracer reads.
+struct TestScene {
+    Scene scene;
+
+    int material(MaterialType type, Vec3 albedo, float ior = 1.5f) {
+        scene.materials.push_back({type, albedo, ior});
+        scene.material_names.push_back("m" + std::to_string(scene.materials.size()));
+        return static_cast<int>(scene.materials.size()) - 1;
+    }
+    // The square [-h, h]^2 of the plane y = 0, facing +y, as two triangles.
+    void floor(int m, float h = 10.0f) {
+        const Vec3 a(-h, 0, -h), b(-h, 0, h), c(h, 0, h), d(h, 0, -h);
+        scene.triangles.push_back(make_triangle(a, b, c, m));
+        scene.triangles.push_back(make_triangle(a, c, d, m));
+    }
+    void sphere(Vec3 c, float r, int m) { scene.spheres.push_back({c, r, m}); }
+    void light(Vec3 p, Vec3 intensity) {
+        scene.has_light = true;
+        scene.light = {p, intensity};
+    }
+    SceneView view() const { return scene.view(); }
+};
+
+const SampleStream kRng(0, 0, 0);
+
+Ray ray_to(Vec3 from, Vec3 to) { return {from, normalize(to - from)}; }
+
+// rho/pi * I * cos(theta) / d^2 for a point p on the floor (normal +y).
+Vec3 expected_direct(Vec3 p, Vec3 light, Vec3 intensity, Vec3 albedo) {
+    const Vec3 to = light - p;
+    const float d2 = length_squared(to);
+    const float cos_theta = to.y / std::sqrt(d2);
+    return albedo * intensity * (cos_theta / (kPi * d2));
+}
+
+void expect_rel_near(Vec3 a, Vec3 b, float rel) {
+    EXPECT_NEAR(a.x, b.x, rel * std::fabs(b.x) + 1e-30f);
+    EXPECT_NEAR(a.y, b.y, rel * std::fabs(b.y) + 1e-30f);
+    EXPECT_NEAR(a.z, b.z, rel * std::fabs(b.z) + 1e-30f);
+}
+
+void expect_exact(Vec3 a, Vec3 b) {
+    EXPECT_EQ(a.x, b.x);
+    EXPECT_EQ(a.y, b.y);
+    EXPECT_EQ(a.z, b.z);
+}
+
+// The Cornell scene with every length multiplied by s and the light by s^2, so that every
+// radiance is unchanged.
+Scene scaled(const Scene& base, float s) {
+    Scene out = base;
+    out.camera.position = base.camera.position * s;
+    out.camera.look_at = base.camera.look_at * s;
+    out.light.position = base.light.position * s;
+    out.light.intensity = base.light.intensity * (s * s);
+    for (Sphere& sp : out.spheres) {
+        sp.center = sp.center * s;
+        sp.radius *= s;
+    }
+    for (Triangle& t : out.triangles) t = make_triangle(t.v0 * s, t.v1 * s, t.v2 * s, t.material);
+    return out;
+}
+
+}  // namespace
+
+TEST(PathTracer, ClosestHitPicksTheNearestPrimitive) {
+    TestScene ts;
+    const int m = ts.material(MaterialType::Diffuse, Vec3(0.5f));
+    ts.floor(m);                      // triangles 0, 1 at y = 0
+    ts.sphere({0, 2, 0}, 0.5f, m);    // sphere 0: top at y = 2.5
+    ts.sphere({0, 5, 0}, 0.5f, m);    // sphere 1 above it
+    const SceneView v = ts.view();
+    const Hit down = closest_hit(v, {{0, 10, 0}, {0, -1, 0}});
+    EXPECT_EQ(down.sphere, 1);
+    EXPECT_EQ(down.triangle, -1);
+    EXPECT_FLOAT_EQ(down.t, 4.5f);
+    const Hit floor_hit = closest_hit(v, {{3, 10, 0.5f}, {0, -1, 0}});
+    EXPECT_EQ(floor_hit.sphere, -1);
+    EXPECT_GE(floor_hit.triangle, 0);
+    EXPECT_FLOAT_EQ(floor_hit.t, 10.0f);
+    // Between the spheres, looking down: the lower sphere, not the floor behind it.
+    const Hit mid = closest_hit(v, {{0, 3.5f, 0}, {0, -1, 0}});
+    EXPECT_EQ(mid.sphere, 0);
+    EXPECT_FLOAT_EQ(mid.t, 1.0f);
+    // A triangle in front of a sphere.
+    const Hit up = closest_hit(v, {{0, -3, 0}, {0, 1, 0}});
+    EXPECT_GE(up.triangle, 0);
+    EXPECT_EQ(up.sphere, -1);
+    EXPECT_FLOAT_EQ(up.t, 3.0f);
+    const Hit none = closest_hit(v, {{0, 10, 0}, {0, 1, 0}});
+    EXPECT_FALSE(none.found());
+    const SurfacePoint sp = surface_at(v, {{0, 10, 0}, {0, -1, 0}}, down);
+    EXPECT_NEAR(sp.normal.y, 1.0f, 1e-6f);
+    EXPECT_NEAR(sp.position.y, 5.5f, 1e-5f);
+}
+
+TEST(PathTracer, OccludedRespectsTMax) {
+    TestScene ts;
+    const int m = ts.material(MaterialType::Diffuse, Vec3(0.5f));
+    ts.sphere({0, 5, 0}, 1.0f, m);
+    ts.floor(m);
+    const SceneView v = ts.view();
+    const Ray up{{0, 1, 0}, {0, 1, 0}};
+    EXPECT_TRUE(occluded(v, up, 100.0f));
+    EXPECT_TRUE(occluded(v, up, 3.01f));
+    EXPECT_FALSE(occluded(v, up, 3.0f));  // the blocker starts at t = 3
+    EXPECT_FALSE(occluded(v, {{3, 1, 0}, {0, 1, 0}}, 100.0f));
+    EXPECT_TRUE(occluded(v, {{3, 1, 0}, {0, -1, 0}}, 100.0f));  // the floor
+    EXPECT_FALSE(occluded(v, {{3, 1, 0}, {0, -1, 0}}, 0.99f));
+}
+
+TEST(PathTracer, PointLightOnDiffusePlaneIsExact) {
+    TestScene ts;
+    const Vec3 albedo(0.5f, 0.6f, 0.7f), intensity(1.0f, 2.0f, 3.0f), light(0.3f, 2.0f, -0.4f);
+    ts.floor(ts.material(MaterialType::Diffuse, albedo));
+    ts.light(light, intensity);
+    const SceneView v = ts.view();
+    for (const Vec3 p : {Vec3(0.2f, 0, 0.1f), Vec3(-3, 0, 4), Vec3(0.3f, 0, -0.4f)}) {
+        const Vec3 expected = expected_direct(p, light, intensity, albedo);
+        const Ray ray = ray_to({1, 1, 1}, p);
+        expect_rel_near(trace_path(v, ray, kRng, 1), expected, 1e-4f);
+        // With more bounces the second ray escapes into a black background: nothing more.
+        expect_rel_near(trace_path(v, ray, kRng, 2), expected, 1e-4f);
+        expect_rel_near(trace_path(v, ray, SampleStream(9, 9, 9), 5), expected, 1e-4f);
+        // direct_light itself, from the point (and a normal facing the light).
+        expect_rel_near(direct_light(v, p, {0, 1, 0}, albedo), expected, 1e-5f);
+    }
+    // Directly below the light: cos = 1, d = 2.
+    const Vec3 below(0.3f, 0.0f, -0.4f);
+    expect_rel_near(direct_light(v, below, {0, 1, 0}, albedo),
+                    albedo * intensity * (1.0f / (kPi * 4.0f)), 1e-6f);
+}
+
+TEST(PathTracer, LightBehindTheSurfaceGivesNothing) {
+    TestScene ts;
+    ts.floor(ts.material(MaterialType::Diffuse, Vec3(0.8f)));
+    ts.light({0, 2, 0}, Vec3(5.0f));
+    const SceneView v = ts.view();
+    // Seen from below, the floor's lit side faces away: black, no light leaks through.
+    expect_exact(trace_path(v, ray_to({1, -1, 1}, {0.2f, 0, 0.1f}), kRng, 1), Vec3(0.0f));
+    expect_exact(direct_light(v, {0, 0, 0}, {0, -1, 0}, Vec3(0.8f)), Vec3(0.0f));
+    // A light exactly in the tangent plane gives cos = 0.
+    expect_exact(direct_light(v, {0, 0, 0}, {1, 0, 0}, Vec3(0.8f)), Vec3(0.0f));
+}
+
+TEST(PathTracer, OccludersCastShadowsGlassIncluded) {
+    const Vec3 p(0.2f, 0.0f, 0.1f), light(0.2f, 3.0f, 0.1f);
+    for (MaterialType type : {MaterialType::Diffuse, MaterialType::Mirror, MaterialType::Glass}) {
+        TestScene ts;
+        ts.floor(ts.material(MaterialType::Diffuse, Vec3(0.5f)));
+        ts.sphere({0.2f, 1.5f, 0.1f}, 0.3f, ts.material(type, Vec3(0.9f)));
+        ts.light(light, Vec3(4.0f));
+        const SceneView v = ts.view();
+        const Ray ray = ray_to({2, 1, 2}, p);  // sees p past the sphere
+        ASSERT_EQ(closest_hit(v, ray).sphere, -1);
+        expect_exact(trace_path(v, ray, kRng, 1), Vec3(0.0f));
+        expect_exact(direct_light(v, p, {0, 1, 0}, Vec3(0.5f)), Vec3(0.0f));
+    }
+    // A sphere beside the segment, or beyond the light, casts no shadow on p.
+    for (const Vec3 c : {Vec3(1.5f, 1.5f, 0.1f), Vec3(0.2f, 4.0f, 0.1f)}) {
+        TestScene ts;
+        ts.floor(ts.material(MaterialType::Diffuse, Vec3(0.5f)));
+        ts.sphere(c, 0.3f, ts.material(MaterialType::Diffuse, Vec3(0.5f)));
+        ts.light(light, Vec3(4.0f));
+        expect_rel_near(direct_light(ts.view(), p, {0, 1, 0}, Vec3(0.5f)),
+                        expected_direct(p, light, Vec3(4.0f), Vec3(0.5f)), 1e-5f);
+    }
+}
+
+TEST(PathTracer, EscapingRaysReturnTheBackground) {
+    TestScene ts;
+    ts.scene.background = {0.1f, 0.2f, 0.3f};
+    ts.light({0, 1, 0}, Vec3(100.0f));  // a point light is never seen directly
+    const SceneView v = ts.view();
+    for (int bounces : {1, 2, 8})
+        expect_exact(trace_path(v, {{0, 0, 0}, {0, 0, -1}}, kRng, bounces), ts.scene.background);
+    // With geometry, a ray that misses it.
+    ts.floor(ts.material(MaterialType::Diffuse, Vec3(0.5f)));
+    expect_exact(trace_path(ts.view(), {{0, 1, 0}, {0, 1, 0}}, kRng, 4), ts.scene.background);
+}
+
+TEST(PathTracer, MirrorReflectsTheSky) {
+    TestScene ts;
+    const Vec3 tint(0.9f, 0.5f, 0.25f);
+    ts.floor(ts.material(MaterialType::Mirror, tint));
+    ts.scene.background = {0.5f, 1.0f, 2.0f};
+    ts.light({0, 3, 0}, Vec3(10.0f));  // mirrors take no light samples
+    const SceneView v = ts.view();
+    const Ray ray = ray_to({1, 1, 1}, {0.2f, 0, 0.1f});
+    for (int bounces : {2, 3, 10})
+        expect_exact(trace_path(v, ray, kRng, bounces), tint * ts.scene.background);
+    // With one bounce the mirror is the last interaction: nothing comes back.
+    expect_exact(trace_path(v, ray, kRng, 1), Vec3(0.0f));
+}
+
+TEST(PathTracer, MirrorShowsWhatItFaces) {
+    // A mirror floor under a diffuse sphere: the reflected ray lands on the sphere's bottom,
+    // which the light (above the sphere) cannot see: black. Beside it: the sky.
+    TestScene ts;
+    ts.floor(ts.material(MaterialType::Mirror, Vec3(1.0f)), 1e4f);  // wide: nothing escapes sideways
+    ts.sphere({0, 2, 0}, 1.0f, ts.material(MaterialType::Diffuse, Vec3(0.5f)));
+    ts.light({0, 5, 0}, Vec3(10.0f));
+    ts.scene.background = Vec3(0.25f);
+    const SceneView v = ts.view();
+    const Ray straight_down{{0.1f, 0.5f, 0}, {0, -1, 0}};  // under the sphere
+    EXPECT_EQ(closest_hit(v, straight_down).triangle >= 0, true);
+    const Vec3 l = trace_path(v, straight_down, kRng, 3);
+    EXPECT_EQ(l.x, 0.0f);  // the sphere's unlit bottom; the next bounce would need > 3
+}
+
+TEST(PathTracer, DiffuseUnderUniformSkyIsAlbedoTimesSky) {
+    // Every cosine-sampled ray from an infinite-ish floor escapes: each path gives exactly
+    // albedo * background, whatever the random numbers.
+    TestScene ts;
+    const Vec3 albedo(0.2f, 0.5f, 0.75f);
+    ts.floor(ts.material(MaterialType::Diffuse, albedo), 1e4f);
+    ts.scene.background = {1.0f, 0.5f, 0.25f};
+    const SceneView v = ts.view();
+    for (int s = 0; s < 200; ++s) {
+        const Vec3 l = trace_path(v, ray_to({0, 1, 0}, {0.5f, 0, 0.5f}), SampleStream(1, 2, s), 4);
+        ASSERT_FLOAT_EQ(l.x, albedo.x * 1.0f);
+        ASSERT_FLOAT_EQ(l.y, albedo.y * 0.5f);
+        ASSERT_FLOAT_EQ(l.z, albedo.z * 0.25f);
+    }
+}
+
+TEST(PathTracer, GlassWhiteFurnace) {
+    // Glass neither absorbs nor emits: under a uniform sky a path through a glass sphere
+    // returns exactly the sky, or black only if it runs out of bounces.
+    TestScene ts;
+    ts.sphere({0, 0, -3}, 1.0f, ts.material(MaterialType::Glass, Vec3(0.0f), 1.5f));
+    ts.scene.background = Vec3(0.5f);
+    const SceneView v = ts.view();
+    int sky = 0, through = 0;
+    const int n = 4000;
+    for (int s = 0; s < n; ++s) {
+        const SampleStream rng(3, 0, s);
+        // Aim at a random point of the sphere's disc.
+        const Vec3 target(rng.at(100) * 1.4f - 0.7f, rng.at(101) * 1.4f - 0.7f, -3.0f);
+        const Ray ray = ray_to({0, 0, 0}, target);
+        ASSERT_TRUE(closest_hit(v, ray).found());
+        const Vec3 l = trace_path(v, ray, rng, 64);
+        ASSERT_FALSE(std::isnan(l.x));
+        ASSERT_TRUE(l.x == 0.0f || l.x == 0.5f) << l.x;
+        sky += l.x == 0.5f;
+        ++through;
+    }
+    EXPECT_EQ(through, n);
+    EXPECT_GE(sky, n * 99 / 100);
+}
+
+TEST(PathTracer, GlassRefractsStraightThroughAtNormalIncidence) {
+    // A ray along a diameter is never bent: behind the sphere it meets a lit diffuse floor
+    // at the point straight ahead. With Fresnel reflection (4% per face) some paths go
+    // back to the black sky; every other path sees exactly the floor's direct light.
+    TestScene ts;
+    const Vec3 albedo(0.5f);
+    ts.floor(ts.material(MaterialType::Diffuse, albedo));
+    ts.sphere({0, 2, 0}, 0.5f, ts.material(MaterialType::Glass, Vec3(0.0f), 1.5f));
+    ts.light({3, 1, 0}, Vec3(2.0f));  // lights the floor under the sphere from the side
+    const SceneView v = ts.view();
+    const Vec3 expected = expected_direct({0, 0, 0}, {3, 1, 0}, Vec3(2.0f), albedo);
+    int lit = 0, dark = 0;
+    for (int s = 0; s < 1000; ++s) {
+        const Vec3 l = trace_path(v, {{0, 4, 0}, {0, -1, 0}}, SampleStream(0, 0, s), 3);
+        if (l.x == 0.0f) {
+            ++dark;
+        } else {
+            ++lit;
+            ASSERT_NEAR(l.x, expected.x, 1e-4f * expected.x);
+        }
+    }
+    // Transmission through both faces: (1 - 0.04)^2 = 92%.
+    EXPECT_NEAR(lit / 1000.0, 0.9216, 0.03);
+    EXPECT_EQ(lit + dark, 1000);
+}
+
+TEST(PathTracer, RenderPixelDeterministicAndSeedDependent) {
+    TestScene ts;
+    ts.floor(ts.material(MaterialType::Diffuse, Vec3(0.6f)));
+    ts.sphere({0, 0.5f, 0}, 0.5f, ts.material(MaterialType::Diffuse, Vec3(0.3f, 0.6f, 0.9f)));
+    ts.light({1, 3, 1}, Vec3(5.0f));
+    ts.scene.background = Vec3(0.1f);
+    const SceneView v = ts.view();
+    const Camera cam = Camera::look_at({0, 2, 4}, {0, 0.3f, 0}, {0, 1, 0}, 40.0f, 16, 16);
+    RenderSettings rs;
+    rs.width = 16;
+    rs.height = 16;
+    rs.spp = 8;
+    rs.bounces = 4;
+    rs.seed = 1;
+    int differ = 0;
+    for (int y = 0; y < 16; y += 3) {
+        for (int x = 0; x < 16; x += 3) {
+            const Vec3 a = render_pixel(v, cam, rs, x, y);
+            const Vec3 b = render_pixel(v, cam, rs, x, y);
+            ASSERT_TRUE(a.x == b.x && a.y == b.y && a.z == b.z);
+            ASSERT_TRUE(std::isfinite(a.x) && std::isfinite(a.y) && std::isfinite(a.z));
+            RenderSettings other = rs;
+            other.seed = 2;
+            const Vec3 c = render_pixel(v, cam, other, x, y);
+            differ += (c.x != a.x || c.y != a.y || c.z != a.z);
+        }
+    }
+    EXPECT_GE(differ, 30);  // of 36 pixels
+}
+
+TEST(PathTracer, RenderPixelAveragesOverThePixel) {
+    // One 1x1 image, 90 degrees: the pixel spans [-1, 1]^2 on the plane z = -1. A black
+    // card covers the left half of that view, the sky (1) the rest: the mean is 1/2.
+    TestScene ts;
+    const int black = ts.material(MaterialType::Diffuse, Vec3(0.0f));
+    const Vec3 a(-100, -100, -2), b(0, -100, -2), c(0, 100, -2), d(-100, 100, -2);
+    ts.scene.triangles.push_back(make_triangle(a, b, c, black));
+    ts.scene.triangles.push_back(make_triangle(a, c, d, black));
+    ts.scene.background = Vec3(1.0f);
+    const Camera cam = Camera::look_at({0, 0, 0}, {0, 0, -1}, {0, 1, 0}, 90.0f, 1, 1);
+    RenderSettings rs;
+    rs.width = rs.height = 1;
+    rs.spp = 4096;
+    rs.bounces = 2;
+    const Vec3 l = render_pixel(ts.view(), cam, rs, 0, 0);
+    EXPECT_NEAR(l.x, 0.5f, 0.03f);  // binomial sd 0.008
+    // Every sample of a uniform view is the sky itself: the mean is exact.
+    TestScene empty;
+    empty.scene.background = {0.25f, 0.5f, 1.0f};
+    rs.spp = 8;
+    expect_exact(render_pixel(empty.view(), cam, rs, 0, 0), empty.scene.background);
+}
+
+// The Cornell box at 1e-4 and 1e5 times its size, with the light scaled by the square: the
+// same random numbers must give the same radiance (no fixed epsilon anywhere).
+TEST(PathTracer, ScaleInvariance) {
+    const Scene base = load_scene(std::string(RT_SOURCE_DIR) + "/common/scenes/cornell.json");
+    RenderSettings rs;
+    rs.width = rs.height = 12;
+    rs.spp = 16;
+    rs.bounces = 4;
+    const Camera base_cam = base.camera.for_image(rs.width, rs.height);
+    for (float s : {1e-4f, 1e-2f, 1e3f, 1e5f}) {
+        const Scene big = scaled(base, s);
+        const Camera cam = big.camera.for_image(rs.width, rs.height);
+        double sum_base = 0, sum_scaled = 0;
+        int close = 0, pixels = 0;
+        for (int y = 0; y < rs.height; ++y) {
+            for (int x = 0; x < rs.width; ++x) {
+                const Vec3 a = render_pixel(base.view(), base_cam, rs, x, y);
+                const Vec3 b = render_pixel(big.view(), cam, rs, x, y);
+                ASSERT_TRUE(std::isfinite(b.x) && std::isfinite(b.y) && std::isfinite(b.z));
+                sum_base += a.x + a.y + a.z;
+                sum_scaled += b.x + b.y + b.z;
+                const float diff = length(a - b), norm = length(a);
+                close += diff <= 1e-3f * norm + 1e-12f;
+                ++pixels;
+            }
+        }
+        EXPECT_GT(sum_base, 0.0);
+        EXPECT_NEAR(sum_scaled / sum_base, 1.0, 1e-2) << "scale " << s;
+        EXPECT_GE(close, pixels * 9 / 10) << "scale " << s;
+    }
+}
+
+TEST(PathTracer, CornellPixelsAreFiniteAndPlausible) {
+    const Scene scene = load_scene(std::string(RT_SOURCE_DIR) + "/common/scenes/cornell.json");
+    RenderSettings rs;
+    rs.width = rs.height = 8;
+    rs.spp = 8;
+    rs.bounces = 4;
+    const Camera cam = scene.camera.for_image(rs.width, rs.height);
+    int lit = 0;
+    for (int y = 0; y < rs.height; ++y)
+        for (int x = 0; x < rs.width; ++x) {
+            const Vec3 l = render_pixel(scene.view(), cam, rs, x, y);
+            ASSERT_TRUE(std::isfinite(l.x) && std::isfinite(l.y) && std::isfinite(l.z));
+            ASSERT_GE(l.x, 0.0f);
+            ASSERT_GE(l.y, 0.0f);
+            ASSERT_GE(l.z, 0.0f);
+            lit += max_component(l) > 0.0f;
+        }
+    EXPECT_GE(lit, 48);  // a closed box under a light: nearly every pixel gets something
+}
