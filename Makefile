@@ -16,12 +16,14 @@ endif
 CXXFLAGS := -std=c++17 $(OPT) $(WARN) -DRT_SOURCE_DIR='"$(CURDIR)"' -MMD -MP
 INCLUDES := -Icommon
 
-COMMON_SRC := common/scene_loader.cpp common/image.cpp common/cli.cpp common/progress.cpp \
-              common/lab_main.cpp
-COMMON_OBJ := $(COMMON_SRC:%.cpp=$(BUILD)/%.o)
-MAIN_OBJ   := $(BUILD)/common/main.o
+# The library part of common/ (what unit tests link) and the driver every lab binary adds.
+LIB_SRC    := common/scene_loader.cpp common/image.cpp common/cli.cpp common/progress.cpp
+LIB_OBJ    := $(LIB_SRC:%.cpp=$(BUILD)/%.o)
+DRIVER_OBJ := $(BUILD)/common/lab_main.o $(BUILD)/common/main.o
+COMMON_OBJ := $(LIB_OBJ) $(DRIVER_OBJ)
 
 PHONY_EXTRA := print-build-command
+PHONY_EXTRA += render grade
 .PHONY: all help deps labs $(PHONY_EXTRA) test test-unit test-labs skeletons check-skeletons golden bench tradeoff \
         clean
 .DEFAULT_GOAL := help
@@ -29,7 +31,9 @@ PHONY_EXTRA := print-build-command
 help:
 	@echo "make lab01        build your lab-01 code (labs/01-serial/skeleton) into ./lab01"
 	@echo "make lab01-ref    build the lab-01 reference solution into ./lab01-ref"
+	@echo "make render       install what is missing, render the default scene to cornell.ppm"
 	@echo "make deps         install what is missing (JSON library, OpenMPI, pytest, numpy)"
+	@echo "make grade LAB=01 grade your lab-01 code: score table and results.json"
 	@echo "make test         build everything and run every test"
 	@echo "make bench        time the lab-01 reference on the Cornell baseline (minutes)"
 	@echo "make tradeoff     error against time: RMSE vs spp for the lab-01 reference"
@@ -48,9 +52,9 @@ $(BUILD)/%.o: %.cpp
 # lab01 builds labs/01-serial/skeleton, lab01-ref builds labs/01-serial/solution. A source
 # includes "path_tracer.h" by quotes, so the skeleton's own copy shadows common/'s.
 define cpu_lab
-$(1): $(patsubst %.cpp,$(BUILD)/%.o,$(wildcard labs/$(2)/skeleton/*.cpp)) $(COMMON_OBJ) $(MAIN_OBJ)
+$(1): $(patsubst %.cpp,$(BUILD)/%.o,$(wildcard labs/$(2)/skeleton/*.cpp)) $(COMMON_OBJ)
 	$(CXX) $(CXXFLAGS) $$^ -o $$@ $(3)
-$(1)-ref: $(patsubst %.cpp,$(BUILD)/%.o,$(wildcard labs/$(2)/solution/*.cpp)) $(COMMON_OBJ) $(MAIN_OBJ)
+$(1)-ref: $(patsubst %.cpp,$(BUILD)/%.o,$(wildcard labs/$(2)/solution/*.cpp)) $(COMMON_OBJ)
 	$(CXX) $(CXXFLAGS) $$^ -o $$@ $(3)
 .PHONY: $(1) $(1)-ref
 endef
@@ -64,7 +68,7 @@ labs: $(LAB_BINARIES)
 UNIT_SRC := $(wildcard tests/unit/*.cpp)
 UNIT_OBJ := $(UNIT_SRC:%.cpp=$(BUILD)/%.o)
 
-$(BUILD)/unit_tests: $(UNIT_OBJ) $(COMMON_OBJ)
+$(BUILD)/unit_tests: $(UNIT_OBJ) $(LIB_OBJ)
 	$(CXX) $(CXXFLAGS) $^ -o $@ -lgtest -lgtest_main -pthread
 
 test-unit: $(BUILD)/unit_tests
@@ -73,13 +77,25 @@ test-unit: $(BUILD)/unit_tests
 test-labs: labs
 	$(PYTHON) -m pytest -q tests
 
-test: test-unit test-labs
+# Every test: installs what is missing first, so it works on a fresh machine.
+test: deps
+	$(MAKE) --no-print-directory test-unit
+	$(MAKE) --no-print-directory test-labs
+
+# Render the default scene (the Cornell baseline) with the lab-01 reference.
+render: deps
+	$(MAKE) --no-print-directory lab01-ref
+	./lab01-ref --out cornell.ppm
 
 skeletons:
 	$(PYTHON) tools/skeletons.py
 
 check-skeletons:
 	$(PYTHON) tools/skeletons.py --check
+
+LAB ?= 01
+grade:
+	$(PYTHON) -m grading.grade $(LAB)
 
 golden: lab01-ref
 	$(PYTHON) tools/make_golden.py
