@@ -59,9 +59,10 @@ $(1)-ref: $(patsubst %.cpp,$(BUILD)/%.o,$(wildcard labs/$(2)/solution/*.cpp)) $(
 .PHONY: $(1) $(1)-ref
 endef
 
-$(eval $(call cpu_lab,lab01,01-serial,))
-
-LAB_BINARIES := lab01 lab01-ref
+# Each lab's own rules (its binaries, extra flags) live in labs/NN-name/lab.mk; each adds
+# its binaries to LAB_BINARIES.
+LAB_BINARIES :=
+include $(sort $(wildcard labs/*/lab.mk))
 labs: $(LAB_BINARIES)
 
 # ---- tests ------------------------------------------------------------------------------
