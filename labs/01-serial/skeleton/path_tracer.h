@@ -3,6 +3,11 @@
 // The path tracer every lab shares: the primitive loops (closest hit, shadow test), the path
 // loop with next-event estimation, and the per-pixel estimator.
 //
+// The path loop is written once for any Geometry: a type for which closest_hit(geometry, ray)
+// and occluded(geometry, ray, t_max) exist. Lab 01's geometry is the SceneView itself (the
+// brute-force loops below); lab 02 supplies an 8-wide AVX2 one. Likewise any Rng with
+// `float at(uint32_t dimension) const` will do; the labs use SampleStream.
+//
 // Lab 01 students write the regions between BEGIN/END SOLUTION; the skeleton generator
 // (grading/skeletons.py) turns this file into labs/01-serial/skeleton/path_tracer.h.
 #pragma once
@@ -65,11 +70,13 @@ RT_HD inline bool occluded(const SceneView& scene, const Ray& ray, float t_max) 
 
 // Radiance the point light sends to a diffuse surface point through its BRDF:
 // rho/pi * I * cos(theta) / d^2 when the segment to the light is clear.
-RT_HD inline Vec3 direct_light(const SceneView& scene, Vec3 origin, Vec3 facing_normal,
-                               Vec3 albedo) {
+template <class Geometry>
+RT_HD inline Vec3 direct_light(const SceneView& scene, const Geometry& geometry, Vec3 origin,
+                               Vec3 facing_normal, Vec3 albedo) {
     // TODO(lab01): cast a shadow ray to the light; if it is clear, return
     // albedo/pi * intensity * cos(theta) / distance^2. Until then: no light at all.
     (void)scene;
+    (void)geometry;
     (void)origin;
     (void)facing_normal;
     (void)albedo;
@@ -79,8 +86,9 @@ RT_HD inline Vec3 direct_light(const SceneView& scene, Vec3 origin, Vec3 facing_
 // Radiance arriving along a camera ray, estimated by one random path of at most
 // max_bounces surface interactions, with next-event estimation at each diffuse one.
 // A path ends when it escapes (picking up the background) or its budget is spent.
-RT_HD inline Vec3 trace_path(const SceneView& scene, Ray ray, const SampleStream& rng,
-                             int max_bounces) {
+template <class Geometry, class Rng>
+RT_HD inline Vec3 trace_path(const SceneView& scene, const Geometry& geometry, Ray ray,
+                             const Rng& rng, int max_bounces) {
     Vec3 radiance(0.0f);
     Vec3 throughput(1.0f);
     // TODO(lab01): the path loop. For each bounce: find the closest hit (escaped rays
@@ -89,7 +97,7 @@ RT_HD inline Vec3 trace_path(const SceneView& scene, Ray ray, const SampleStream
     // Until then: flat colour of the first surface seen, no lighting.
     (void)max_bounces;
     (void)rng;
-    const Hit hit = closest_hit(scene, ray);
+    const Hit hit = closest_hit(geometry, ray);
     if (!hit.found()) return scene.background;
     radiance = scene.materials[surface_at(scene, ray, hit).material].albedo;
     return radiance;
@@ -97,14 +105,21 @@ RT_HD inline Vec3 trace_path(const SceneView& scene, Ray ray, const SampleStream
 
 // The estimate of one pixel: the mean of spp paths through uniformly jittered points of the
 // pixel (a box filter). Pixel index and sample number key the random numbers.
-RT_HD inline Vec3 render_pixel(const SceneView& scene, const Camera& camera,
-                               const RenderSettings& settings, int x, int y) {
+template <class Geometry>
+RT_HD inline Vec3 render_pixel(const SceneView& scene, const Geometry& geometry,
+                               const Camera& camera, const RenderSettings& settings, int x, int y) {
     const uint64_t pixel = static_cast<uint64_t>(y) * settings.width + x;
     Vec3 sum(0.0f);
     // TODO(lab01): average settings.spp paths, each through a random point of the pixel
     // (SampleStream(settings.seed, pixel, s), dimensions kDimPixelX/kDimPixelY).
     // Until then: one path through the pixel's corner.
     const SampleStream rng(settings.seed, pixel, 0);
-    sum = trace_path(scene, camera.ray_through(x, y), rng, settings.bounces);
+    sum = trace_path(scene, geometry, camera.ray_through(x, y), rng, settings.bounces);
     return sum;
+}
+
+// Lab 01's geometry is the scene itself: the brute-force loops above.
+RT_HD inline Vec3 render_pixel(const SceneView& scene, const Camera& camera,
+                               const RenderSettings& settings, int x, int y) {
+    return render_pixel(scene, scene, camera, settings, x, y);
 }
