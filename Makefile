@@ -23,7 +23,7 @@ DRIVER_OBJ := $(BUILD)/common/lab_main.o $(BUILD)/common/main.o
 COMMON_OBJ := $(LIB_OBJ) $(DRIVER_OBJ)
 
 PHONY_EXTRA := print-build-command
-PHONY_EXTRA += render grade
+PHONY_EXTRA += render grade check-nvcc
 .PHONY: all help deps labs $(PHONY_EXTRA) test test-unit test-labs skeletons check-skeletons golden bench tradeoff \
         clean
 .DEFAULT_GOAL := help
@@ -93,6 +93,14 @@ skeletons:
 
 check-skeletons:
 	$(PYTHON) tools/skeletons.py --check
+
+# The shared host+device code must build for the GPU too (CUDA labs reuse it).
+NVCC ?= nvcc
+check-nvcc:
+	@command -v $(NVCC) >/dev/null || { echo "check-nvcc: no CUDA toolkit (nvcc) found"; exit 2; }
+	@mkdir -p $(BUILD)/cuda
+	$(NVCC) -std=c++17 -O3 -Icommon -arch=sm_90 -Xcompiler -Wall,-Werror \
+	    -c tests/cuda/device_compile_check.cu -o $(BUILD)/cuda/device_compile_check.o
 
 LAB ?= 01
 grade:

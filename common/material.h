@@ -22,7 +22,7 @@ RT_HD inline Vec3 sample_cosine_hemisphere(Vec3 n, float u1, float u2) {
     const float phi = 2.0f * kPi * u2;
     const float x = r * cosf(phi);
     const float y = r * sinf(phi);
-    const float z = sqrtf(fmaxf(0.0f, 1.0f - u1));
+    const float z = sqrtf(max_float(0.0f, 1.0f - u1));
     Vec3 t, b;
     orthonormal_basis(n, t, b);
     return t * x + b * y + n * z;
@@ -32,7 +32,7 @@ RT_HD inline Vec3 sample_cosine_hemisphere(Vec3 n, float u1, float u2) {
 // cos_i: cosine of the incident angle (> 0); eta = n_incident / n_transmitted.
 // Returns 1 for total internal reflection and stores the transmitted cosine in cos_t.
 RT_HD inline float fresnel_dielectric(float cos_i, float eta, float& cos_t) {
-    const float sin2_t = eta * eta * fmaxf(0.0f, 1.0f - cos_i * cos_i);
+    const float sin2_t = eta * eta * max_float(0.0f, 1.0f - cos_i * cos_i);
     if (sin2_t >= 1.0f) {
         cos_t = 0.0f;
         return 1.0f;

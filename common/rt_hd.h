@@ -4,8 +4,6 @@
 
 #if defined(__CUDACC__)
 #define RT_HD __host__ __device__
-#define RT_INLINE __forceinline__
 #else
 #define RT_HD
-#define RT_INLINE inline __attribute__((always_inline))
 #endif

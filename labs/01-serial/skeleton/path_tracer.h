@@ -119,6 +119,16 @@ RT_HD inline Vec3 render_pixel(const SceneView& scene, const Geometry& geometry,
 }
 
 // Lab 01's geometry is the scene itself: the brute-force loops above.
+RT_HD inline Vec3 direct_light(const SceneView& scene, Vec3 origin, Vec3 facing_normal,
+                               Vec3 albedo) {
+    return direct_light(scene, scene, origin, facing_normal, albedo);
+}
+
+template <class Rng>
+RT_HD inline Vec3 trace_path(const SceneView& scene, Ray ray, const Rng& rng, int max_bounces) {
+    return trace_path(scene, scene, ray, rng, max_bounces);
+}
+
 RT_HD inline Vec3 render_pixel(const SceneView& scene, const Camera& camera,
                                const RenderSettings& settings, int x, int y) {
     return render_pixel(scene, scene, camera, settings, x, y);
