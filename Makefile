@@ -23,7 +23,7 @@ DRIVER_OBJ := $(BUILD)/common/lab_main.o $(BUILD)/common/main.o
 COMMON_OBJ := $(LIB_OBJ) $(DRIVER_OBJ)
 
 PHONY_EXTRA := print-build-command
-PHONY_EXTRA += render grade check-nvcc
+PHONY_EXTRA += render grade check-nvcc bench-micro
 .PHONY: all help deps labs $(PHONY_EXTRA) test test-unit test-labs skeletons check-skeletons golden bench tradeoff \
         clean
 .DEFAULT_GOAL := help
@@ -36,6 +36,7 @@ help:
 	@echo "make grade LAB=01 grade your lab-01 code: score table and results.json"
 	@echo "make test         build everything and run every test"
 	@echo "make bench        time the lab-01 reference on the Cornell baseline (minutes)"
+	@echo "make bench-micro  Google Benchmark of the inner loops (closest hit, shadow ray, path)"
 	@echo "make tradeoff     error against time: RMSE vs spp for the lab-01 reference"
 	@echo "make golden       regenerate the golden images in reference/ (minutes)"
 	@echo "make skeletons    regenerate the skeletons from the solutions"
@@ -111,6 +112,12 @@ golden: lab01-ref
 
 bench: lab01-ref
 	$(PYTHON) tools/bench_serial.py baseline
+
+$(BUILD)/intersect_bench: $(BUILD)/bench/intersect_bench.o $(LIB_OBJ)
+	$(CXX) $(CXXFLAGS) $^ -o $@ -lbenchmark -pthread
+
+bench-micro: $(BUILD)/intersect_bench
+	$(BUILD)/intersect_bench --benchmark_min_time=0.2
 
 tradeoff: lab01-ref
 	$(PYTHON) tools/bench_serial.py tradeoff

@@ -1,0 +1,102 @@
+// Microbenchmarks of the shared renderer's inner loops (Google Benchmark): where a path's
+// time goes. `make bench-micro` prints the table.
+#include <benchmark/benchmark.h>
+
+#include <string>
+#include <vector>
+
+#include "path_tracer.h"
+#include "scene_loader.h"
+
+namespace {
+
+const Scene& cornell() {
+    static const Scene scene = load_scene(std::string(RT_SOURCE_DIR) + "/common/scenes/cornell.json");
+    return scene;
+}
+
+// Rays as a render makes them: from the camera through random pixels, then bounced once.
+std::vector<Ray> sample_rays(size_t n) {
+    const Scene& scene = cornell();
+    const SceneView view = scene.view();
+    const Camera camera = scene.camera.for_image(600, 600);
+    std::vector<Ray> rays;
+    for (size_t i = 0; rays.size() < n; ++i) {
+        const SampleStream rng(1, i, 0);
+        const Ray primary = camera.ray_through(600 * rng.at(0), 600 * rng.at(1));
+        const Hit hit = closest_hit(view, primary);
+        if (!hit.found()) continue;
+        const SurfacePoint s = surface_at(view, primary, hit);
+        const Vec3 facing = dot(primary.direction, s.normal) < 0 ? s.normal : -s.normal;
+        rays.push_back({offset_ray_origin(s.position, facing, hit.t),
+                        sample_cosine_hemisphere(facing, rng.at(2), rng.at(3))});
+    }
+    return rays;
+}
+
+void BM_closest_hit_cornell(benchmark::State& state) {
+    const SceneView view = cornell().view();
+    const std::vector<Ray> rays = sample_rays(4096);
+    size_t i = 0;
+    for (auto _ : state) benchmark::DoNotOptimize(closest_hit(view, rays[i++ & 4095]));
+    state.SetItemsProcessed(state.iterations());
+}
+BENCHMARK(BM_closest_hit_cornell);
+
+void BM_occluded_cornell(benchmark::State& state) {
+    const Scene& scene = cornell();
+    const SceneView view = scene.view();
+    const std::vector<Ray> rays = sample_rays(4096);
+    size_t i = 0;
+    for (auto _ : state) {
+        const Ray& r = rays[i++ & 4095];
+        const Vec3 to_light = scene.light.position - r.origin;
+        const float d = length(to_light);
+        benchmark::DoNotOptimize(occluded(view, {r.origin, to_light / d}, d));
+    }
+    state.SetItemsProcessed(state.iterations());
+}
+BENCHMARK(BM_occluded_cornell);
+
+void BM_intersect_triangle(benchmark::State& state) {
+    const Scene& scene = cornell();
+    const std::vector<Ray> rays = sample_rays(4096);
+    size_t i = 0;
+    for (auto _ : state) {
+        const Ray& r = rays[i & 4095];
+        const RayShear shear(r.direction);
+        benchmark::DoNotOptimize(
+            intersect_triangle(r, shear, scene.triangles[i++ % scene.triangles.size()], 1e30f));
+    }
+    state.SetItemsProcessed(state.iterations());
+}
+BENCHMARK(BM_intersect_triangle);
+
+void BM_intersect_sphere(benchmark::State& state) {
+    const Scene& scene = cornell();
+    const std::vector<Ray> rays = sample_rays(4096);
+    size_t i = 0;
+    for (auto _ : state) {
+        benchmark::DoNotOptimize(intersect_sphere(rays[i++ & 4095], scene.spheres[0], 1e30f));
+    }
+    state.SetItemsProcessed(state.iterations());
+}
+BENCHMARK(BM_intersect_sphere);
+
+void BM_trace_path_cornell(benchmark::State& state) {
+    const Scene& scene = cornell();
+    const SceneView view = scene.view();
+    const Camera camera = scene.camera.for_image(600, 600);
+    uint64_t i = 0;
+    for (auto _ : state) {
+        const SampleStream rng(0, i++, 0);
+        const Ray ray = camera.ray_through(600 * rng.at(0), 600 * rng.at(1));
+        benchmark::DoNotOptimize(trace_path(view, ray, rng, 4));
+    }
+    state.SetItemsProcessed(state.iterations());
+}
+BENCHMARK(BM_trace_path_cornell);
+
+}  // namespace
+
+BENCHMARK_MAIN();
