@@ -30,7 +30,8 @@ static std::string json_escape(const std::string& s) {
     return out;
 }
 
-static int run(int argc, char** argv) {
+// `setup_reported` tells lab_main whether hooks.setup_done has been called already.
+static int run(int argc, char** argv, const LabHooks& hooks, bool& setup_reported) {
     const Options options = parse_options(argc, argv, argv[0]);
     const Scene scene = load_scene(options.scene_path);
     const RenderSettings settings = settings_for(scene, options);
@@ -38,17 +39,24 @@ static int run(int argc, char** argv) {
     // Open the outputs before rendering: a bad path fails in a millisecond, not after the
     // render, and neither file appears until its bytes are complete.
     std::unique_ptr<AtomicFile> ppm, pfm;
-    if (!options.ppm_path.empty()) ppm = std::make_unique<AtomicFile>(options.ppm_path);
-    if (!options.pfm_path.empty()) pfm = std::make_unique<AtomicFile>(options.pfm_path);
+    if (hooks.writes_output) {
+        if (!options.ppm_path.empty()) ppm = std::make_unique<AtomicFile>(options.ppm_path);
+        if (!options.pfm_path.empty()) pfm = std::make_unique<AtomicFile>(options.pfm_path);
+    }
 
     Image image(settings.width, settings.height);
-    Progress progress(settings.height, progress_wanted(options.quiet));
+    Progress progress(settings.height, hooks.writes_output && progress_wanted(options.quiet));
     const RenderJob job{scene,
                         settings,
                         scene.camera.for_image(settings.width, settings.height),
                         options.threads,
                         progress};
+    if (hooks.setup_done) {
+        setup_reported = true;
+        hooks.setup_done(true);
+    }
     const RenderStats stats = render(job, image);
+    if (!hooks.writes_output) return 0;
 
     if (ppm) ppm->commit(ppm_bytes(image));
     if (pfm) pfm->commit(pfm_bytes(image));
@@ -71,14 +79,19 @@ static int run(int argc, char** argv) {
     return 0;
 }
 
-int lab_main(int argc, char** argv) {
+int lab_main(int argc, char** argv, const LabHooks& hooks) {
+    bool setup_reported = false;
+    // A process that fails before setup_done still tells the others, so none waits forever.
+    const auto fail = [&](const char* message) {
+        if (hooks.writes_output) std::fprintf(stderr, "error: %s\n", message);
+        if (hooks.setup_done && !setup_reported) hooks.setup_done(false);
+        return kExitBadInput;
+    };
     try {
-        return run(argc, argv);
+        return run(argc, argv, hooks, setup_reported);
     } catch (const InputError& e) {
-        std::fprintf(stderr, "error: %s\n", e.what());
-        return kExitBadInput;
+        return fail(e.what());
     } catch (const std::bad_alloc&) {
-        std::fprintf(stderr, "error: out of memory (is the image size or spp absurd?)\n");
-        return kExitBadInput;
+        return fail("out of memory (is the image size or spp absurd?)");
     }
 }

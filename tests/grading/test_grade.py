@@ -23,8 +23,8 @@ def test_reference_gets_full_marks(lab01_ref, tmp_path):
     assert not (tmp_path / "maps").exists()  # no failures, no heatmaps
 
 
-def test_skeleton_gets_nothing_and_a_heatmap(lab01, tmp_path):
-    results, table = grade(lab01, tmp_path)
+def test_skeleton_gets_nothing_and_a_heatmap(lab01_pristine_skeleton, tmp_path):
+    results, table = grade(lab01_pristine_skeleton, tmp_path)
     assert results["score"] == 0, table
     assert "FAIL" in table and "total" in table
     assert (tmp_path / "maps" / "cornell-diff.png").read_bytes().startswith(b"\x89PNG")

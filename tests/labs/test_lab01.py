@@ -23,16 +23,22 @@ def test_reference_passes(lab01_ref, check, tmp_path):
     assert result.passed, str(result)
 
 
-def test_skeleton_is_visibly_incomplete(lab01):
+def test_skeleton_is_visibly_incomplete(lab01_pristine_skeleton):
     """Until students fill it in, the skeleton builds and runs but fails the image checks."""
-    results = [checks.check_sphere_interior(lab01), checks.check_golden(lab01, "cornell")]
+    skeleton = lab01_pristine_skeleton
+    results = [checks.check_sphere_interior(skeleton), checks.check_golden(skeleton, "cornell")]
     assert not any(r.passed for r in results), "\n".join(map(str, results))
 
 
-def test_skeleton_renders_something(lab01):
+def test_skeleton_renders_something(lab01_pristine_skeleton):
     """...and what it renders is an image, not a crash or a blank: the sphere's flat colour."""
-    run = run_lab(lab01, width=32, height=32, spp=1)
+    run = run_lab(lab01_pristine_skeleton, width=32, height=32, spp=1)
     assert run.image is not None and run.image.max() > 0
+
+
+def test_students_build_runs(lab01):
+    """`make lab01` builds the student's copy and it runs (what it renders is graded)."""
+    assert run_lab(lab01, width=8, height=8, spp=1).image.shape == (8, 8, 3)
 
 
 def test_summary_line_and_json(lab01_ref):

@@ -8,14 +8,12 @@ the full matrix.
 """
 import concurrent.futures
 import pathlib
-import shlex
-import shutil
-import subprocess
 
 import pytest
 
 from grading import checks
-from grading.harness import ROOT, build
+from grading.harness import ROOT
+from grading.variants import build_variant
 
 CHECKS = {
     "interior": checks.check_sphere_interior,
@@ -70,34 +68,16 @@ MUTANTS = {
 }
 
 
-def build_command() -> list[str]:
-    out = subprocess.run(["make", "-s", "-C", str(ROOT), "print-build-command"],
-                         capture_output=True, text=True, check=True).stdout
-    flags = [f for f in shlex.split(out) if not f.startswith(("-DRT_SOURCE_DIR", "-MMD", "-MP"))]
-    return flags + [f'-DRT_SOURCE_DIR="{ROOT}"']
-
-
 def build_mutant(name: str, workdir: pathlib.Path) -> pathlib.Path:
     file, old, new, _ = MUTANTS[name]
-    src = workdir / "src"
-    shutil.copytree(ROOT / "common", src, ignore=shutil.ignore_patterns("scenes", "*.cpp"))
-    shutil.copy(ROOT / "labs" / "01-serial" / "solution" / "render.cpp", src)
-    target = src / file
-    text = target.read_text()
-    assert text.count(old) >= 1, f"mutant '{name}': text to mutate not found in {file}"
-    target.write_text(text.replace(old, new, 1))
-    objects = [ROOT / "build" / "common" / f"{o}.o"
-               for o in ("scene_loader", "image", "cli", "progress", "lab_main", "main")]
-    binary = workdir / "lab"
-    subprocess.run([*build_command(), "-w", f"-I{src}", str(src / "render.cpp"),
-                    *map(str, objects), "-o", str(binary)], check=True, capture_output=True)
-    return binary
+    original = (ROOT / "labs" / "01-serial" / "solution" / file
+                if file == "render.cpp" else ROOT / "common" / file).read_text()
+    assert original.count(old) >= 1, f"mutant '{name}': text to mutate not found in {file}"
+    return build_variant("01-serial", workdir, {file: original.replace(old, new, 1)})
 
 
 @pytest.fixture(scope="module")
-def mutant_results(tmp_path_factory, lab01_ref):
-    build("lab01-ref")
-
+def mutant_results(tmp_path_factory):
     def evaluate(name):
         binary = build_mutant(name, tmp_path_factory.mktemp("mutant"))
         return name, {check: CHECKS[check](binary) for check in CHECKS}

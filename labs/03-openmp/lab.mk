@@ -1,0 +1,50 @@
+# Lab 03: OpenMP. ./lab03 (skeleton) and ./lab03-ref (solution), plus the variants the
+# handout measures, all with the shared command line:
+#   lab03-bench            the solution with schedule(runtime): OMP_SCHEDULE picks the loop
+#                          schedule (tools/bench_openmp.py; the default build keeps the best)
+#   lab03-simd-ref         the solution on lab 02's AVX2 geometry (-DRT_USE_SIMD); only when
+#                          common/simd_pixel_renderer.h exists
+#   lab03-shared-rng       the classic mistake: one generator shared by all threads, locked
+#   lab03-shared-rng-race  the same without the lock: a data race
+#   lab03-row-costs        lab 01's serial render, timing each row (the cost profile)
+LAB03 := labs/03-openmp
+LAB03_BUILD := $(BUILD)/$(LAB03)
+
+# Every object of this lab is compiled with OpenMP; binaries link with it (cpu_lab's third
+# argument and the rules below).
+$(LAB03_BUILD)/%.o: CXXFLAGS += -fopenmp
+$(eval $(call cpu_lab,lab03,03-openmp,-fopenmp))
+
+# Variants: one source, other defines, objects in their own folders.
+$(LAB03_BUILD)/bench/render.o: $(LAB03)/solution/render.cpp
+	@mkdir -p $(dir $@)
+	$(CXX) $(CXXFLAGS) -DRT_RUNTIME_SCHEDULE $(INCLUDES) -c $< -o $@
+$(LAB03_BUILD)/shared-rng-race/shared_rng.o: $(LAB03)/shared_rng.cpp
+	@mkdir -p $(dir $@)
+	$(CXX) $(CXXFLAGS) -DRT_SHARED_RNG_RACE $(INCLUDES) -c $< -o $@
+
+lab03-bench: $(LAB03_BUILD)/bench/render.o $(COMMON_OBJ)
+	$(CXX) $(CXXFLAGS) $^ -o $@ -fopenmp
+lab03-shared-rng: $(LAB03_BUILD)/shared_rng.o $(COMMON_OBJ)
+	$(CXX) $(CXXFLAGS) $^ -o $@ -fopenmp
+lab03-shared-rng-race: $(LAB03_BUILD)/shared-rng-race/shared_rng.o $(COMMON_OBJ)
+	$(CXX) $(CXXFLAGS) $^ -o $@ -fopenmp
+lab03-row-costs: $(LAB03_BUILD)/row_costs.o $(COMMON_OBJ)
+	$(CXX) $(CXXFLAGS) $^ -o $@ -fopenmp
+.PHONY: lab03-bench lab03-shared-rng lab03-shared-rng-race lab03-row-costs lab03-simd-ref
+
+LAB_BINARIES += lab03 lab03-ref lab03-bench lab03-shared-rng lab03-shared-rng-race \
+                lab03-row-costs
+
+ifneq ($(wildcard common/simd_pixel_renderer.h),)
+$(LAB03_BUILD)/simd/render.o: $(LAB03)/solution/render.cpp
+	@mkdir -p $(dir $@)
+	$(CXX) $(CXXFLAGS) -DRT_USE_SIMD $(INCLUDES) -c $< -o $@
+lab03-simd-ref: $(LAB03_BUILD)/simd/render.o $(COMMON_OBJ)
+	$(CXX) $(CXXFLAGS) $^ -o $@ -fopenmp
+LAB_BINARIES += lab03-simd-ref
+else
+lab03-simd-ref:
+	@echo "lab03-simd-ref: needs common/simd_pixel_renderer.h (lab 02), which is not here yet" >&2
+	@exit 1
+endif

@@ -1,0 +1,48 @@
+// GENERATED from labs/03-openmp/solution/render.cpp by tools/skeletons.py: edit this file freely,
+// it is yours. (Instructors: edit the solution and run `make skeletons`.)
+// Lab 03: lab 01's pixel loop, shared among the cores with OpenMP.
+//
+// Each pixel is still lab 01's render_pixel (through PixelRenderer), and its random numbers
+// are a function of (seed, pixel, sample, dimension) only, never of which thread draws them
+// or when. Threads share no state but the read-only scene and disjoint rows of the image, so
+// the image is lab 01's, bit for bit, for any thread count and any schedule.
+//
+// Built with -DRT_USE_SIMD (lab03-simd-ref), each pixel uses lab 02's AVX2 geometry instead.
+// Built with -DRT_RUNTIME_SCHEDULE (lab03-bench), the loop takes its schedule from the
+// OMP_SCHEDULE environment variable, which is how the handout's schedule table is measured.
+#include <omp.h>
+
+#include <string>
+
+#include "lab.h"
+#include "pixel_renderer.h"
+#include "timer.h"
+
+const char* const kLabName = "03-openmp";
+
+// The team size: --threads T, or for T = 0 every core OpenMP may use (the CPUs this process
+// may run on, unless OMP_NUM_THREADS says otherwise).
+static int thread_count(int requested) {
+    // TODO(lab03): return `requested` when it is positive; for 0 ("every core"), ask
+    // OpenMP how many threads it would use (omp_get_max_threads()).
+    (void)requested;
+    return 1;
+}
+
+RenderStats render(const RenderJob& job, Image& image) {
+    const PixelRenderer pixel(job);
+    const int width = job.settings.width;
+    const int height = job.settings.height;
+    const int threads = thread_count(job.threads);
+    const Timer timer;
+    // TODO(lab03): share the rows among `threads` threads with an OpenMP parallel loop,
+    // and choose its schedule by measuring (see the handout). Until then: correct, but
+    // serial, whatever --threads says.
+    for (int y = 0; y < height; ++y) {
+        for (int x = 0; x < width; ++x) image.at(x, y) = pixel(x, y);
+        job.progress.rows_done();
+    }
+    const double seconds = timer.seconds();
+    return {seconds, cpu_model_name() + ", " + std::to_string(threads) +
+                         (threads == 1 ? " thread" : " threads")};
+}
