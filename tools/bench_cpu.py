@@ -1,0 +1,72 @@
+#!/usr/bin/env python3
+"""The CPU labs side by side, in the shape of the report's Table 4, on this machine.
+
+    make bench-cpu                       Cornell at 300x300, 128 spp (quick)
+    tools/bench_cpu.py --full            the baseline: 600x600, 512 spp, 4 bounces
+
+Every row is a reference solution; time is render time as the binary reports it (best of
+--repeat, rows interleaved round by round so a busy spell hits all of them); speedup is
+against the lab-01 reference measured in the same rounds; efficiency is speedup / cores used.
+Rows whose binary is missing are listed as such. Prints a table; asserts nothing.
+"""
+import argparse
+import os
+import pathlib
+import sys
+
+ROOT = pathlib.Path(__file__).resolve().parent.parent
+sys.path.insert(0, str(ROOT))
+from grading.harness import available_cores, run_lab  # noqa: E402
+
+# OpenMPI refuses to run as root unless told; benchmarks run as whoever runs them.
+os.environ.setdefault("OMPI_ALLOW_RUN_AS_ROOT", "1")
+os.environ.setdefault("OMPI_ALLOW_RUN_AS_ROOT_CONFIRM", "1")
+
+
+def rows(cores: int):
+    """(label, binary, threads, launcher, cores used)"""
+    mpirun = ["mpirun", "--oversubscribe", "--bind-to", "none", "-np", str(cores)]
+    return [
+        ("serial (lab 01)", "lab01-ref", None, [], 1),
+        ("SIMD A: SSE vec3", "lab02a-ref", None, [], 1),
+        ("SIMD B: AVX2 8-wide", "lab02-ref", None, [], 1),
+        (f"OpenMP, {cores} threads", "lab03-ref", cores, [], cores),
+        (f"OpenMP + SIMD, {cores} threads", "lab03-simd-ref", cores, [], cores),
+        (f"MPI, {cores} ranks", "lab04-ref", 1, mpirun, cores),
+        (f"MPI + SIMD, {cores} ranks", "lab04-simd-ref", 1, mpirun, cores),
+    ]
+
+
+def main() -> int:
+    p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    p.add_argument("--full", action="store_true", help="the 600x600, 512 spp baseline")
+    p.add_argument("--repeat", type=int, default=3)
+    a = p.parse_args()
+    size, spp = (600, 512) if a.full else (300, 128)
+    cores = available_cores()
+    table = rows(cores)
+    best = {label: None for label, *_ in table}
+    for _ in range(a.repeat):
+        for label, binary, threads, launcher, _ in table:
+            path = ROOT / binary
+            if not path.exists():
+                continue
+            run = run_lab(path, width=size, height=size, spp=spp, bounces=4, threads=threads,
+                          launcher=launcher)
+            s = run.json["seconds"]
+            best[label] = s if best[label] is None else min(best[label], s)
+    serial = best["serial (lab 01)"]
+    print(f"Cornell {size}x{size}, {spp} spp, 4 bounces; best of {a.repeat}; "
+          f"{cores} cores available")
+    print(f"{'version':<32} {'seconds':>8} {'speedup':>8} {'efficiency':>10}")
+    for label, binary, _, _, used in table:
+        if best[label] is None:
+            print(f"{label:<32} {'(not built: ' + binary + ')':>28}")
+            continue
+        speedup = serial / best[label]
+        print(f"{label:<32} {best[label]:>8.3f} {speedup:>7.2f}x {speedup / used:>9.0%}")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
