@@ -92,10 +92,11 @@ Image read_pfm(const std::string& path) {
     if (scale.empty() || scale[0] != '-')
         throw InputError(path + ": big-endian PFM is not supported (expected a negative scale)");
     ++pos;  // the single whitespace byte after the header
-    Image image(w, h);
-    const size_t need = image.pixels.size() * 3 * sizeof(float);
+    // Check the size before allocating: a garbage header must not ask for gigabytes.
+    const size_t need = static_cast<size_t>(w) * h * 3 * sizeof(float);
     if (data.size() - std::min(pos, data.size()) != need)
         throw InputError(path + ": expected " + std::to_string(need) + " bytes of pixels");
+    Image image(w, h);
     const char* src = data.data() + pos;
     for (int y = h - 1; y >= 0; --y) {
         for (int x = 0; x < w; ++x) {
@@ -118,10 +119,10 @@ Image read_ppm(const std::string& path) {
     if (next_token(path, data, pos) != "255")
         throw InputError(path + ": only 8-bit PPM (maxval 255) is supported");
     ++pos;
+    const size_t need = static_cast<size_t>(w) * h * 3;
+    if (data.size() - std::min(pos, data.size()) != need)
+        throw InputError(path + ": expected " + std::to_string(need) + " bytes of pixels");
     Image image(w, h);
-    if (data.size() - std::min(pos, data.size()) != image.pixels.size() * 3)
-        throw InputError(path + ": expected " + std::to_string(image.pixels.size() * 3) +
-                         " bytes of pixels");
     const auto* src = reinterpret_cast<const unsigned char*>(data.data() + pos);
     for (Vec3& p : image.pixels) {
         p = {decode_srgb8(src[0]), decode_srgb8(src[1]), decode_srgb8(src[2])};
@@ -131,6 +132,9 @@ Image read_ppm(const std::string& path) {
 }
 
 AtomicFile::AtomicFile(std::string path) : path_(std::move(path)) {
+    struct stat st;
+    if (::stat(path_.c_str(), &st) == 0 && S_ISDIR(st.st_mode))
+        throw InputError(path_ + ": cannot write output file: it is a directory");
     temp_path_ = path_ + ".partial-XXXXXX";
     fd_ = mkstemp(&temp_path_[0]);
     if (fd_ < 0) throw InputError(path_ + ": cannot write output file: " + std::strerror(errno));

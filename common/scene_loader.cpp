@@ -1,5 +1,6 @@
 #include "scene_loader.h"
 
+#include <cctype>
 #include <cerrno>
 #include <cmath>
 #include <cstring>
@@ -16,6 +17,13 @@
 using nlohmann::json;
 
 namespace {
+
+// One JSON pointer token (RFC 6901): '~' becomes "~0" and '/' becomes "~1".
+std::string pointer_token(const std::string& key) {
+    std::string out;
+    for (char c : key) out += c == '~' ? "~0" : (c == '/' ? "~1" : std::string(1, c));
+    return out;
+}
 
 // A char iterator that publishes how far the parser has read, so SAX events can be tied to
 // a place in the text (nlohmann's SAX interface reports no positions of its own).
@@ -54,6 +62,7 @@ public:
 
     std::map<std::string, size_t> offsets;  // JSON pointer -> offset of the value's first char
     std::string duplicate_key_pointer;      // first key that appeared twice in one object
+    std::string duplicate_key;              // that key, unescaped
     size_t error_offset = 0;                // where the syntax error is
     std::string error_message;              // nlohmann's explanation
 
@@ -77,8 +86,10 @@ public:
     bool key(string_t& k) override {
         Frame& f = frames_.back();
         f.key = k;
-        if (!f.keys.insert(k).second && duplicate_key_pointer.empty())
+        if (!f.keys.insert(k).second && duplicate_key_pointer.empty()) {
             duplicate_key_pointer = child_pointer();
+            duplicate_key = k;
+        }
         offsets[child_pointer() + "#key"] = token_start('"');
         return dom_.key(k);
     }
@@ -99,6 +110,24 @@ public:
                      const nlohmann::detail::exception& ex) override {
         error_offset = position == 0 ? 0 : position - 1;
         error_message = ex.what();
+        // nlohmann points at the last character it read. When a whole token came where it
+        // is not allowed ("unexpected string literal"), point at the token's first character;
+        // a malformed token ("invalid literal") stays at the character that broke it.
+        if (error_message.find("unexpected") != std::string::npos &&
+            error_offset < text_.size()) {
+            size_t i = error_offset;
+            auto in_word = [&](size_t k) {
+                return std::isalnum(static_cast<unsigned char>(text_[k])) ||
+                       std::strchr("+-.", text_[k]) != nullptr;
+            };
+            if (text_[i] == '"') {
+                while (i > 0 && !(text_[i - 1] == '"' && (i < 2 || text_[i - 2] != '\\'))) --i;
+                if (i > 0) --i;
+            } else if (in_word(i)) {
+                while (i > 0 && in_word(i - 1)) --i;
+            }
+            error_offset = i;
+        }
         return false;
     }
 
@@ -110,11 +139,6 @@ private:
         std::set<std::string> keys;  // keys seen, to catch duplicates
     };
 
-    static std::string escape(const std::string& token) {  // RFC 6901
-        std::string out;
-        for (char c : token) out += c == '~' ? "~0" : (c == '/' ? "~1" : std::string(1, c));
-        return out;
-    }
     std::string pointer() const {
         std::string p;
         for (const std::string& token : path_) p += "/" + token;
@@ -122,7 +146,7 @@ private:
     }
     std::string child_pointer() const {
         const Frame& f = frames_.back();
-        return pointer() + "/" + (f.is_object ? escape(f.key) : std::to_string(f.index));
+        return pointer() + "/" + (f.is_object ? pointer_token(f.key) : std::to_string(f.index));
     }
     // Offset of the token the parser has just finished: scan back from what it has read to
     // the token's first character (the opening quote for strings).
@@ -151,7 +175,7 @@ private:
     }
     std::string current_token() const {
         const Frame& f = frames_.back();
-        return f.is_object ? escape(f.key) : std::to_string(f.index);
+        return f.is_object ? pointer_token(f.key) : std::to_string(f.index);
     }
     bool value_done(bool ok) {
         if (!frames_.empty()) {
@@ -218,7 +242,7 @@ public:
                 list += std::string(list.empty() ? "" : ", ") + "\"" + a + "\"";
             }
             if (!known)
-                fail_key(pointer + "/" + it.key(),
+                fail_key(pointer + "/" + pointer_token(it.key()),
                          "unknown key \"" + it.key() + "\" (expected one of " + list + ")");
         }
     }
@@ -268,7 +292,7 @@ public:
         const long long x = v.get<long long>();
         if (x < lo || x > hi)
             fail(pointer, "expected an integer in " + std::to_string(lo) + ".." +
-                              std::to_string(hi) + ", found " + std::to_string(x));
+                              std::to_string(hi) + ", found " + v.dump());
         return static_cast<int>(x);
     }
 
@@ -309,7 +333,7 @@ Scene parse_scene(const std::string& text, const std::string& name) {
     SceneReader r(name, text, recorder.offsets);
     if (!recorder.duplicate_key_pointer.empty()) {
         const std::string& p = recorder.duplicate_key_pointer;
-        r.fail_key(p, "duplicate key \"" + p.substr(p.rfind('/') + 1) + "\"");
+        r.fail_key(p, "duplicate key \"" + recorder.duplicate_key + "\"");
     }
 
     Scene scene;
@@ -351,7 +375,7 @@ Scene parse_scene(const std::string& text, const std::string& name) {
                                  SceneReader::type_of(materials));
     std::map<std::string, int> material_index;
     for (auto it = materials.begin(); it != materials.end(); ++it) {
-        const std::string p = "/materials/" + it.key();
+        const std::string p = "/materials/" + pointer_token(it.key());
         const json& m = it.value();
         if (!m.is_object()) r.fail(p, "expected an object, found " + SceneReader::type_of(m));
         const json& type = r.require(m, p, "type");

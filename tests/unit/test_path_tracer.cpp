@@ -16,7 +16,11 @@ struct TestScene {
     Scene scene;
 
     int material(MaterialType type, Vec3 albedo, float ior = 1.5f) {
-        scene.materials.push_back({type, albedo, ior});
+        Material m{};  // field by field: the tests survive new members
+        m.type = type;
+        m.albedo = albedo;
+        m.ior = ior;
+        scene.materials.push_back(m);
         scene.material_names.push_back("m" + std::to_string(scene.materials.size()));
         return static_cast<int>(scene.materials.size()) - 1;
     }
@@ -26,10 +30,17 @@ struct TestScene {
         scene.triangles.push_back(make_triangle(a, b, c, m));
         scene.triangles.push_back(make_triangle(a, c, d, m));
     }
-    void sphere(Vec3 c, float r, int m) { scene.spheres.push_back({c, r, m}); }
+    void sphere(Vec3 c, float r, int m) {
+        Sphere s{};
+        s.center = c;
+        s.radius = r;
+        s.material = m;
+        scene.spheres.push_back(s);
+    }
     void light(Vec3 p, Vec3 intensity) {
         scene.has_light = true;
-        scene.light = {p, intensity};
+        scene.light.position = p;
+        scene.light.intensity = intensity;
     }
     SceneView view() const { return scene.view(); }
 };
@@ -216,7 +227,7 @@ TEST(PathTracer, MirrorShowsWhatItFaces) {
     ts.scene.background = Vec3(0.25f);
     const SceneView v = ts.view();
     const Ray straight_down{{0.1f, 0.5f, 0}, {0, -1, 0}};  // under the sphere
-    EXPECT_EQ(closest_hit(v, straight_down).triangle >= 0, true);
+    EXPECT_GE(closest_hit(v, straight_down).triangle, 0);
     const Vec3 l = trace_path(v, straight_down, kRng, 3);
     EXPECT_EQ(l.x, 0.0f);  // the sphere's unlit bottom; the next bounce would need > 3
 }
@@ -370,6 +381,97 @@ TEST(PathTracer, ScaleInvariance) {
         EXPECT_GT(sum_base, 0.0);
         EXPECT_NEAR(sum_scaled / sum_base, 1.0, 1e-2) << "scale " << s;
         EXPECT_GE(close, pixels * 9 / 10) << "scale " << s;
+    }
+}
+
+// A closed room leaks no light: inside a cube of 12 triangles under a bright sky, every
+// path must stay black. Camera rays aimed exactly at the cube's edges and corners (where two
+// walls meet) must find a wall; whole paths in random directions must never escape.
+TEST(PathTracer, ClosedBoxDoesNotLeak) {
+    for (float scale : {1e-4f, 1.0f, 1e5f}) {
+        for (const Vec3 offset : {Vec3(0.0f), Vec3(37.0f, -120.0f, 5.0f)}) {
+            TestScene ts;
+            const int wall = ts.material(MaterialType::Diffuse, Vec3(0.9f));
+            const int glass = ts.material(MaterialType::Glass, Vec3(0.0f), 1.5f);
+            const int mirror = ts.material(MaterialType::Mirror, Vec3(1.0f));
+            Vec3 corner[8];
+            for (int i = 0; i < 8; ++i)
+                corner[i] = (Vec3(i & 1 ? 1.0f : -1.0f, i & 2 ? 1.0f : -1.0f, i & 4 ? 1.0f : -1.0f) +
+                             offset) * scale;
+            // Each face as a quad (v0 v1 v2 v3) split along v0-v2, facing inwards.
+            const int faces[6][4] = {{0, 1, 3, 2}, {4, 6, 7, 5}, {0, 4, 5, 1},
+                                     {2, 3, 7, 6}, {0, 2, 6, 4}, {1, 5, 7, 3}};
+            for (int f = 0; f < 6; ++f) {
+                const int m = f == 1 ? mirror : wall;
+                const int* q = faces[f];
+                ts.scene.triangles.push_back(make_triangle(corner[q[0]], corner[q[1]], corner[q[2]], m));
+                ts.scene.triangles.push_back(make_triangle(corner[q[0]], corner[q[2]], corner[q[3]], m));
+            }
+            ts.sphere((Vec3(0.3f, -0.4f, 0.2f) + offset) * scale, 0.3f * scale, glass);
+            ts.scene.background = Vec3(1.0f);
+            const SceneView v = ts.view();
+            const Vec3 centre = (Vec3(-0.2f, 0.3f, -0.1f) + offset) * scale;
+            int misses = 0, leaks = 0;
+            for (int s = 0; s < 3000; ++s) {
+                const SampleStream rng(0, 0, s);
+                // A point on one of the 12 edges (from corner i0 along one axis), and a corner.
+                const int e = s % 12, axis = e / 4, a = e & 1, b = (e >> 1) & 1;
+                const int i0 = axis == 0 ? (a << 1) | (b << 2) : axis == 1 ? a | (b << 2) : a | (b << 1);
+                const Vec3 p0 = corner[i0], p1 = corner[i0 | (1 << axis)];
+                for (const Vec3 target : {p0 + (p1 - p0) * rng.at(100), corner[s % 8]}) {
+                    if (!closest_hit(v, {centre, normalize(target - centre)}).found()) ++misses;
+                }
+                // A whole path, starting in a uniformly random direction.
+                const Vec3 d = sample_cosine_hemisphere(s % 2 ? Vec3(0, 0, 1) : Vec3(0, 0, -1),
+                                                        rng.at(101), rng.at(102));
+                const Vec3 l = trace_path(v, {centre, d}, rng, 12);
+                ASSERT_FALSE(std::isnan(l.x));
+                if (!is_black(l)) ++leaks;
+            }
+            EXPECT_EQ(misses, 0) << "scale " << scale << " offset " << offset.x;
+            EXPECT_EQ(leaks, 0) << "scale " << scale << " offset " << offset.x;
+        }
+    }
+}
+
+// The same inside a diffuse sphere, with long paths: each bounce starts just inside the
+// surface, so the hit point, the normal and the sampled direction must stay accurate bounce
+// after bounce (errors must not compound).
+TEST(PathTracer, SphereRoomDoesNotLeak) {
+    for (float scale : {1e-4f, 1.0f, 1e3f, 1e5f}) {
+        for (float radius : {0.5f, 2.0f, 50.0f}) {
+            TestScene ts;
+            const Vec3 centre = Vec3(3.0f, -2.0f, 1.0f) * scale;
+            ts.sphere(centre, radius * scale, ts.material(MaterialType::Diffuse, Vec3(0.9f)));
+            ts.scene.background = Vec3(1.0f);
+            const SceneView v = ts.view();
+            int leaks = 0;
+            for (int s = 0; s < 2000; ++s) {
+                const SampleStream rng(1, 0, s);
+                const Vec3 d = sample_cosine_hemisphere(s % 2 ? Vec3(1, 0, 0) : Vec3(-1, 0, 0),
+                                                        rng.at(100), rng.at(101));
+                const Vec3 origin = centre + Vec3(0.2f * radius * scale, 0.0f, 0.0f);
+                if (!is_black(trace_path(v, {origin, d}, rng, 32))) ++leaks;
+            }
+            EXPECT_EQ(leaks, 0) << "scale " << scale << " radius " << radius;
+        }
+    }
+}
+
+// A sphere's shading normal is unit length even where the hit point is off the surface by
+// rounding (the sampling basis and reflect() assume a unit normal).
+TEST(PathTracer, SphereNormalIsUnitLength) {
+    TestScene ts;
+    ts.sphere({3, -2, 1}, 2.0f, ts.material(MaterialType::Diffuse, Vec3(0.5f)));
+    const SceneView v = ts.view();
+    Hit hit;
+    hit.sphere = 0;
+    // A ray whose t is a little off, as after a few bounces of rounding.
+    for (float t : {2.0f, 2.0001f, 1.9999f}) {
+        hit.t = t;
+        const SurfacePoint sp = surface_at(v, {{3, -2, 1}, {1, 0, 0}}, hit);
+        EXPECT_NEAR(length(sp.normal), 1.0f, 1e-6f) << "t " << t;
+        EXPECT_GT(sp.normal.x, 0.99f);
     }
 }
 

@@ -7,7 +7,9 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdio>
 #include <filesystem>
+#include <fstream>
 #include <string>
 #include <vector>
 
@@ -20,7 +22,7 @@ const char* const kName = "case.json";
 
 struct Marked {
     std::string text;      // without the marker
-    std::string position;  // "line L, column C" of the marker
+    std::string position;  // "case.json:line L, column C:", the marker's place as reported
 };
 
 Marked unmark(const std::string& marked, char marker = '@') {
@@ -38,7 +40,8 @@ Marked unmark(const std::string& marked, char marker = '@') {
     }
     std::string text = marked;
     text.erase(at, 1);
-    return {text, "line " + std::to_string(line) + ", column " + std::to_string(column)};
+    return {text, std::string(kName) + ":line " + std::to_string(line) + ", column " +
+                      std::to_string(column) + ":"};
 }
 
 // The message of the InputError that parsing throws, or "" (with a failure) if none.
@@ -60,7 +63,7 @@ void expect_error(const std::string& marked, const std::vector<std::string>& wor
     const Marked m = unmark(marked);
     const std::string message = error_of(m.text);
     if (message.empty()) return;
-    EXPECT_NE(message.find(kName), std::string::npos) << "no file name in: " << message;
+    EXPECT_EQ(message.rfind(kName, 0), 0u) << "does not start with the file name: " << message;
     EXPECT_NE(message.find(m.position), std::string::npos)
         << "expected " << m.position << " in: " << message;
     for (const std::string& w : words)
@@ -145,6 +148,25 @@ TEST(SceneLoader, MissingFileIsAnInputErrorNamingIt) {
     } catch (const InputError& e) {
         EXPECT_NE(std::string(e.what()).find(path), std::string::npos) << e.what();
     }
+}
+
+TEST(SceneLoader, ErrorsFromAFileNameThePath) {
+    const std::string path = ::testing::TempDir() + "rt-unit-bad-scene.json";
+    {
+        std::ofstream out(path);
+        out << "{\n  \"camera\": { \"position\": [0, 0, 5], \"look_at\": [0, 0, 0] },\n"
+               "  \"materials\": { \"w\": { \"type\": \"diffuse\", \"albedo\": [0.5, 0.5, 0.5] } },\n"
+               "  \"spheres\": [ { \"center\": [0, 0, 0], \"radius\": -2, \"material\": \"w\" } ]\n}\n";
+    }
+    try {
+        load_scene(path);
+        ADD_FAILURE() << "no error";
+    } catch (const InputError& e) {
+        const std::string m = e.what();
+        EXPECT_EQ(m.rfind(path + ":line 4, column 49:", 0), 0u) << m;
+        EXPECT_NE(m.find("radius > 0"), std::string::npos) << m;
+    }
+    std::remove(path.c_str());
 }
 
 TEST(SceneLoader, MinimalSceneGetsDefaults) {
@@ -263,6 +285,15 @@ TEST(SceneLoaderErrors, MissingCommaBetweenMembers) {
 TEST(SceneLoaderErrors, MissingCommaInArray) {
     expect_error("{\n  \"camera\": { \"position\": [0, 0 @5], \"look_at\": [0, 0, 0] }\n}\n",
                  {"invalid JSON", "expected"});
+}
+
+// A token of several characters that is well formed but out of place is reported at its
+// first character, like every other error.
+TEST(SceneLoaderErrors, UnexpectedLongTokenAtItsStart) {
+    expect_error("{\n  \"camera\": { \"position\": [0, 0 @-12.5], \"look_at\": [0, 0, 0] }\n}\n",
+                 {"invalid JSON", "expected"});
+    expect_error("{\n  \"background\": [0, 0, 0] @true\n}\n", {"invalid JSON", "expected"});
+    expect_error("{\n  \"background\" @\"black\"\n}\n", {"invalid JSON", "expected ':'"});
 }
 
 // Lexical errors are reported at the first character that cannot continue the token.
@@ -573,6 +604,15 @@ TEST(SceneLoaderErrors, RenderWidthZeroOrAbsurd) {
                  {"unknown key", "\"samples\"", "\"spp\""});
 }
 
+// Integers beyond 64-bit signed range are rejected with the value as written, not as it
+// wraps around in a long long.
+TEST(SceneLoaderErrors, HugeIntegerReportedAsWritten) {
+    expect_error(scene_with(kGoodSphere, "  \"render\": { \"width\": @18446744073709551615 },\n"),
+                 {"width", "expected an integer", "found 18446744073709551615"});
+    expect_error(scene_with(kGoodSphere, "  \"render\": { \"spp\": @9223372036854775808 },\n"),
+                 {"spp", "found 9223372036854775808"});
+}
+
 TEST(SceneLoaderErrors, RenderLimitsAreInclusive) {
     const Scene s = parse_scene(
         scene_with(kGoodSphere, "  \"render\": { \"width\": 16384, \"height\": 1, \"bounces\": 64 },\n"),
@@ -586,6 +626,11 @@ TEST(SceneLoaderErrors, RenderLimitsAreInclusive) {
 TEST(SceneLoaderErrors, UnknownKeyWithSlashIsLocated) {
     expect_error(scene_with(kGoodSphere, "  @\"light/position\": [0, 1, 0],\n"),
                  {"unknown key", "\"light/position\""});
+}
+
+TEST(SceneLoaderErrors, DuplicateKeyWithSlashIsNamed) {
+    expect_error(scene_with(kGoodSphere, "  \"a/b\": 1,\n  @\"a/b\": 2,\n"),
+                 {"duplicate key \"a/b\""});
 }
 
 TEST(SceneLoaderErrors, MaterialNameWithSlashIsLocated) {

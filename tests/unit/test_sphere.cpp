@@ -41,8 +41,15 @@ Vec3 random_unit(std::mt19937& gen) {
     }
 }
 
-// Sphere material index is irrelevant to intersection.
-Sphere sphere(Vec3 c, float r) { return {c, r, 0}; }
+// A sphere of material 0 (irrelevant to intersection), field by field so that new members
+// of Sphere do not break the tests.
+Sphere sphere(Vec3 c, float r) {
+    Sphere s{};
+    s.center = c;
+    s.radius = r;
+    s.material = 0;
+    return s;
+}
 
 }  // namespace
 
@@ -143,7 +150,7 @@ TEST(Sphere, ExtremeScalesDistance1e4TimesRadius) {
         const Sphere s = sphere(c, r);
         for (int i = 0; i < 2000; ++i) {
             const Vec3 dir_to_eye = random_unit(gen);
-            const Ray probe{c + dir_to_eye * (1e4f * r), Vec3(0.0f)};
+            const Vec3 eye = c + dir_to_eye * (1e4f * r);
             Vec3 t1, t2;
             orthonormal_basis(dir_to_eye, t1, t2);
             float a, b;
@@ -152,7 +159,7 @@ TEST(Sphere, ExtremeScalesDistance1e4TimesRadius) {
                 b = u(gen);
             } while (a * a + b * b > 0.81f);
             const Vec3 target = c + (t1 * a + t2 * b) * r;
-            const Ray ray{probe.origin, normalize(target - probe.origin)};
+            const Ray ray{eye, normalize(target - eye)};
             const double ref = reference_t(ray, s);
             ASSERT_GT(ref, 0) << "r=" << r;
             const float t = intersect_sphere(ray, s, FLT_MAX);

@@ -108,35 +108,44 @@ TEST(Triangle, Misses) {
     EXPECT_FLOAT_EQ(hit({{0, 0, 0}, {0, 0, -1}}, tri, 2.01f), 2.0f);
 }
 
+// Random rays against a double-precision reference, at unit scale and at the extremes
+// (1e-4, 1e5), with the triangle away from the world origin.
 TEST(Triangle, RandomRaysMatchDoubleReference) {
     std::mt19937 gen(5);
     std::uniform_real_distribution<float> u(-2.0f, 2.0f);
-    const Triangle tri = make_triangle({0.1f, -0.3f, 0.2f}, {1.2f, 0.4f, -0.5f}, {-0.4f, 1.1f, 0.3f}, 0);
-    int hits = 0;
-    for (int i = 0; i < 20000; ++i) {
-        // Aim at a random barycentric point (inside or a little outside).
-        std::uniform_real_distribution<float> b(-0.2f, 1.2f);
-        const float b1 = b(gen), b2 = b(gen);
-        const Vec3 target = tri.v0 + (tri.v1 - tri.v0) * b1 + (tri.v2 - tri.v0) * b2;
-        const Vec3 origin(u(gen), u(gen), u(gen));
-        const Ray ray{origin, normalize(target - origin)};
-        const float t = hit(ray, tri);
-        ASSERT_FALSE(std::isnan(t));
-        const bool clearly_inside = b1 > 1e-3f && b2 > 1e-3f && b1 + b2 < 1 - 1e-3f;
-        const bool clearly_outside = b1 < -1e-3f || b2 < -1e-3f || b1 + b2 > 1 + 1e-3f;
-        const double ref = plane_t(ray, tri);
-        if (clearly_inside && ref > 1e-3) {
-            ++hits;
-            ASSERT_LT(t, FLT_MAX) << "ray " << i;
-            // The distance of the hit point from the plane is what t's error is: compare
-            // that, so that grazing rays (ill-conditioned t) are judged fairly.
-            const double cos_angle = std::fabs(dot(ray.direction, tri.normal));
-            ASSERT_LT(std::fabs(t - ref) * cos_angle, 1e-6 * (1 + ref)) << "ray " << i;
-        } else if (clearly_outside) {
-            ASSERT_EQ(t, FLT_MAX) << "ray " << i;
+    std::uniform_real_distribution<float> bary(-0.2f, 1.2f);
+    for (float scale : {1e-4f, 1.0f, 1e5f}) {
+        const Vec3 offset(3.0f, -2.0f, 5.0f);
+        const Triangle tri = make_triangle((Vec3(0.1f, -0.3f, 0.2f) + offset) * scale,
+                                           (Vec3(1.2f, 0.4f, -0.5f) + offset) * scale,
+                                           (Vec3(-0.4f, 1.1f, 0.3f) + offset) * scale, 0);
+        int hits = 0;
+        for (int i = 0; i < 20000; ++i) {
+            // Aim at a random barycentric point (inside or a little outside).
+            const float b1 = bary(gen), b2 = bary(gen);
+            const Vec3 target = tri.v0 + (tri.v1 - tri.v0) * b1 + (tri.v2 - tri.v0) * b2;
+            const Vec3 origin = (offset + Vec3(u(gen), u(gen), u(gen))) * scale;
+            const Ray ray{origin, normalize(target - origin)};
+            const float t = hit(ray, tri);
+            ASSERT_FALSE(std::isnan(t));
+            const bool clearly_inside = b1 > 1e-3f && b2 > 1e-3f && b1 + b2 < 1 - 1e-3f;
+            const bool clearly_outside = b1 < -1e-3f || b2 < -1e-3f || b1 + b2 > 1 + 1e-3f;
+            const double ref = plane_t(ray, tri);
+            if (clearly_inside && ref > 1e-3 * scale) {
+                ++hits;
+                ASSERT_LT(t, FLT_MAX) << "scale " << scale << " ray " << i;
+                // The hit point's distance from the plane is what t's error amounts to:
+                // compare that, so that grazing rays (ill-conditioned t) are judged fairly.
+                const double cos_angle = std::fabs(dot(ray.direction, tri.normal));
+                ASSERT_LT(std::fabs(t - ref) * cos_angle, 2e-6 * (8.0 * scale + ref))
+                    << "scale " << scale << " ray " << i;
+                ASSERT_LT(std::fabs(t - ref), 1e-4 * ref) << "scale " << scale << " ray " << i;
+            } else if (clearly_outside) {
+                ASSERT_EQ(t, FLT_MAX) << "scale " << scale << " ray " << i;
+            }
         }
+        EXPECT_GT(hits, 3000) << "scale " << scale;
     }
-    EXPECT_GT(hits, 3000);
 }
 
 TEST(Triangle, ParallelRaysInThePlaneMiss) {

@@ -37,7 +37,7 @@ RT_HD inline SurfacePoint surface_at(const SceneView& scene, const Ray& ray, con
     const Vec3 p = ray.at(hit.t);
     if (hit.sphere >= 0) {
         const Sphere& s = scene.spheres[hit.sphere];
-        return {p, (p - s.center) * (1.0f / s.radius), s.material};
+        return {p, normalize(p - s.center), s.material};
     }
     const Triangle& tri = scene.triangles[hit.triangle];
     return {p, tri.normal, tri.material};
