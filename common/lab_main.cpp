@@ -56,6 +56,7 @@ static int run(int argc, char** argv, const LabHooks& hooks, bool& setup_reporte
         hooks.setup_done(true);
     }
     const RenderStats stats = render(job, image);
+    progress.finish();  // the bar's last line before anything else is printed
     if (!hooks.writes_output) return 0;
 
     if (ppm) ppm->commit(ppm_bytes(image));

@@ -11,8 +11,8 @@ Progress::Progress(long total_rows, bool enabled)
       enabled_(enabled),
       start_(std::chrono::steady_clock::now()) {}
 
-Progress::~Progress() {
-    if (drawn_) {
+void Progress::finish() {
+    if (drawn_.exchange(false)) {
         draw(done_.load());
         std::fputc('\n', stderr);
     }
@@ -27,12 +27,13 @@ void Progress::rows_done(long n) {
     long long due = next_draw_ns_.load(std::memory_order_relaxed);
     if (now < due) return;
     // One thread wins the redraw; ten redraws a second is plenty.
-    if (next_draw_ns_.compare_exchange_strong(due, now + 100'000'000)) draw(done);
+    if (next_draw_ns_.compare_exchange_strong(due, now + 100'000'000)) {
+        drawn_ = true;
+        draw(done);
+    }
 }
 
 void Progress::draw(long done) {
-    if (!enabled_) return;
-    drawn_ = true;
     const double fraction = static_cast<double>(done) / total_;
     const double elapsed =
         std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count();
@@ -42,7 +43,7 @@ void Progress::draw(long done) {
     for (int i = 0; i < width; ++i) bar[i] = i < filled ? '#' : '.';
     bar[width] = '\0';
     const double eta = fraction > 0 ? elapsed * (1 - fraction) / fraction : 0;
-    std::fprintf(stderr, "\r[%s] %5.1f%%  %6.1f s elapsed, ~%.0f s left ", bar,
+    std::fprintf(stderr, "\r[%s] %5.1f%%  %6.1f s elapsed, ~%.1f s left ", bar,
                  100.0 * fraction, elapsed, eta);
     std::fflush(stderr);
 }

@@ -9,9 +9,10 @@ class Progress {
 public:
     // Shows a bar when `enabled` (stderr is a terminal and not --quiet); else does nothing.
     Progress(long total_rows, bool enabled);
-    ~Progress();  // ends the line if a bar was drawn
+    ~Progress() { finish(); }
 
     void rows_done(long n = 1);  // report finished work; cheap when disabled or throttled
+    void finish();               // final redraw and end of line, if a bar was drawn
 
 private:
     void draw(long done);
