@@ -1,6 +1,12 @@
 // Three-component float vector: points, directions and RGB radiance alike.
 #pragma once
 
+#if defined(RT_VEC3_SSE)
+// Lab 02 Part A: the same interface on SSE registers. Angle brackets: found through -I, so
+// labs/02-simd/skeleton/vec3_sse.h can take the place of common/'s in the student's build.
+#include <vec3_sse.h>
+#else
+
 #include <cmath>
 
 #include "rt_hd.h"
@@ -60,3 +66,5 @@ RT_HD inline void orthonormal_basis(Vec3 n, Vec3& t, Vec3& b) {
     t = {1.0f + sign * n.x * n.x * a, sign * c, -sign * n.x};
     b = {c, sign + n.y * n.y * a, -n.y};
 }
+
+#endif  // RT_VEC3_SSE

@@ -27,6 +27,7 @@ ROOT = pathlib.Path(__file__).resolve().parent.parent
 # Shared files whose solution regions belong to a lab's students.
 SHARED_SOURCES = {
     "01-serial": ["common/path_tracer.h"],
+    "02-simd": ["common/packet_tracer.h", "common/vec3_sse.h"],
 }
 
 BEGIN = re.compile(r"^\s*// BEGIN SOLUTION\s*$")
