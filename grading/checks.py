@@ -146,6 +146,19 @@ def check_reproducible(binary, **kwargs) -> CheckResult:
                        f"same seed identical: {same}; new seed changes image: {differs}")
 
 
+def check_speedup(binary, baseline, min_speedup: float, *, threads=None, launcher=(),
+                  repeat: int = 3) -> CheckResult:
+    """Render time against a baseline binary (the lab-01 reference), interleaved in one run,
+    best of `repeat`: a ratio, so a busy machine slows both sides alike."""
+    from grading.harness import interleaved_speedup, render_seconds
+    scene = dict(width=120, height=120, spp=32, bounces=4, seed=1)
+    speedup, base, fast = interleaved_speedup(
+        lambda: render_seconds(baseline, **scene),
+        lambda: render_seconds(binary, threads=threads, launcher=launcher, **scene), n=repeat)
+    return CheckResult(f"speedup >= {min_speedup:g}x", speedup >= min_speedup,
+                       f"{speedup:.2f}x ({base:.3f} s -> {fast:.3f} s, best of {repeat})")
+
+
 def correctness_checks(binary) -> list[CheckResult]:
     """Every check a lab's rendering must pass, in the order a student should read them."""
     return [
