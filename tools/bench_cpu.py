@@ -10,6 +10,8 @@ against the lab-01 reference measured in the same rounds; efficiency is speedup 
 Rows whose binary is missing are listed as such. Prints a table; asserts nothing.
 """
 import argparse
+import datetime
+import json
 import os
 import pathlib
 import sys
@@ -41,6 +43,8 @@ def main() -> int:
     p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     p.add_argument("--full", action="store_true", help="the 600x600, 512 spp baseline")
     p.add_argument("--repeat", type=int, default=3)
+    p.add_argument("--record", metavar="FILE.json",
+                   help="also write the table as JSON (reference/timings/ keeps these)")
     a = p.parse_args()
     size, spp = (600, 512) if a.full else (300, 128)
     cores = available_cores()
@@ -56,8 +60,9 @@ def main() -> int:
             s = run.json["seconds"]
             best[label] = s if best[label] is None else min(best[label], s)
     serial = best["serial (lab 01)"]
+    device = run_lab(ROOT / "lab01-ref", width=8, height=8, spp=1).json["device"]
     print(f"Cornell {size}x{size}, {spp} spp, 4 bounces; best of {a.repeat}; "
-          f"{cores} cores available")
+          f"{cores} cores available; {device.split(',')[0]}")
     print(f"{'version':<32} {'seconds':>8} {'speedup':>8} {'efficiency':>10}")
     for label, binary, _, _, used in table:
         if best[label] is None:
@@ -65,6 +70,21 @@ def main() -> int:
             continue
         speedup = serial / best[label]
         print(f"{label:<32} {best[label]:>8.3f} {speedup:>7.2f}x {speedup / used:>9.0%}")
+    if a.record:
+        record = {
+            "what": f"Cornell {size}x{size}, {spp} spp, 4 bounces, best of {a.repeat}",
+            "cpu": device.split(",")[0], "cores": cores,
+            "load_average_after": os.getloadavg()[0],
+            "date": datetime.date.today().isoformat(),
+            "rows": [{"version": label, "binary": binary, "cores_used": used,
+                      "seconds": best[label],
+                      "speedup": serial / best[label] if best[label] else None}
+                     for label, binary, _, _, used in table if best[label] is not None],
+        }
+        path = pathlib.Path(a.record)
+        path.parent.mkdir(parents=True, exist_ok=True)
+        path.write_text(json.dumps(record, indent=2) + "\n")
+        print(f"recorded in {path}")
     return 0
 
 
