@@ -1,0 +1,200 @@
+"""Lab 03 (OpenMP): the reference renders lab 01's image bit for bit for any thread count and
+is faster by a margin scaled to the cores present; the skeleton is correct but serial (same
+bits, no speedup); the SIMD+OpenMP variant passes the golden comparison; the shared-RNG
+variant, the classic mistake, renders but not lab 01's image."""
+import concurrent.futures
+import dataclasses
+import os
+
+import pytest
+
+from grading import checks
+from grading.harness import ROOT, available_cores, build, render_seconds, run_lab
+from grading.variants import build_pristine_skeleton
+
+# Small renders for the bitwise comparisons: every pixel, sample and bounce is exercised.
+SMALL = dict(width=48, height=40, spp=8, seed=3)
+# The timed render: about a second serially on the course's two-core VM.
+TIMED = dict(width=256, height=256, spp=32, seed=1)
+ROUNDS = 5  # best of 5: on a shared machine, some round of each is usually undisturbed
+SIMD_HEADER = ROOT / "common" / "simd_pixel_renderer.h"
+
+
+@pytest.fixture(scope="module")
+def lab03_ref():
+    return build("lab03-ref")[0]
+
+
+@pytest.fixture(scope="module")
+def lab03_skeleton(tmp_path_factory):
+    """The skeleton exactly as generated from the solution, whatever a student has done to
+    labs/03-openmp/skeleton/ since: its expected failures stay expected."""
+    return build_pristine_skeleton("03-openmp", tmp_path_factory.mktemp("lab03-skeleton"),
+                                   extra_flags=["-fopenmp"])
+
+
+@pytest.fixture(scope="module")
+def lab01_bits(lab01_ref):
+    """lab01-ref's PFM of the small render: what every thread count must reproduce."""
+    return run_lab(lab01_ref, **SMALL).image.tobytes()
+
+
+# --- correctness: bit for bit -------------------------------------------------------------
+
+@pytest.mark.parametrize("threads", [1, 2, 3, 4, 7, 64, None],
+                         ids=lambda t: f"threads={t or 'default'}")
+def test_reference_is_lab01_bit_for_bit(lab03_ref, lab01_bits, threads):
+    """Counter-based random numbers: a pixel's value cannot depend on which thread rendered
+    it, so any thread count (64 threads: more than the 40 rows) gives lab 01's bits."""
+    run = run_lab(lab03_ref, threads=threads, **SMALL)
+    assert run.image.tobytes() == lab01_bits, \
+        f"--threads {threads}: image differs from lab01-ref's bits"
+
+
+@pytest.mark.parametrize("schedule", ["static", "static,1", "dynamic,3", "guided"])
+def test_every_schedule_is_lab01_bit_for_bit(lab01_bits, schedule, monkeypatch):
+    """lab03-bench takes its schedule from OMP_SCHEDULE (the handout's table): any schedule
+    gives the same bits."""
+    bench = build("lab03-bench")[0]
+    monkeypatch.setenv("OMP_SCHEDULE", schedule)
+    run = run_lab(bench, threads=3, **SMALL)
+    assert run.image.tobytes() == lab01_bits, f"OMP_SCHEDULE={schedule}: image differs"
+
+
+def test_reference_passes_golden(lab03_ref):
+    result = checks.check_golden(lab03_ref, "cornell")
+    assert result.passed, str(result)
+
+
+def test_device_names_the_thread_count(lab03_ref):
+    """--threads T is used as given; the default is every core this process may use."""
+    assert run_lab(lab03_ref, threads=3, **SMALL).json["device"].endswith(", 3 threads")
+    if "OMP_NUM_THREADS" not in os.environ:  # which would override "every core"
+        cores = available_cores()
+        want = f", {cores} thread" + ("s" if cores > 1 else "")
+        device = run_lab(lab03_ref, **SMALL).json["device"]
+        assert device.endswith(want), f"default threads: {device!r}, wanted {want!r}"
+
+
+@pytest.mark.parametrize("bad", ["0", "-1", "two", "1.5", ""])
+def test_bad_thread_count_is_rejected(lab03_ref, bad):
+    run = run_lab(lab03_ref, extra=["--threads", bad], check=False, **SMALL)
+    assert run.returncode == 2 and "--threads" in run.stderr, (run.returncode, run.stderr)
+
+
+# --- the skeleton: correct but serial -------------------------------------------------------
+
+@pytest.mark.parametrize("threads", [1, 2, None], ids=lambda t: f"threads={t or 'default'}")
+def test_skeleton_is_correct(lab03_skeleton, lab01_bits, threads):
+    """The skeleton renders lab 01's image from the start (what it lacks is speed)."""
+    run = run_lab(lab03_skeleton, threads=threads, **SMALL)
+    assert run.image.tobytes() == lab01_bits
+
+
+# --- speed ----------------------------------------------------------------------------------
+
+def side_by_side_seconds(serial, cores: int) -> float:
+    """Mean render seconds of `cores` copies of a serial render run at once. Against one run
+    alone it gives the machine's capacity, how many cores' worth of throughput it gives us
+    right now: about `cores` when idle; close to 1 when shared with other users' jobs (the
+    kernel shares CPUs among sessions, not threads), and then no program can show a
+    speedup."""
+    with concurrent.futures.ThreadPoolExecutor(cores) as pool:
+        times = list(pool.map(lambda _: render_seconds(serial, **TIMED), range(cores)))
+    return sum(times) / len(times)
+
+
+@pytest.fixture(scope="module")
+def speedups(lab01_ref, lab03_ref, lab03_skeleton):
+    """Speedups over lab01-ref of lab03-ref and of the skeleton with every core, and the
+    machine's capacity: measured as shared/DESIGN.md says, interleaved in one run, render
+    time only, best of ROUNDS."""
+    cores = available_cores()
+    if cores < 2:
+        pytest.skip("only one core available to this process: no parallel speedup to measure")
+    single, together, ref, skeleton = [], [], [], []
+    for _ in range(ROUNDS):
+        single.append(render_seconds(lab01_ref, **TIMED))
+        together.append(side_by_side_seconds(lab01_ref, cores))
+        ref.append(render_seconds(lab03_ref, **TIMED))
+        skeleton.append(render_seconds(lab03_skeleton, **TIMED))
+    base = min(single)
+    capacity = min(cores, cores * base / min(together))
+    if capacity < 1.5:
+        pytest.skip(f"the machine is too busy to measure a parallel speedup: {cores} serial "
+                    f"renders at once ran only {capacity:.2f}x as fast as one")
+    return Speedups(cores, capacity, base, min(ref), min(skeleton))
+
+
+@dataclasses.dataclass
+class Speedups:
+    cores: int         # available_cores()
+    capacity: float    # cores' worth of throughput, measured alongside
+    base: float        # lab01-ref's best seconds
+    ref: float         # lab03-ref's best seconds, every core
+    skeleton: float    # the skeleton's best seconds, every core
+
+    def required(self) -> float:
+        """What the tests demand: 75% of the measured capacity. This holds on a busy machine
+        and with SMT (where available_cores() counts hardware threads), because the capacity
+        is measured under the same conditions. The lab's real bar, 0.9 x cores (1.8x on two
+        cores), is what tools/bench_openmp.py and the handout measure on a quiet machine; the
+        reference reaches it there."""
+        return 0.75 * self.capacity
+
+    def describe(self, name: str, seconds: float) -> str:
+        return (f"{name} {self.base / seconds:.2f}x over lab01-ref ({self.base:.3f} s -> "
+                f"{seconds:.3f} s) on {self.cores} cores giving {self.capacity:.2f}x "
+                f"capacity; needs >= {self.required():.2f}x")
+
+
+def test_reference_speedup(speedups):
+    s = speedups
+    assert s.base / s.ref >= s.required(), s.describe("lab03-ref", s.ref)
+
+
+def test_skeleton_is_serial(speedups):
+    """Correct but serial: the skeleton is no faster than lab 01 until the parallel loop is
+    written (TODO(lab03) in labs/03-openmp/skeleton/render.cpp), so it fails the speedup test
+    above."""
+    s = speedups
+    speedup = s.base / s.skeleton
+    assert speedup < 1.3, s.describe("skeleton", s.skeleton) + ": expected ~1x"
+    assert speedup < s.required(), s.describe("skeleton", s.skeleton)
+
+
+# --- variants -------------------------------------------------------------------------------
+
+@pytest.fixture(scope="module")
+def lab03_simd_ref():
+    if not SIMD_HEADER.exists():
+        pytest.skip("lab03-simd-ref needs common/simd_pixel_renderer.h (lab 02's "
+                    "SimdPixelRenderer), which is not in the tree yet")
+    flags = next((line for line in open("/proc/cpuinfo") if line.startswith("flags")), "")
+    if " avx2" not in flags or " fma" not in flags:
+        pytest.skip("lab03-simd-ref needs a CPU with AVX2 and FMA; this one has not")
+    return build("lab03-simd-ref")[0]
+
+
+def test_simd_variant_passes_golden(lab03_simd_ref):
+    """SIMD may differ from lab 01 in the last bits, so it is compared statistically."""
+    result = checks.check_golden(lab03_simd_ref, "cornell")
+    assert result.passed, str(result)
+
+
+def test_simd_variant_same_for_any_thread_count(lab03_simd_ref):
+    """Its pixels still do not depend on the thread that renders them."""
+    images = {run_lab(lab03_simd_ref, threads=t, **SMALL).image.tobytes() for t in (1, 3)}
+    assert len(images) == 1
+
+
+@pytest.mark.parametrize("variant", ["lab03-shared-rng", "lab03-shared-rng-race"])
+def test_shared_rng_is_not_lab01(variant, lab01_bits):
+    """The classic mistake renders a plausible image, but not lab 01's: a stateful generator
+    cannot give each (pixel, sample, dimension) its own number. (It is also slower and not
+    repeatable from run to run; tools/bench_openmp.py measures that rather than a test,
+    since neither is guaranteed on every machine.)"""
+    binary = build(variant)[0]
+    run = run_lab(binary, threads=2, **SMALL)
+    assert run.image is not None and float(run.image.mean()) > 0
+    assert run.image.tobytes() != lab01_bits
