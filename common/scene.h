@@ -1,6 +1,7 @@
 // The scene model: what a scene file describes, in flat arrays that a GPU can copy as-is.
 #pragma once
 
+#include <cstdint>
 #include <string>
 #include <vector>
 

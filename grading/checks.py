@@ -159,6 +159,35 @@ def check_speedup(binary, baseline, min_speedup: float, *, threads=None, launche
                        f"{speedup:.2f}x ({base:.3f} s -> {fast:.3f} s, best of {repeat})")
 
 
+def check_parallel_speedup(binary, baseline, *, threads=None, launcher=(),
+                           fraction: float = 0.75) -> CheckResult:
+    """Speedup of a parallel lab over the serial baseline, against the machine's capacity
+    measured alongside (grading.harness.measure_parallel)."""
+    from grading.harness import measure_parallel, render_seconds
+    scene = dict(width=256, height=256, spp=32, seed=1)
+    timing = measure_parallel(
+        lambda: render_seconds(baseline, **scene),
+        {"yours": lambda: render_seconds(binary, threads=threads, launcher=launcher, **scene)})
+    if timing.capacity < 1.5:
+        return CheckResult("parallel speedup", False,
+                           f"not measurable: the machine gave only {timing.capacity:.2f} cores' "
+                           f"worth of throughput; run again when it is less busy")
+    return CheckResult("parallel speedup", timing.speedup("yours") >= timing.required(fraction),
+                       timing.describe("yours"))
+
+
+def check_bitwise_equal(binary, baseline, *, thread_counts=(1, 2, 3, 7), launcher=()) -> CheckResult:
+    """The image is the baseline's, bit for bit, for every thread count: what a counter-based
+    RNG and a race-free parallel loop guarantee."""
+    settings = dict(width=48, height=40, spp=8, seed=3)
+    want = run_lab(baseline, **settings).image.tobytes()
+    differing = [t for t in thread_counts
+                 if run_lab(binary, threads=t, launcher=launcher, **settings).image.tobytes() != want]
+    return CheckResult("bit-identical to lab 01", not differing,
+                       "identical for threads " + ", ".join(map(str, thread_counts)) if not differing
+                       else "differs for threads " + ", ".join(map(str, differing)))
+
+
 def correctness_checks(binary) -> list[CheckResult]:
     """Every check a lab's rendering must pass, in the order a student should read them."""
     return [

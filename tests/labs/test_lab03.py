@@ -2,14 +2,13 @@
 is faster by a margin scaled to the cores present; the skeleton is correct but serial (same
 bits, no speedup); the SIMD+OpenMP variant passes the golden comparison; the shared-RNG
 variant, the classic mistake, renders but not lab 01's image."""
-import concurrent.futures
-import dataclasses
 import os
 
 import pytest
 
 from grading import checks
-from grading.harness import ROOT, available_cores, build, render_seconds, run_lab
+from grading.harness import ROOT, available_cores, build, measure_parallel, render_seconds, \
+    run_lab
 from grading.variants import build_pristine_skeleton
 
 # Small renders for the bitwise comparisons: every pixel, sample and bounce is exercised.
@@ -93,74 +92,34 @@ def test_skeleton_is_correct(lab03_skeleton, lab01_bits, threads):
 
 # --- speed ----------------------------------------------------------------------------------
 
-def side_by_side_seconds(serial, cores: int) -> float:
-    """Mean render seconds of `cores` copies of a serial render run at once. Against one run
-    alone it gives the machine's capacity, how many cores' worth of throughput it gives us
-    right now: about `cores` when idle; close to 1 when shared with other users' jobs (the
-    kernel shares CPUs among sessions, not threads), and then no program can show a
-    speedup."""
-    with concurrent.futures.ThreadPoolExecutor(cores) as pool:
-        times = list(pool.map(lambda _: render_seconds(serial, **TIMED), range(cores)))
-    return sum(times) / len(times)
-
-
 @pytest.fixture(scope="module")
 def speedups(lab01_ref, lab03_ref, lab03_skeleton):
-    """Speedups over lab01-ref of lab03-ref and of the skeleton with every core, and the
-    machine's capacity: measured as shared/DESIGN.md says, interleaved in one run, render
-    time only, best of ROUNDS."""
-    cores = available_cores()
-    if cores < 2:
+    """Speedups over lab01-ref of lab03-ref and of the skeleton with every core, measured with
+    the machine's capacity alongside (grading.harness.measure_parallel)."""
+    if available_cores() < 2:
         pytest.skip("only one core available to this process: no parallel speedup to measure")
-    single, together, ref, skeleton = [], [], [], []
-    for _ in range(ROUNDS):
-        single.append(render_seconds(lab01_ref, **TIMED))
-        together.append(side_by_side_seconds(lab01_ref, cores))
-        ref.append(render_seconds(lab03_ref, **TIMED))
-        skeleton.append(render_seconds(lab03_skeleton, **TIMED))
-    base = min(single)
-    capacity = min(cores, cores * base / min(together))
-    if capacity < 1.5:
-        pytest.skip(f"the machine is too busy to measure a parallel speedup: {cores} serial "
-                    f"renders at once ran only {capacity:.2f}x as fast as one")
-    return Speedups(cores, capacity, base, min(ref), min(skeleton))
-
-
-@dataclasses.dataclass
-class Speedups:
-    cores: int         # available_cores()
-    capacity: float    # cores' worth of throughput, measured alongside
-    base: float        # lab01-ref's best seconds
-    ref: float         # lab03-ref's best seconds, every core
-    skeleton: float    # the skeleton's best seconds, every core
-
-    def required(self) -> float:
-        """What the tests demand: 75% of the measured capacity. This holds on a busy machine
-        and with SMT (where available_cores() counts hardware threads), because the capacity
-        is measured under the same conditions. The lab's real bar, 0.9 x cores (1.8x on two
-        cores), is what tools/bench_openmp.py and the handout measure on a quiet machine; the
-        reference reaches it there."""
-        return 0.75 * self.capacity
-
-    def describe(self, name: str, seconds: float) -> str:
-        return (f"{name} {self.base / seconds:.2f}x over lab01-ref ({self.base:.3f} s -> "
-                f"{seconds:.3f} s) on {self.cores} cores giving {self.capacity:.2f}x "
-                f"capacity; needs >= {self.required():.2f}x")
+    timing = measure_parallel(lambda: render_seconds(lab01_ref, **TIMED),
+                              {"lab03-ref": lambda: render_seconds(lab03_ref, **TIMED),
+                               "skeleton": lambda: render_seconds(lab03_skeleton, **TIMED)},
+                              rounds=ROUNDS)
+    if timing.capacity < 1.5:
+        pytest.skip(f"the machine is too busy to measure a parallel speedup: "
+                    f"{timing.cores} serial renders at once ran only {timing.capacity:.2f}x "
+                    f"as fast as one")
+    return timing
 
 
 def test_reference_speedup(speedups):
-    s = speedups
-    assert s.base / s.ref >= s.required(), s.describe("lab03-ref", s.ref)
+    assert speedups.speedup("lab03-ref") >= speedups.required(), speedups.describe("lab03-ref")
 
 
 def test_skeleton_is_serial(speedups):
     """Correct but serial: the skeleton is no faster than lab 01 until the parallel loop is
     written (TODO(lab03) in labs/03-openmp/skeleton/render.cpp), so it fails the speedup test
     above."""
-    s = speedups
-    speedup = s.base / s.skeleton
-    assert speedup < 1.3, s.describe("skeleton", s.skeleton) + ": expected ~1x"
-    assert speedup < s.required(), s.describe("skeleton", s.skeleton)
+    speedup = speedups.speedup("skeleton")
+    assert speedup < 1.3, speedups.describe("skeleton") + ": expected ~1x"
+    assert speedup < speedups.required(), speedups.describe("skeleton")
 
 
 # --- variants -------------------------------------------------------------------------------

@@ -1,0 +1,47 @@
+// Entry point of lab 04's binaries: MPI around the shared driver (common/lab_main.cpp).
+// Every rank parses the flags, loads the scene and renders; only rank 0 opens the output
+// files, writes them and prints the summary or the error line. Not a student file.
+#include <mpi.h>
+
+#include <cstdio>
+#include <cstdlib>
+
+#include "errors.h"
+#include "lab.h"
+
+// Ends MPI once, however the process ends: a normal return, or `--help`, which exits from
+// inside the flag parser.
+static void finalize_mpi() {
+    int finalized = 0;
+    MPI_Finalized(&finalized);
+    if (!finalized) MPI_Finalize();
+}
+
+int main(int argc, char** argv) {
+    // FUNNELED: OpenMP threads render inside a rank, but only the main thread calls MPI.
+    int provided = 0;
+    MPI_Init_thread(&argc, &argv, MPI_THREAD_FUNNELED, &provided);
+    std::atexit(finalize_mpi);
+    int rank = 0;
+    MPI_Comm_rank(MPI_COMM_WORLD, &rank);
+    // Rank 0 speaks for everyone; the driver keeps the others quiet, and this keeps `--help`
+    // from printing its usage once per rank.
+    if (rank != 0 && !std::freopen("/dev/null", "w", stdout)) return 1;
+
+    LabHooks hooks;
+    hooks.writes_output = rank == 0;
+    // Before rendering, the ranks agree that every one of them is ready: a rank that failed
+    // (a bad flag, a scene file missing on its host, an unwritable --out on rank 0) would
+    // otherwise leave the others waiting for it forever.
+    hooks.setup_done = [](bool setup_ok) {
+        int all_ok = setup_ok;
+        MPI_Allreduce(MPI_IN_PLACE, &all_ok, 1, MPI_INT, MPI_MIN, MPI_COMM_WORLD);
+        if (setup_ok && !all_ok) {
+            throw InputError("another MPI rank could not set up the render (on several hosts: "
+                             "is the scene file at the same path on each?)");
+        }
+    };
+    const int status = lab_main(argc, argv, hooks);
+    finalize_mpi();
+    return status;
+}
