@@ -29,11 +29,12 @@ PHONY_EXTRA += render grade check-nvcc bench-micro bench-cpu
 .DEFAULT_GOAL := help
 
 help:
-	@echo "make lab01        build your lab-01 code (labs/01-serial/skeleton) into ./lab01"
-	@echo "make lab01-ref    build the lab-01 reference solution into ./lab01-ref"
+	@echo "make labNN        build your code for lab NN (labs/NN-name/skeleton) into ./labNN"
+	@echo "make labNN-ref    build lab NN's reference solution into ./labNN-ref"
+	@echo "                  labs: $(LAB_BINARIES)"
 	@echo "make render       install what is missing, render the default scene to cornell.ppm"
 	@echo "make deps         install what is missing (JSON library, OpenMPI, pytest, numpy)"
-	@echo "make grade LAB=01 grade your lab-01 code: score table and results.json"
+	@echo "make grade LAB=NN grade your lab NN code (01-04): score table and results.json"
 	@echo "make test         build everything and run every test"
 	@echo "make bench        time the lab-01 reference on the Cornell baseline (minutes)"
 	@echo "make bench-cpu    the CPU labs side by side (the report's Table 4 for this machine)"
