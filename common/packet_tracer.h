@@ -133,23 +133,7 @@ inline Float8 intersect_triangle(const RayPacket& ray, const RayShear8& shear,
 
     // Rare: a lane on an edge, or rounded to zero. Redo those lanes in double, one by one.
     const Mask8 on_edge = candidates & ((u == 0.0f) | (v == 0.0f) | (w == 0.0f));
-    if (any(on_edge)) {
-        float uvw[3][kLanes];
-        u.store(uvw[0]);
-        v.store(uvw[1]);
-        w.store(uvw[2]);
-        for (int lane = 0; lane < kLanes; ++lane) {
-            if (!(on_edge.bits() >> lane & 1)) continue;
-            const float lax = ax.lane(lane), lay = ay.lane(lane), lbx = bx.lane(lane);
-            const float lby = by.lane(lane), lcx = cx.lane(lane), lcy = cy.lane(lane);
-            uvw[0][lane] = static_cast<float>(edge_function_exact(lcx, lcy, lbx, lby));
-            uvw[1][lane] = static_cast<float>(edge_function_exact(lax, lay, lcx, lcy));
-            uvw[2][lane] = static_cast<float>(edge_function_exact(lbx, lby, lax, lay));
-        }
-        u = Float8::load(uvw[0]);
-        v = Float8::load(uvw[1]);
-        w = Float8::load(uvw[2]);
-    }
+    if (any(on_edge)) redo_edges_exactly(on_edge, ax, ay, bx, by, cx, cy, u, v, w);
     const Mask8 any_negative = (u < 0.0f) | (v < 0.0f) | (w < 0.0f);
     const Mask8 any_positive = (u > 0.0f) | (v > 0.0f) | (w > 0.0f);
     const Mask8 inside = and_not(candidates, any_negative & any_positive);

@@ -25,6 +25,7 @@
 #include "material.h"
 #include "ray.h"
 #include "rng.h"
+#include "triangle.h"
 
 constexpr int kLanes = 8;  // floats in one AVX2 register
 
@@ -277,3 +278,25 @@ public:
 private:
     U64x8 key_;  // hash of (seed, pixel, sample) per lane
 };
+
+// The watertight triangle test's rare case, 8 lanes wide: where an edge function rounded to
+// exactly zero (`on_edge`), recompute u, v, w of those lanes in double (triangle.h's
+// edge_function_exact), so the sign is exact there too.
+inline void redo_edges_exactly(Mask8 on_edge, Float8 ax, Float8 ay, Float8 bx, Float8 by,
+                               Float8 cx, Float8 cy, Float8& u, Float8& v, Float8& w) {
+    float uvw[3][kLanes];
+    u.store(uvw[0]);
+    v.store(uvw[1]);
+    w.store(uvw[2]);
+    for (int lane = 0; lane < kLanes; ++lane) {
+        if (!(on_edge.bits() >> lane & 1)) continue;
+        const float lax = ax.lane(lane), lay = ay.lane(lane), lbx = bx.lane(lane);
+        const float lby = by.lane(lane), lcx = cx.lane(lane), lcy = cy.lane(lane);
+        uvw[0][lane] = static_cast<float>(edge_function_exact(lcx, lcy, lbx, lby));
+        uvw[1][lane] = static_cast<float>(edge_function_exact(lax, lay, lcx, lcy));
+        uvw[2][lane] = static_cast<float>(edge_function_exact(lbx, lby, lax, lay));
+    }
+    u = Float8::load(uvw[0]);
+    v = Float8::load(uvw[1]);
+    w = Float8::load(uvw[2]);
+}
