@@ -376,3 +376,17 @@ TEST(Triangle, NoSelfIntersectionAfterOffset) {
         }
     }
 }
+
+// A plane the ray reaches only after t_max, or one exactly at t_max, is culled; one just
+// before t_max is not, whatever the sign of the triangle's normal.
+TEST(Triangle, CullKeepsHitsJustBeforeTMax) {
+    const Triangle front = make_triangle({-1, -1, -2}, {1, -1, -2}, {0, 1, -2}, 0);
+    const Triangle back = make_triangle({-1, -1, -2}, {0, 1, -2}, {1, -1, -2}, 0);
+    const Ray ray{{0, 0, 0}, {0, 0, -1}};
+    for (const Triangle& tri : {front, back}) {
+        EXPECT_EQ(hit(ray, tri, 2.0001f), 2.0f);
+        EXPECT_EQ(hit(ray, tri, 2.0f), 2.0f);  // exactly at t_max: a miss, reported as t_max
+        EXPECT_EQ(hit(ray, tri, 1.9f), 1.9f);
+        EXPECT_EQ(hit({{0, 0, -3}, {0, 0, -1}}, tri, 10.0f), 10.0f);  // plane behind the ray
+    }
+}
