@@ -36,6 +36,14 @@ def build(*targets: str) -> list[pathlib.Path]:
     return [ROOT / t for t in targets]
 
 
+def cpu_has_avx2() -> bool:
+    """Whether this CPU runs lab 02's Part B (AVX2 and FMA), as its binaries check too."""
+    for line in pathlib.Path("/proc/cpuinfo").read_text().splitlines():
+        if line.startswith("flags"):
+            return " avx2" in line and " fma" in line
+    return False
+
+
 def available_cores() -> int:
     """Cores this process may run on (what thresholds scale with)."""
     return len(os.sched_getaffinity(0))

@@ -21,7 +21,6 @@ import concurrent.futures
 import os
 import pathlib
 import re
-import subprocess
 import sys
 import time
 

@@ -12,7 +12,6 @@ SIMD results may differ from lab 01's in the last bits (Part B computes sin and 
 own polynomial), so images are compared statistically (grading.checks), never bit for bit,
 except where a test says why the bits must agree.
 """
-import pathlib
 import shlex
 import subprocess
 
@@ -20,18 +19,9 @@ import numpy as np
 import pytest
 
 from grading import checks
-from grading.harness import ROOT, available_cores, build, interleaved_speedup, render_seconds, \
-    run_lab
+from grading.harness import ROOT, available_cores, build, cpu_has_avx2, interleaved_speedup, \
+    render_seconds, run_lab
 from grading.variants import build_pristine_skeleton, pristine_skeleton_sources
-
-
-def cpu_has_avx2() -> bool:
-    flags = ""
-    for line in pathlib.Path("/proc/cpuinfo").read_text().splitlines():
-        if line.startswith("flags"):
-            flags = line
-            break
-    return " avx2" in flags and " fma" in flags
 
 
 needs_avx2 = pytest.mark.skipif(not cpu_has_avx2(), reason="this CPU has no AVX2/FMA")

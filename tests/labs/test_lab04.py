@@ -419,3 +419,29 @@ def test_two_hosts(lab04_ref, small_reference, two_hosts, tmp_path, monkeypatch)
         run = run_lab(lab04_ref, **SMALL, seed=3, launcher=launcher, timeout=60)
         assert "2 ranks on 2 hosts" in run.json["device"], run.json["device"]
         assert_bitwise(run.image, small_reference, f"two hosts, {distribution}")
+
+
+# ---- the grader on the skeleton and the reference -------------------------------------------
+
+def test_grader_catches_the_missing_gather(lab04_pristine_skeleton, tmp_path):
+    """The rubric of lab 04 (grading/grade.py) on the skeleton as generated: with more than one
+    rank its image lacks rows, so the bitwise check and the golden images (rendered with two
+    ranks) give nothing."""
+    from grading.grade import grade
+    results = grade("04", lab04_pristine_skeleton, tmp_path)
+    passed = {t["name"]: t["score"] == t["max_score"] for t in results["tests"]}
+    detail = "\n".join(f"{t['name']}: {t['output']}" for t in results["tests"])
+    assert not passed["bit-identical to lab 01"], detail
+    assert not passed["golden image 'cornell'"], detail
+    assert not passed["golden image 'showcase'"], detail
+    assert results["score"] <= 40, detail
+
+
+def test_grader_gives_the_reference_full_marks(lab04_ref, tmp_path):
+    from grading.grade import grade
+    results = grade("04", lab04_ref, tmp_path)
+    detail = "\n".join(f"{t['name']}: {t['output']}" for t in results["tests"])
+    speed = next(t for t in results["tests"] if t["name"] == "parallel speedup")
+    if speed["output"].startswith("not measurable"):
+        pytest.skip(speed["output"])
+    assert results["score"] == results["max_score"] == 100, detail
