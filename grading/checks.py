@@ -6,6 +6,8 @@ How often a correct renderer fails each check (its false-failure rate), and why:
   block and global z-test (grading/compare.py explains the model and its assumptions).
 - sphere interior: the estimator has zero variance there (every next-event estimate is the
   same), so only float rounding differs from the closed form: ~1e-5 relative, bound 3e-4.
+- millions of samples: the same zero-variance scene at 2^22 and 2^12 spp; a double sum keeps
+  the two means equal to float rounding (~1e-7), bound 1e-5; a float sum drifts by ~1e-2.
 - lit plane: the only noise is where the pixel jitter lands; at 256 spp the per-pixel error
   is ~1e-3, bounds 3e-3 (mean) and 2e-2 (max) are far outside it.
 - glass pane: the mean of 262,144 Bernoulli(~4%) paths has a relative standard error of
@@ -72,6 +74,27 @@ def check_sphere_interior(binary, bounces=(1, 2, 4)) -> CheckResult:
     return CheckResult("analytic sphere interior", ok,
                        f"largest relative error {worst:.2e} over bounces {list(bounces)}"
                        f" (allowed 3e-4)")
+
+
+def check_million_samples(binary, spp: int = 1 << 22) -> CheckResult:
+    """Numerical stability at millions of samples: the sphere interior (zero variance, so
+    every sample of a pixel has the same value up to rounding) at 2^22 spp against the same
+    render at 2^12 spp, one bounce. A float running sum drifts by ~1% between the two; a sum
+    in double keeps them equal to float rounding."""
+    albedo, radius, intensity = 0.6, 2.0, 3.0
+    few = 1 << 12
+    with tempfile.TemporaryDirectory() as tmp:
+        path = scenes.write_scene(pathlib.Path(tmp) / "interior.json",
+                                  scenes.sphere_interior(albedo, radius, intensity))
+        many_image = run_lab(binary, path, width=2, height=2, spp=spp, bounces=1).image
+        few_image = run_lab(binary, path, width=2, height=2, spp=few, bounces=1).image
+    if not (np.all(few_image > 0) and np.all(np.isfinite(many_image))):
+        return CheckResult("millions of samples", False,
+                           "the lit sphere interior rendered black or non-finite pixels")
+    drift = float(np.max(np.abs(many_image / few_image - 1.0)))
+    return CheckResult("millions of samples", drift < 1e-5,
+                       f"the mean at {spp} spp differs from the mean at {few} spp by up to "
+                       f"{drift:.2e} (allowed 1e-5)")
 
 
 def check_lit_plane(binary) -> CheckResult:

@@ -66,13 +66,13 @@ RenderStats render(const RenderJob& job, Image& image) {
 #pragma omp parallel for schedule(dynamic, 1) num_threads(threads)
     for (int y = 0; y < settings.height; ++y) {
         for (int x = 0; x < settings.width; ++x) {
-            Vec3 sum(0.0f);
+            SampleSum sum;
             for (int s = 0; s < settings.spp; ++s) {
                 const Ray ray = job.camera.ray_through(x + rng.at(kDimPixelX),
                                                        y + rng.at(kDimPixelY));
-                sum += trace_path(scene, scene, ray, rng, settings.bounces);
+                sum.add(trace_path(scene, scene, ray, rng, settings.bounces));
             }
-            image.at(x, y) = sum * (1.0f / settings.spp);
+            image.at(x, y) = sum.mean(settings.spp);
         }
         job.progress.rows_done();
     }

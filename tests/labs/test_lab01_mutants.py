@@ -17,6 +17,7 @@ from grading.variants import build_variant
 
 CHECKS = {
     "interior": checks.check_sphere_interior,
+    "millions": checks.check_million_samples,
     "plane": checks.check_lit_plane,
     "glass": checks.check_glass_slab,
     "cornell": lambda b: checks.check_golden(b, "cornell"),
@@ -63,6 +64,8 @@ MUTANTS = {
                               "", ["cornell", "showcase"]),
     "fixed epsilon offset": ("ray.h", "return p + n * (scale * kRelativeOffset);",
                              "return p + n * (0.0f * scale + 1e-4f);", ["scale"]),
+    "float running sum": ("sample_sum.h", "double r = 0.0, g = 0.0, b = 0.0;",
+                          "float r = 0.0f, g = 0.0f, b = 0.0f;", ["millions"]),
     "no offset at all": ("ray.h", "return p + n * (scale * kRelativeOffset);",
                          "return p + n * (0.0f * scale);", ["cornell"]),
 }

@@ -83,6 +83,7 @@ def lab02a_pristine_skeleton(tmp_path_factory):
 
 CHECKS = [
     checks.check_sphere_interior,
+    checks.check_million_samples,
     checks.check_lit_plane,
     checks.check_glass_slab,
     lambda b: checks.check_golden(b, "cornell"),
@@ -90,8 +91,8 @@ CHECKS = [
     checks.check_scale_invariance,
     checks.check_reproducible,
 ]
-CHECK_IDS = ["sphere-interior", "lit-plane", "glass-pane", "golden-cornell", "golden-showcase",
-             "scale", "reproducible"]
+CHECK_IDS = ["sphere-interior", "million-samples", "lit-plane", "glass-pane", "golden-cornell",
+             "golden-showcase", "scale", "reproducible"]
 
 
 # ---- Part B --------------------------------------------------------------------------------

@@ -21,6 +21,7 @@
 #include <cfloat>
 #include <cstddef>
 
+#include "sample_sum.h"
 #include "scene.h"
 #include "simd8.h"
 
@@ -332,7 +333,7 @@ inline Vec3x8 trace_paths(const SceneView& scene, RayPacket ray, const SampleStr
 inline Vec3 render_pixel_packets(const SceneView& scene, const Camera& camera,
                                  const RenderSettings& settings, int x, int y) {
     const uint64_t pixel = static_cast<uint64_t>(y) * settings.width + x;
-    Vec3 sum(0.0f);
+    SampleSum sum;  // in double, as render_pixel's
     for (int s = 0; s < settings.spp; s += kLanes) {
         const int count = settings.spp - s < kLanes ? settings.spp - s : kLanes;
         const SampleStream8 rng(settings.seed, pixel, s);
@@ -347,7 +348,7 @@ inline Vec3 render_pixel_packets(const SceneView& scene, const Camera& camera,
         radiance.x.store(r);
         radiance.y.store(g);
         radiance.z.store(b);
-        for (int lane = 0; lane < count; ++lane) sum += Vec3(r[lane], g[lane], b[lane]);
+        for (int lane = 0; lane < count; ++lane) sum.add(Vec3(r[lane], g[lane], b[lane]));
     }
-    return sum * (1.0f / settings.spp);
+    return sum.mean(settings.spp);
 }
