@@ -1,5 +1,6 @@
-"""The autograder end to end: full marks for the reference, a clear zero-ish for the
-skeleton, and a results.json in Gradescope's shape."""
+"""The autograder end to end: full marks for the references, a clear zero-ish for lab 01's
+skeleton, a results.json in Gradescope's shape, and for labs 02-03 broken hand-ins that lose
+exactly the points meant to catch them (lab 04's are in tests/labs/test_lab04.py)."""
 import json
 import subprocess
 import sys
