@@ -3,8 +3,8 @@
 // Summed in float, every add rounds at the magnitude of the sum, not of the sample: past a
 // million samples each add loses a fixed part of the sample to rounding, and the mean drifts
 // by about 1% (a render of the zero-variance sphere interior shows -0.9% at 2^20 spp and +1.1%
-// at 2^22). In double the drift is ~1e-10 at any spp a render can afford. One double add per
-// sample and channel costs nothing next to tracing the path.
+// at 2^22). In double the means at 2^12 and 2^22 spp agree to float rounding (1.2e-7
+// measured). One double add per sample and channel costs nothing next to tracing the path.
 #pragma once
 
 #include "vec3.h"

@@ -59,17 +59,26 @@ def check_golden(binary, scene: str, *, seed: int = 7, spp: int = GOLDEN_TEST_SP
     return CheckResult(f"golden image '{scene}'", report.passed, report.summary())
 
 
-def check_sphere_interior(binary, bounces=(1, 2, 4)) -> CheckResult:
-    """Closed form: camera and light inside a diffuse sphere (grading/scenes.py)."""
-    albedo, radius, intensity = 0.6, 2.0, 3.0
-    worst = 0.0
+# The sphere interior both checks below render: albedo, radius, light intensity.
+INTERIOR = dict(albedo=0.6, radius=2.0, intensity=3.0)
+
+
+def render_interior(binary, runs: dict) -> dict:
+    """Renders the sphere interior once per entry of `runs` (key -> run_lab settings)."""
     with tempfile.TemporaryDirectory() as tmp:
         path = scenes.write_scene(pathlib.Path(tmp) / "interior.json",
-                                  scenes.sphere_interior(albedo, radius, intensity))
-        for b in bounces:
-            image = run_lab(binary, path, width=16, height=16, spp=4, bounces=b).image
-            want = scenes.sphere_interior_radiance(albedo, radius, intensity, b)
-            worst = max(worst, float(np.max(np.abs(image / want - 1.0))))
+                                  scenes.sphere_interior(**INTERIOR))
+        return {label: run_lab(binary, path, **how).image for label, how in runs.items()}
+
+
+def check_sphere_interior(binary, bounces=(1, 2, 4)) -> CheckResult:
+    """Closed form: camera and light inside a diffuse sphere (grading/scenes.py)."""
+    worst = 0.0
+    images = render_interior(binary, {b: dict(width=16, height=16, spp=4, bounces=b)
+                                      for b in bounces})
+    for b, image in images.items():
+        want = scenes.sphere_interior_radiance(**INTERIOR, bounces=b)
+        worst = max(worst, float(np.max(np.abs(image / want - 1.0))))
     ok = worst < 3e-4
     return CheckResult("analytic sphere interior", ok,
                        f"largest relative error {worst:.2e} over bounces {list(bounces)}"
@@ -81,13 +90,10 @@ def check_million_samples(binary, spp: int = 1 << 22) -> CheckResult:
     every sample of a pixel has the same value up to rounding) at 2^22 spp against the same
     render at 2^12 spp, one bounce. A float running sum drifts by ~1% between the two; a sum
     in double keeps them equal to float rounding."""
-    albedo, radius, intensity = 0.6, 2.0, 3.0
     few = 1 << 12
-    with tempfile.TemporaryDirectory() as tmp:
-        path = scenes.write_scene(pathlib.Path(tmp) / "interior.json",
-                                  scenes.sphere_interior(albedo, radius, intensity))
-        many_image = run_lab(binary, path, width=2, height=2, spp=spp, bounces=1).image
-        few_image = run_lab(binary, path, width=2, height=2, spp=few, bounces=1).image
+    images = render_interior(binary, {n: dict(width=2, height=2, spp=n, bounces=1)
+                                      for n in (spp, few)})
+    many_image, few_image = images[spp], images[few]
     if not (np.all(few_image > 0) and np.all(np.isfinite(many_image))):
         return CheckResult("millions of samples", False,
                            "the lit sphere interior rendered black or non-finite pixels")

@@ -96,6 +96,22 @@ def run_check(check, name, binary, heatmap_dir) -> tuple[bool, str]:
         return False, f"could not run: {e}"
 
 
+def passed_by_check(results: dict) -> dict[str, bool]:
+    """Check name -> whether it earned all its points."""
+    return {t["name"]: t["score"] == t["max_score"] for t in results["tests"]}
+
+
+def describe(results: dict) -> str:
+    """One line per check: its name and what it saw."""
+    return "\n".join(f"{t['name']}: {t['output']}" for t in results["tests"])
+
+
+def unmeasurable(results: dict, check: str = "parallel speedup") -> str | None:
+    """What the speedup check said when the machine was too busy to measure it, else None."""
+    output = next(t["output"] for t in results["tests"] if t["name"] == check)
+    return output if output.startswith("not measurable") else None
+
+
 def print_table(lab: str, binary: pathlib.Path, results: dict) -> None:
     print(f"Lab {lab} — {binary}")
     print(f"{'check':<32} {'points':>7}  what it saw")

@@ -7,7 +7,7 @@ import sys
 
 import pytest
 
-from grading.grade import grade as grade_in_process
+from grading.grade import describe, grade as grade_in_process, passed_by_check, unmeasurable
 from grading.harness import ROOT, build, cpu_has_avx2
 
 
@@ -38,56 +38,48 @@ def test_skeleton_gets_nothing_and_a_heatmap(lab01_pristine_skeleton, tmp_path):
 # Graded in-process (grading.grade.grade), check by check: each broken build must lose the
 # points of the check meant to catch its bug, and keep the rest.
 
-def passed_checks(results):
-    return {t["name"]: t["score"] == t["max_score"] for t in results["tests"]}
-
-
-def outputs(results):
-    return "\n".join(f"{t['name']}: {t['output']}" for t in results["tests"])
-
-
-def skip_if_not_measurable(results, check="parallel speedup"):
-    """The parallel-speedup check reports a machine too busy to measure as a failure (no
-    points, try again); a test of the rubric skips then, rather than fail on the machine."""
-    output = next(t["output"] for t in results["tests"] if t["name"] == check)
-    if output.startswith("not measurable"):
-        pytest.skip(output)
+def skip_if_not_measurable(results):
+    """A machine too busy to measure the speedup fails that check (no points, try again); a
+    test of the rubric skips then, rather than fail on the machine."""
+    reason = unmeasurable(results)
+    if reason:
+        pytest.skip(reason)
 
 
 def test_lab02_scalar_hand_in_loses_only_the_speedup(lab01_ref, tmp_path):
     """Lab 01's reference handed in for lab 02: every image is right, but it is not SIMD."""
     results = grade_in_process("02", lab01_ref, tmp_path)
-    passed = passed_checks(results)
-    assert not passed.pop("speedup >= 1.5x"), outputs(results)
-    assert all(passed.values()), outputs(results)
+    passed = passed_by_check(results)
+    assert not passed.pop("speedup >= 1.5x"), describe(results)
+    assert all(passed.values()), describe(results)
 
 
 @pytest.mark.skipif(not cpu_has_avx2(), reason="this CPU has no AVX2/FMA: lab 02's Part B cannot run")
 def test_lab02_reference_gets_full_marks(tmp_path):
     results = grade_in_process("02", build("lab02-ref")[0], tmp_path)
-    assert results["score"] == results["max_score"] == 100, outputs(results)
+    assert results["score"] == results["max_score"] == 100, describe(results)
 
 
 def test_lab03_shared_generator_loses_bits_and_speed(tmp_path):
     """The classic mistake (one locked generator for all threads): the image is still right
     statistically, but not lab 01's bits, and the threads take turns at the lock."""
     results = grade_in_process("03", build("lab03-shared-rng")[0], tmp_path)
-    passed = passed_checks(results)
-    assert not passed["bit-identical to lab 01"], outputs(results)
-    assert passed["golden image 'cornell'"] and passed["golden image 'showcase'"], outputs(results)
-    assert not passed["parallel speedup"], outputs(results)
+    passed = passed_by_check(results)
+    assert not passed["bit-identical to lab 01"], describe(results)
+    assert passed["golden image 'cornell'"] and passed["golden image 'showcase'"], describe(results)
+    assert not passed["parallel speedup"], describe(results)
 
 
 def test_lab03_serial_hand_in_loses_only_the_speedup(lab01_ref, tmp_path):
     """Lab 01's reference handed in for lab 03: the same bits, one core."""
     results = grade_in_process("03", lab01_ref, tmp_path)
     skip_if_not_measurable(results)
-    passed = passed_checks(results)
-    assert not passed.pop("parallel speedup"), outputs(results)
-    assert all(passed.values()), outputs(results)
+    passed = passed_by_check(results)
+    assert not passed.pop("parallel speedup"), describe(results)
+    assert all(passed.values()), describe(results)
 
 
 def test_lab03_reference_gets_full_marks(tmp_path):
     results = grade_in_process("03", build("lab03-ref")[0], tmp_path)
     skip_if_not_measurable(results)
-    assert results["score"] == results["max_score"] == 100, outputs(results)
+    assert results["score"] == results["max_score"] == 100, describe(results)
