@@ -23,7 +23,7 @@ DRIVER_OBJ := $(BUILD)/common/lab_main.o $(BUILD)/common/main.o
 COMMON_OBJ := $(LIB_OBJ) $(DRIVER_OBJ)
 
 PHONY_EXTRA := print-build-command
-PHONY_EXTRA += render grade check-nvcc bench-micro bench-cpu
+PHONY_EXTRA += render grade check-nvcc bench-micro bench-cpu count-work
 .PHONY: all help deps labs $(PHONY_EXTRA) test test-unit test-labs skeletons check-skeletons golden bench tradeoff \
         clean
 .DEFAULT_GOAL := help
@@ -39,6 +39,7 @@ help:
 	@echo "make bench        time the lab-01 reference on the Cornell baseline (minutes)"
 	@echo "make bench-cpu    the CPU labs side by side (the report's Table 4 for this machine)"
 	@echo "make bench-micro  Google Benchmark of the inner loops (closest hit, shadow ray, path)"
+	@echo "make count-work   instructions per camera path, split by query (needs valgrind)"
 	@echo "make tradeoff     error against time: RMSE vs spp for the lab-01 reference"
 	@echo "make golden       regenerate the golden images in reference/ (minutes)"
 	@echo "make skeletons    regenerate the skeletons from the solutions"
@@ -120,6 +121,9 @@ $(BUILD)/intersect_bench: $(BUILD)/bench/intersect_bench.o $(LIB_OBJ)
 
 bench-cpu: labs
 	$(PYTHON) tools/bench_cpu.py
+
+count-work:
+	$(PYTHON) tools/count_work.py
 
 bench-micro: $(BUILD)/intersect_bench
 	$(BUILD)/intersect_bench --benchmark_min_time=0.2
