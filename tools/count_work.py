@@ -81,6 +81,9 @@ def main() -> None:
     parser.add_argument("--spp", type=int, default=16)
     parser.add_argument("--bounces", type=int, default=4)
     args = parser.parse_args()
+    for name in ("width", "height", "spp", "bounces"):
+        if getattr(args, name) < 1:
+            parser.error(f"--{name} must be at least 1")
     for tool in ("valgrind", "callgrind_annotate", "g++"):
         if not shutil.which(tool):
             fail(f"{tool} is not installed (apt-get install valgrind)")
@@ -124,4 +127,7 @@ def main() -> None:
 
 
 if __name__ == "__main__":
-    main()
+    try:
+        main()
+    except subprocess.CalledProcessError as error:
+        fail(f"'{' '.join(map(str, error.cmd[:2]))} ...' failed with exit status {error.returncode}")
