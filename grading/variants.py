@@ -11,10 +11,13 @@ import subprocess
 
 from grading.harness import ROOT, build
 
-_DRIVER_OBJECTS = ("scene_loader", "image", "cli", "progress", "lab_main", "main")
+# The shared driver every lab binary links: common/<name>.cpp, built as build/common/<name>.o.
+DRIVER_SOURCES = ("scene_loader", "image", "cli", "progress", "lab_main", "main")
 
 
-def _build_command() -> list[str]:
+def build_command() -> list[str]:
+    """The Makefile's compiler command for lab binaries (make print-build-command), without
+    its dependency-file flags, with RT_SOURCE_DIR quoted for a direct call."""
     out = subprocess.run(["make", "-s", "-C", str(ROOT), "print-build-command"],
                          capture_output=True, text=True, check=True).stdout
     flags = [f for f in shlex.split(out) if not f.startswith(("-DRT_SOURCE_DIR", "-MMD", "-MP"))]
@@ -33,10 +36,10 @@ def build_variant(lab: str, workdir: pathlib.Path, overrides: dict[str, str],
         shutil.copy(cpp, src)
     for name, text in overrides.items():
         (src / name).write_text(text)
-    objects = [str(ROOT / "build" / "common" / f"{o}.o") for o in _DRIVER_OBJECTS]
+    objects = [str(ROOT / "build" / "common" / f"{o}.o") for o in DRIVER_SOURCES]
     binary = workdir / "lab"
     sources = sorted(str(p) for p in src.glob("*.cpp"))
-    p = subprocess.run([*_build_command(), *extra_flags, "-w", f"-I{src}", *sources, *objects,
+    p = subprocess.run([*build_command(), *extra_flags, "-w", f"-I{src}", *sources, *objects,
                         "-o", str(binary)], capture_output=True, text=True)
     if p.returncode != 0:
         raise RuntimeError(f"building a {lab} variant failed:\n{p.stderr[-2000:]}")

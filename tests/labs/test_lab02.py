@@ -12,7 +12,6 @@ SIMD results may differ from lab 01's in the last bits (Part B computes sin and 
 own polynomial), so images are compared statistically (grading.checks), never bit for bit,
 except where a test says why the bits must agree.
 """
-import shlex
 import subprocess
 
 import numpy as np
@@ -21,7 +20,8 @@ import pytest
 from grading import checks
 from grading.harness import ROOT, available_cores, build, cpu_has_avx2, interleaved_speedup, \
     render_seconds, run_lab
-from grading.variants import build_pristine_skeleton, pristine_skeleton_sources
+from grading.variants import DRIVER_SOURCES, build_command, build_pristine_skeleton, \
+    pristine_skeleton_sources
 
 
 needs_avx2 = pytest.mark.skipif(not cpu_has_avx2(), reason="this CPU has no AVX2/FMA")
@@ -69,13 +69,9 @@ def lab02a_pristine_skeleton(tmp_path_factory):
     build("lab02a-ref")
     work = tmp_path_factory.mktemp("lab02a-skeleton")
     (work / "vec3_sse.h").write_text(pristine_skeleton_sources("02-simd")["vec3_sse.h"])
-    out = subprocess.run(["make", "-s", "-C", str(ROOT), "print-build-command"],
-                         capture_output=True, text=True, check=True).stdout
-    flags = [f for f in shlex.split(out) if not f.startswith(("-DRT_SOURCE_DIR", "-MMD", "-MP"))]
-    drivers = [ROOT / "build" / "vec3-sse-ref" / "common" / f"{o}.o"
-               for o in ("scene_loader", "image", "cli", "progress", "lab_main", "main")]
+    drivers = [ROOT / "build" / "vec3-sse-ref" / "common" / f"{o}.o" for o in DRIVER_SOURCES]
     binary = work / "lab02a"
-    subprocess.run([*flags, f'-DRT_SOURCE_DIR="{ROOT}"', "-DRT_VEC3_SSE", f"-I{work}",
+    subprocess.run([*build_command(), "-DRT_VEC3_SSE", f"-I{work}",
                     f"-I{ROOT / 'common'}", str(ROOT / "labs" / "02-simd" / "render_vec3_sse.cpp"),
                     *map(str, drivers), "-o", str(binary)], check=True, capture_output=True)
     return binary
