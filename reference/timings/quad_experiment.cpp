@@ -132,6 +132,7 @@ static inline float intersect_quad(const PermutedRay& sh, const Quad& q, float t
     return woop_distance(e32, e03, e20, pz[0], pz[2], pz[3], sh.sz, t_max);
 }
 
+// The plane cull of intersect_triangle (triangle.h), once for both triangles.
 static inline bool plane_culled(const Ray& ray, const Quad& q, float t_max) {
     const float denom = dot(q.normal, ray.direction);
     const float num = q.offset - dot(q.normal, ray.origin);
