@@ -67,15 +67,15 @@ def lab04():
 def lab04_pristine_skeleton(tmp_path_factory, lab04_ref):
     """The skeleton exactly as tools/skeletons.py generates it (students' edits to theirs do
     not matter here), compiled and linked as `make lab04` does."""
-    from grading.variants import build_command, pristine_skeleton_sources
+    from grading.variants import DRIVER_SOURCES, build_command, pristine_skeleton_sources
     work = tmp_path_factory.mktemp("lab04-skeleton")
     for name, text in pristine_skeleton_sources("04-mpi").items():
         (work / name).write_text(text)
     mpi = {part: shlex.split(subprocess.run(["mpicxx", f"--showme:{part}"], capture_output=True,
                                             text=True, check=True).stdout)
            for part in ("compile", "link")}
-    objects = [ROOT / "build" / "common" / f"{o}.o"
-               for o in ("scene_loader", "image", "cli", "progress", "lab_main")]
+    # The shared driver, with lab 04's MPI entry point in place of common/main.cpp.
+    objects = [ROOT / "build" / "common" / f"{o}.o" for o in DRIVER_SOURCES if o != "main"]
     objects.append(ROOT / "build" / "labs" / "04-mpi" / "mpi_main.o")
     binary = work / "lab04"
     p = subprocess.run([*build_command(), "-fopenmp", "-DOMPI_SKIP_MPICXX=1",
