@@ -14,15 +14,21 @@ ifeq ($(CI),true)
 WARN     += -Werror
 endif
 CXXFLAGS := -std=c++17 $(OPT) $(WARN) -DRT_SOURCE_DIR='"$(CURDIR)"' -MMD -MP
-INCLUDES := -Icommon
+# common/ in three layers: core/ (the scalar renderer, host and device), host/ (the driver),
+# simd/ (lab 02's AVX2 library, only for the builds that put it on the include path). Shared
+# headers include each other with <...>, so a folder earlier on the include path (a lab's
+# skeleton, a variant, a test's mutant) stands in for any of them.
+INCLUDES      := -Icommon/core -Icommon/host
+SIMD_INCLUDES := -Icommon/simd $(INCLUDES)
 
-# The library part of common/ (what unit tests link) and the driver every lab binary adds.
-LIB_SRC    := common/scene_loader.cpp common/image.cpp common/cli.cpp common/progress.cpp
+# The library part of common/host (what unit tests link) and the driver every lab binary adds.
+LIB_SRC    := common/host/scene_loader.cpp common/host/json_with_positions.cpp common/host/image.cpp common/host/cli.cpp \
+              common/host/progress.cpp common/host/interrupt_cleanup.cpp
 LIB_OBJ    := $(LIB_SRC:%.cpp=$(BUILD)/%.o)
-DRIVER_OBJ := $(BUILD)/common/lab_main.o $(BUILD)/common/main.o
+DRIVER_OBJ := $(BUILD)/common/host/lab_main.o $(BUILD)/common/host/main.o
 COMMON_OBJ := $(LIB_OBJ) $(DRIVER_OBJ)
 
-PHONY_EXTRA := print-build-command
+PHONY_EXTRA := variant
 PHONY_EXTRA += render grade check-nvcc bench-micro bench-cpu count-work
 .PHONY: all help deps labs $(PHONY_EXTRA) test test-unit test-labs skeletons check-skeletons golden bench tradeoff \
         clean
@@ -33,8 +39,13 @@ help:
 	@echo "make labNN-ref    build lab NN's reference solution into ./labNN-ref"
 	@echo "                  labs: $(LAB_BINARIES)"
 	@echo "make render       install what is missing, render the default scene to cornell.ppm"
+	@echo "                  with the fastest reference here (GPU, else OpenMP+AVX2)"
 	@echo "make deps         install what is missing (JSON library, OpenMPI, pytest, numpy)"
 	@echo "make grade LAB=NN grade your lab NN code (01-04): score table and results.json"
+	@echo "make check-nvcc   compile every header of common/core for the GPU (needs nvcc)"
+	@echo "make kernel-report registers, spills, stack and shared memory of every CUDA kernel"
+	@echo "make gpu-check OUT=DIR  on a GPU machine: build, test and benchmark the CUDA labs"
+	@echo "make lab05-bench  the lab-05 kernel shapes the handout measures (needs a GPU)"
 	@echo "make test         build everything and run every test"
 	@echo "make bench        time the lab-01 reference on the Cornell baseline (minutes)"
 	@echo "make bench-cpu    the CPU labs side by side (the report's Table 4 for this machine)"
@@ -48,14 +59,18 @@ help:
 deps:
 	@bash tools/install_deps.sh
 
+# LAB_INCLUDES: a lab's own folder, set per object below, first on the include path.
 $(BUILD)/%.o: %.cpp
 	@mkdir -p $(dir $@)
-	$(CXX) $(CXXFLAGS) $(INCLUDES) -c $< -o $@
+	$(CXX) $(CXXFLAGS) $(LAB_INCLUDES) $(INCLUDES) -c $< -o $@
 
 # ---- labs -------------------------------------------------------------------------------
-# lab01 builds labs/01-serial/skeleton, lab01-ref builds labs/01-serial/solution. A source
-# includes "path_tracer.h" by quotes, so the skeleton's own copy shadows common/'s.
+# lab01 builds labs/01-serial/skeleton, lab01-ref builds labs/01-serial/solution. Each
+# folder comes first on the include path of its own objects, so the skeleton's copy of a
+# shared header (lab 01's path_tracer.h) stands in for common/'s.
 define cpu_lab
+$(BUILD)/labs/$(2)/skeleton/%.o: LAB_INCLUDES = -Ilabs/$(2)/skeleton
+$(BUILD)/labs/$(2)/solution/%.o: LAB_INCLUDES = -Ilabs/$(2)/solution
 $(1): $(patsubst %.cpp,$(BUILD)/%.o,$(wildcard labs/$(2)/skeleton/*.cpp)) $(COMMON_OBJ)
 	$(CXX) $(CXXFLAGS) $$^ -o $$@ $(3)
 $(1)-ref: $(patsubst %.cpp,$(BUILD)/%.o,$(wildcard labs/$(2)/solution/*.cpp)) $(COMMON_OBJ)
@@ -65,8 +80,11 @@ endef
 
 # Each lab's own rules (its binaries, extra flags) live in labs/NN-name/lab.mk; each adds
 # its binaries to LAB_BINARIES.
+# cuda.mk (nvcc, the cuda_lab rule) comes first: the CUDA labs' lab.mk files use it.
 LAB_BINARIES :=
+include cuda.mk
 include $(sort $(wildcard labs/*/lab.mk))
+include grading/grading.mk
 labs: $(LAB_BINARIES)
 
 # ---- tests ------------------------------------------------------------------------------
@@ -87,10 +105,10 @@ test: deps
 	$(MAKE) --no-print-directory test-unit
 	$(MAKE) --no-print-directory test-labs
 
-# Render the default scene (the Cornell baseline) with the lab-01 reference.
+# Render the default scene (the Cornell baseline) with the fastest reference this machine can
+# run, saying which and how long it took (tools/render.sh).
 render: deps
-	$(MAKE) --no-print-directory lab01-ref
-	./lab01-ref --out cornell.ppm
+	@MAKE="$(MAKE)" bash tools/render.sh
 
 skeletons:
 	$(PYTHON) tools/skeletons.py
@@ -98,17 +116,26 @@ skeletons:
 check-skeletons:
 	$(PYTHON) tools/skeletons.py --check
 
-# The shared host+device code must build for the GPU too (CUDA labs reuse it).
+# common/core/ is exactly what runs on the GPU too: every header of it must compile under nvcc
+# on its own, with nothing but core/ on the include path, and a kernel must call the path
+# tracer.
 NVCC ?= nvcc
+CORE_HEADERS := $(notdir $(wildcard common/core/*.h))
 check-nvcc:
 	@command -v $(NVCC) >/dev/null || { echo "check-nvcc: no CUDA toolkit (nvcc) found"; exit 2; }
 	@mkdir -p $(BUILD)/cuda
-	$(NVCC) -std=c++17 -O3 -Icommon -arch=sm_90 -Xcompiler -Wall,-Werror \
+	@for h in $(CORE_HEADERS); do \
+	    printf '#include <%s>\n' $$h > $(BUILD)/cuda/header_$${h%.h}.cu; \
+	    $(NVCC) -std=c++17 -Icommon/core -arch=sm_90 -Xcompiler -Wall,-Werror -Werror all-warnings \
+	        -c $(BUILD)/cuda/header_$${h%.h}.cu -o $(BUILD)/cuda/header_$${h%.h}.o || exit 1; \
+	done
+	$(NVCC) -std=c++17 -O3 -Icommon/core -arch=sm_90 -Xcompiler -Wall,-Werror -Werror all-warnings \
 	    -c tests/cuda/device_compile_check.cu -o $(BUILD)/cuda/device_compile_check.o
+	@echo "check-nvcc: $(words $(CORE_HEADERS)) headers of common/core and the kernel check compile for sm_90"
 
 LAB ?= 01
 grade:
-	$(PYTHON) -m grading.grade $(LAB)
+	$(PYTHON) -m grading.grade $(LAB) --trusted
 
 golden: lab01-ref
 	$(PYTHON) tools/make_golden.py
@@ -118,6 +145,10 @@ bench: lab01-ref
 
 $(BUILD)/intersect_bench: $(BUILD)/bench/intersect_bench.o $(LIB_OBJ)
 	$(CXX) $(CXXFLAGS) $^ -o $@ -lbenchmark -pthread
+
+# The quads-as-one-primitive experiment of reference/timings/README.md (run by hand).
+$(BUILD)/quad_experiment: $(BUILD)/bench/quad_experiment.o $(LIB_OBJ)
+	$(CXX) $(CXXFLAGS) $^ -o $@
 
 bench-cpu: labs
 	$(PYTHON) tools/bench_cpu.py
@@ -131,9 +162,18 @@ bench-micro: $(BUILD)/intersect_bench
 tradeoff: lab01-ref
 	$(PYTHON) tools/bench_serial.py tradeoff
 
-# The exact compiler command lab binaries are built with (the mutation tests reuse it).
-print-build-command:
-	@echo $(CXX) $(CXXFLAGS)
+# ---- variants -----------------------------------------------------------------------------
+# A lab built from a folder of edited sources outside the tree: the pristine skeleton as
+# generated, a mutation test's mutant. `make variant VARIANT_LAB=01-serial VARIANT=DIR`
+# compiles DIR/*.cpp with DIR first on the include path (a header there stands in for the
+# shared one) and links the lab's driver into DIR/lab. Each lab.mk sets VARIANT_FLAGS_<lab>,
+# VARIANT_DRIVER_<lab> and VARIANT_LIBS_<lab> to what its own binaries are built with.
+variant: $(VARIANT_DRIVER_$(VARIANT_LAB))
+	@test -n "$(VARIANT)" -a -n "$(VARIANT_DRIVER_$(VARIANT_LAB))" || \
+	    { echo "variant: needs VARIANT=DIR and VARIANT_LAB=<a lab with VARIANT_DRIVER_<lab>>" >&2; exit 2; }
+	$(CXX) $(filter-out -MMD -MP,$(CXXFLAGS)) -w -I$(VARIANT) $(VARIANT_FLAGS_$(VARIANT_LAB)) \
+	    $(INCLUDES) $(sort $(wildcard $(VARIANT)/*.cpp)) $(VARIANT_DRIVER_$(VARIANT_LAB)) \
+	    -o $(VARIANT)/lab $(VARIANT_LIBS_$(VARIANT_LAB))
 
 clean:
 	rm -rf $(BUILD) $(LAB_BINARIES) .pytest_cache

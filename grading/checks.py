@@ -21,14 +21,16 @@ tests/labs/test_lab01_mutants.py.
 from __future__ import annotations
 
 import dataclasses
+import functools
 import pathlib
 import tempfile
+import time
 
 import numpy as np
 
 from grading import scenes
 from grading.compare import compare
-from grading.harness import golden, run_lab
+from grading.harness import ImageError, golden, run_lab
 
 
 @dataclasses.dataclass
@@ -36,15 +38,34 @@ class CheckResult:
     name: str
     passed: bool
     detail: str
+    # The machine could not measure this (too busy, even after retries): the grader awards
+    # the points provisionally and marks the test for a regrade instead of failing it.
+    regrade: bool = False
 
     def __str__(self) -> str:
         return f"{'PASS' if self.passed else 'FAIL'} {self.name}: {self.detail}"
+
+
+def image_checked(name: str):
+    """A check whose renders raise ImageError (no image, wrong size, NaN/Inf pixels) fails
+    with that message instead of raising: a NaN makes every comparison false, so no check may
+    look at such an image, and the mutation tests still get a CheckResult from each check."""
+    def wrap(check):
+        @functools.wraps(check)
+        def checked(*args, **kwargs) -> CheckResult:
+            try:
+                return check(*args, **kwargs)
+            except ImageError as e:
+                return CheckResult(name, False, str(e))
+        return checked
+    return wrap
 
 
 # Test renders are small and quick; the golden comparison knows their noise level exactly.
 GOLDEN_TEST_SPP = 64
 
 
+@image_checked("golden image")
 def check_golden(binary, scene: str, *, seed: int = 7, spp: int = GOLDEN_TEST_SPP,
                  heatmap_dir: pathlib.Path | None = None, launcher=(), threads=None,
                  extra=()) -> CheckResult:
@@ -71,6 +92,7 @@ def render_interior(binary, runs: dict) -> dict:
         return {label: run_lab(binary, path, **how).image for label, how in runs.items()}
 
 
+@image_checked("analytic sphere interior")
 def check_sphere_interior(binary, bounces=(1, 2, 4)) -> CheckResult:
     """Closed form: camera and light inside a diffuse sphere (grading/scenes.py)."""
     worst = 0.0
@@ -85,6 +107,7 @@ def check_sphere_interior(binary, bounces=(1, 2, 4)) -> CheckResult:
                        f" (allowed 3e-4)")
 
 
+@image_checked("millions of samples")
 def check_million_samples(binary, spp: int = 1 << 22) -> CheckResult:
     """Numerical stability at millions of samples: the sphere interior (zero variance, so
     every sample of a pixel has the same value up to rounding) at 2^22 spp against the same
@@ -103,6 +126,7 @@ def check_million_samples(binary, spp: int = 1 << 22) -> CheckResult:
                        f"{drift:.2e} (allowed 1e-5)")
 
 
+@image_checked("analytic lit plane")
 def check_lit_plane(binary) -> CheckResult:
     """Closed form: a diffuse floor lit by a point light, one bounce, per-pixel integral."""
     w = h = 24
@@ -119,6 +143,7 @@ def check_lit_plane(binary) -> CheckResult:
                        f" (allowed 3e-3, 2e-2)")
 
 
+@image_checked("analytic glass pane (Fresnel)")
 def check_glass_slab(binary) -> CheckResult:
     """Closed form: Fresnel reflectance of a glass pane at normal incidence."""
     scene = scenes.glass_slab(ior=1.5, albedo=0.8, intensity=4.0)
@@ -138,6 +163,7 @@ def check_glass_slab(binary) -> CheckResult:
 SCALE_FACTORS = (1e-4, 1e-2, 1e3, 1e5)
 
 
+@image_checked("scale invariance 1e-4..1e5")
 def check_scale_invariance(binary, scene: str = "cornell", factors=SCALE_FACTORS) -> CheckResult:
     """A scene scaled by any factor from 1e-4 to 1e5 (intensity by the factor squared)
     renders the same: same seed, so the same random numbers and almost the same paths."""
@@ -163,6 +189,7 @@ def check_scale_invariance(binary, scene: str = "cornell", factors=SCALE_FACTORS
                        f"{bad_fraction:.2%} of pixel values off by > 5% (allowed 1%, 2%)")
 
 
+@image_checked("reproducible")
 def check_reproducible(binary, **kwargs) -> CheckResult:
     """Same seed, same bits; another seed, another image."""
     args = dict(width=32, height=32, spp=8, **kwargs)
@@ -175,36 +202,125 @@ def check_reproducible(binary, **kwargs) -> CheckResult:
                        f"same seed identical: {same}; new seed changes image: {differs}")
 
 
+# The timed renders: the golden 'cornell' view with enough paths that process start-up is a
+# few percent of the time. Rendering the golden scene means every timed image can be checked.
+TIMED_SCENE = "cornell"
+
+
+def timed_settings(spp: int) -> dict:
+    g = golden(TIMED_SCENE)
+    return dict(scene=g.scene, width=g.meta["width"], height=g.meta["height"],
+                bounces=g.meta["bounces"], seed=1, spp=spp)
+
+
+def wrong_timed_image(image, spp: int) -> str | None:
+    """Why a timed render is not a correct image of the golden scene, or None: speed is
+    graded only for correct work, on the very runs that were timed."""
+    g = golden(TIMED_SCENE)
+    report = compare(image, spp, g.mean, g.variance, g.meta["golden_spp"])
+    return None if report.passed else f"the timed render is wrong ({report.summary()})"
+
+
+@image_checked("speedup")
 def check_speedup(binary, baseline, min_speedup: float, *, threads=None, launcher=(),
-                  repeat: int = 3) -> CheckResult:
-    """Render time against a baseline binary (the lab-01 reference), interleaved in one run,
-    best of `repeat`: a ratio, so a busy machine slows both sides alike."""
-    from grading.harness import interleaved_speedup, render_seconds
-    scene = dict(width=120, height=120, spp=32, bounces=4, seed=1)
-    speedup, base, fast = interleaved_speedup(
-        lambda: render_seconds(baseline, **scene),
-        lambda: render_seconds(binary, threads=threads, launcher=launcher, **scene), n=repeat)
-    return CheckResult(f"speedup >= {min_speedup:g}x", speedup >= min_speedup,
-                       f"{speedup:.2f}x ({base:.3f} s -> {fast:.3f} s, best of {repeat})")
+                  repeat: int = 3, spp: int = 256) -> CheckResult:
+    """Wall-clock time against a baseline binary (the lab-01 reference), measured by the
+    grader around each whole process (never the `seconds` a program reports about itself),
+    interleaved, best of `repeat`: a ratio, so a busy machine slows both sides alike. Every
+    timed image must match the golden image, or there is no speed to grade."""
+    name = f"speedup >= {min_speedup:g}x"
+    settings = timed_settings(spp)
+    base, fast = [], []
+    for _ in range(repeat):
+        base.append(run_lab(baseline, **settings).wall_seconds)
+        run = run_lab(binary, threads=threads, launcher=launcher, **settings)
+        wrong = wrong_timed_image(run.image, spp)
+        if wrong:
+            return CheckResult(name, False, f"{wrong}: speed is graded only for a correct image")
+        fast.append(run.wall_seconds)
+    speedup = min(base) / min(fast)
+    return CheckResult(name, speedup >= min_speedup,
+                       f"{speedup:.2f}x ({min(base):.3f} s -> {min(fast):.3f} s wall clock "
+                       f"measured by the grader, best of {repeat})")
 
 
+def launch_overhead(reference, launcher, rounds: int = 3) -> float:
+    """Seconds a launcher (mpirun) and MPI start-up add to a run, measured on a trusted
+    reference binary rendering one pixel: subtracted from the candidate's wall-clock time so
+    that a fixed start-up of ~0.5 s does not hide a parallel speedup."""
+    return min(run_lab(reference, width=1, height=1, spp=1, launcher=launcher).wall_seconds
+               for _ in range(rounds))
+
+
+# On a machine giving fewer than BUSY cores' worth of throughput (a quiet two-core machine
+# gives 1.9-2.0) a missed bar may be the machine's fault: under bursts of other load the
+# reference measured 0.95x with 1.79x capacity measured in the same rounds, and ~1x under a
+# steady load of 9 on two cores. Such a result is measured again and, failing that, marked
+# for regrade. On a quiet machine a speedup below VISIBLY_PARALLEL is a serial program (a
+# serial renderer measures 0.95-1.05x against the serial reference) and fails at once.
+VISIBLY_PARALLEL = 1.1
+BUSY = 1.9
+
+
+@image_checked("parallel speedup")
 def check_parallel_speedup(binary, baseline, *, threads=None, launcher=(),
-                           fraction: float = 0.75) -> CheckResult:
-    """Speedup of a parallel lab over the serial baseline, against the machine's capacity
-    measured alongside (grading.harness.measure_parallel)."""
-    from grading.harness import measure_parallel, render_seconds
-    scene = dict(width=256, height=256, spp=32, seed=1)
-    timing = measure_parallel(
-        lambda: render_seconds(baseline, **scene),
-        {"yours": lambda: render_seconds(binary, threads=threads, launcher=launcher, **scene)})
-    if timing.capacity < 1.5:
-        return CheckResult("parallel speedup", False,
+                           fraction: float = 0.75, spp: int = 512, attempts: int = 3,
+                           overhead_reference=None) -> CheckResult:
+    """Speedup of a parallel lab over the serial baseline, in wall-clock time measured by the
+    grader, against the machine's capacity measured alongside (grading.harness.
+    measure_parallel). Every timed image must be the baseline's, bit for bit (what labs 03 and
+    04 promise). A machine too busy to measure is retried; if it stays too busy the test is
+    marked for regrade (points provisional), never failed: that is not the student's doing."""
+    from grading.harness import measure_parallel
+    settings = timed_settings(spp)
+    want: list[bytes] = []
+    wrong: list[str] = []
+    overhead = launch_overhead(overhead_reference, launcher) if overhead_reference else 0.0
+
+    def base() -> float:
+        run = run_lab(baseline, **settings)
+        if not want:
+            want.append(run.image.tobytes())
+        return run.wall_seconds
+
+    def yours() -> float:
+        run = run_lab(binary, threads=threads, launcher=launcher, **settings)
+        if want and run.image.tobytes() != want[0] and not wrong:
+            wrong.append("the timed render differs from the serial reference's image")
+        return max(run.wall_seconds - overhead, 1e-3)
+
+    best = None  # the measurable attempt closest to the bar
+    for attempt in range(1, attempts + 1):
+        timing = measure_parallel(base, {"yours": yours})
+        if wrong:
+            return CheckResult("parallel speedup", False,
+                               f"{wrong[0]}: speed is graded only for a correct image")
+        if timing.capacity >= 1.5:
+            margin = timing.speedup("yours") / timing.required(fraction)
+            if best is None or margin > best[0]:
+                best = (margin, timing)
+            if margin >= 1:
+                break
+            if timing.speedup("yours") < VISIBLY_PARALLEL and timing.capacity >= BUSY:
+                break  # serial on a quiet machine: measuring again would not change that
+        if attempt < attempts:
+            time.sleep(2.0 * attempt)  # let the other load pass
+    note = f" (launch overhead {overhead:.3f} s subtracted)" if overhead else ""
+    if best is None:
+        return CheckResult("parallel speedup", True,
                            f"not measurable: the machine gave only {timing.capacity:.2f} cores' "
-                           f"worth of throughput; run again when it is less busy")
-    return CheckResult("parallel speedup", timing.speedup("yours") >= timing.required(fraction),
-                       timing.describe("yours"))
+                           f"worth of throughput in {attempts} attempts; points provisional, "
+                           f"marked for regrade", regrade=True)
+    margin, timing = best
+    if margin < 1 and timing.capacity < BUSY:
+        return CheckResult("parallel speedup", True,
+                           f"not measurable: short of the bar on a machine too busy to judge "
+                           f"({timing.describe('yours')}{note}); points provisional, "
+                           f"marked for regrade", regrade=True)
+    return CheckResult("parallel speedup", margin >= 1, timing.describe("yours") + note)
 
 
+@image_checked("bit-identical to lab 01")
 def check_bitwise_equal(binary, baseline, *, runs=None) -> CheckResult:
     """The image is the baseline's, bit for bit, for every way of running it (thread counts,
     rank counts): what a counter-based RNG and a race-free parallel loop guarantee. `runs`
@@ -224,14 +340,74 @@ def mpirun(ranks: int) -> list[str]:
     return ["mpirun", "-q", "--oversubscribe", "--bind-to", "none", "-np", str(ranks)]
 
 
-def correctness_checks(binary) -> list[CheckResult]:
-    """Every check a lab's rendering must pass, in the order a student should read them."""
-    return [
-        check_sphere_interior(binary),
-        check_lit_plane(binary),
-        check_glass_slab(binary),
-        check_golden(binary, "cornell"),
-        check_golden(binary, "showcase"),
-        check_scale_invariance(binary),
-        check_reproducible(binary),
-    ]
+# ---- scenes far from the origin, and primitives far larger than the view -----------------
+# Both render with the same random numbers as their plain versions; what could differ is only
+# float rounding, which a renderer must keep from showing (ray offsets that grow with the
+# primitive, light measured from the surface point, not the offset origin).
+
+TRANSLATIONS = (1e2, 1e4)  # in units of the scene's size: the interior's radius, the camera's height
+
+
+def _direction(distance: float) -> list[float]:
+    """An offset of about `distance` off every axis, so no coordinate stays small."""
+    return [distance, -0.7 * distance, 0.3 * distance]
+
+
+def render_floor(binary, scene: dict, width: int = 32, height: int = 32, spp: int = 64):
+    """floor_view (grading/scenes.py) rendered with one bounce, with its relative error per
+    pixel where it is smooth: the lower half of the image, the floor within ~4 units of the
+    camera, where every subsample sees the floor (the upper half reaches the horizon, where a
+    finite floor ends and a pixel spans a huge range of distances)."""
+    with tempfile.TemporaryDirectory() as tmp:
+        path = scenes.write_scene(pathlib.Path(tmp) / "floor.json", scene)
+        image = run_lab(binary, path, width=width, height=height, spp=spp, bounces=1).image
+    want, full = scenes.floor_view_expected(scene, width, height)
+    full[: height // 2] = False
+    return np.abs(image.mean(axis=2)[full] / want[full] - 1.0)
+
+
+def check_translation_invariance(binary) -> CheckResult:
+    """A scene moved far from the origin, by up to 1e4 times its size, renders as before: the
+    zero-variance sphere interior (closed form, 2 bounces) and a lit floor (closed form per
+    pixel). Light measured from the offset ray origin instead of the surface point fails it:
+    the offset grows with |position|, and the sphere interior moved by 1e4 radii rendered 39%
+    too bright."""
+    worst_interior, worst_floor = 0.0, 0.0
+    radius = INTERIOR["radius"]
+    want = scenes.sphere_interior_radiance(**INTERIOR, bounces=2)
+    with tempfile.TemporaryDirectory() as tmp:
+        for t in TRANSLATIONS:
+            scene = scenes.translated(scenes.sphere_interior(**INTERIOR), _direction(t * radius))
+            path = scenes.write_scene(pathlib.Path(tmp) / "interior.json", scene)
+            image = run_lab(binary, path, width=16, height=16, spp=4, bounces=2).image
+            worst_interior = max(worst_interior, float(np.max(np.abs(image / want - 1.0))))
+    for t in TRANSLATIONS:
+        err = render_floor(binary, scenes.translated(scenes.floor_view(1e3), _direction(t)))
+        worst_floor = max(worst_floor, float(err.mean()))
+    # Rounding at 2e4 from the origin moves the interior's wall points by ~1e-3 of its radius:
+    # measured 5e-4 for the reference. The floor's noise is the jitter's, ~5e-3 at 64 spp.
+    ok = worst_interior < 2e-3 and worst_floor < 1.5e-2
+    return CheckResult("translation invariance", ok,
+                       f"moved by up to 1e4x its size: sphere interior off by up to "
+                       f"{worst_interior:.2e} (allowed 2e-3), lit floor by {worst_floor:.2e} "
+                       f"on average (allowed 1.5e-2)")
+
+
+LARGE_FLOORS = (1e1, 1e3, 1e5)  # floor half-sizes, in units of the camera's height
+
+
+def check_large_primitives(binary) -> CheckResult:
+    """A floor far larger than the view renders as a small one: a quad of half-size 10 to
+    1e5 and a sphere of radius 1e3 to 1e5, seen from 1 unit above. An offset that scales
+    only with the hit point and not with the primitive's coordinates lets shadow rays hit the
+    floor they leave: the quad of half-size 1e5 rendered 38% too dark."""
+    worst = (0.0, "")
+    cases = [("quad", h) for h in LARGE_FLOORS] + [("sphere", h) for h in LARGE_FLOORS[1:]]
+    for kind, half in cases:
+        err = float(render_floor(binary, scenes.floor_view(half, kind=kind)).mean())
+        if err >= worst[0]:
+            worst = (err, f"{kind} {half:g}")
+    # The jitter's noise is ~5e-3 at 64 spp; a sphere of radius 1e5 adds ~3e-3 of float
+    # rounding in its hit points (measured).
+    return CheckResult("large primitives", worst[0] < 1.5e-2,
+                       f"worst: {worst[1]}, mean relative error {worst[0]:.2e} (allowed 1.5e-2)")

@@ -98,6 +98,7 @@ from typing import NamedTuple, Sequence
 
 import numpy as np
 
+from . import heatmap
 from .pfm import PFMError, read_pfm
 
 __all__ = [
@@ -573,7 +574,6 @@ def compare(image, test_spp, golden, variance, golden_spp, alpha: float = 1e-4,
         failures=candidates[:MAX_LISTED_FAILURES], first_nonfinite=first_nonfinite,
         z_maps=st.z_maps)
     if not passed and heatmap_path is not None and st.z_maps:
-        from . import heatmap
         b = min(st.z_maps)
         heatmap.write_heatmap(os.fspath(heatmap_path), st.z_maps[b], crit, b, h, w,
                               _block_sums(nonfinite_px[:, :, None].astype(np.float64), b)[:, :, 0] > 0)
@@ -595,7 +595,6 @@ def heatmap_png(path, image, golden, variance, test_spp, golden_spp, block: int 
         block_sizes = tuple(block_sizes) + (int(block),)
     st = _statistics(image, test_spp, golden, variance, golden_spp, alpha, block_sizes,
                      zero_var_rtol)
-    from . import heatmap
     h, w = st.img.shape[:2]
     nonfinite = (~np.isfinite(st.img)).any(axis=2)[:, :, None].astype(np.float64)
     heatmap.write_heatmap(os.fspath(path), st.z_maps[block], st.critical, block, h, w,

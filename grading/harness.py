@@ -1,27 +1,29 @@
 """The per-lab test harness: build lab binaries, run them, load their images, time them.
 
-Every lab binary takes the same command line (shared/DESIGN.md), so one harness serves all
+Every lab binary takes the same command line (DESIGN.md), so one harness serves all
 labs, the pytest suites and the grader alike.
 """
 from __future__ import annotations
 
 import concurrent.futures
+import contextlib
 import dataclasses
 import json
 import os
 import pathlib
 import subprocess
-import tempfile
 import time
 from typing import Callable, Sequence
 
 import numpy as np
 
 from grading.pfm import read_pfm
+from grading.sandbox import Limits, Runner
 
 ROOT = pathlib.Path(__file__).resolve().parent.parent
 SCENES = ROOT / "common" / "scenes"
 GOLDEN = ROOT / "reference" / "golden"
+DEFAULT_SCENE = SCENES / "cornell.json"  # what a lab binary renders without --scene
 
 _built: set[str] = set()
 
@@ -49,6 +51,43 @@ def available_cores() -> int:
     return len(os.sched_getaffinity(0))
 
 
+@dataclasses.dataclass(frozen=True)
+class RunPolicy:
+    """How run_lab runs binaries: trusted (the lab tests, a student's own `make grade`) or in
+    the sandbox (grading others' code), and under which limits (grading/sandbox.py)."""
+    trusted: bool = True
+    limits: Limits = Limits(wall_seconds=600, memory_bytes=None)
+
+
+_policy = RunPolicy()
+
+
+@contextlib.contextmanager
+def policy(p: RunPolicy):
+    """Every run_lab inside the block, in any thread, runs under `p`. A module global rather
+    than a context variable because the timing checks run binaries from worker threads."""
+    global _policy
+    saved, _policy = _policy, p
+    try:
+        yield p
+    finally:
+        _policy = saved
+
+
+def current_policy() -> RunPolicy:
+    return _policy
+
+
+class RunError(RuntimeError):
+    """The binary did not finish cleanly: crashed, timed out, flooded its output, exited
+    non-zero. The message names the symptom first."""
+
+
+class ImageError(RuntimeError):
+    """The binary exited cleanly but its image cannot be graded: missing, unreadable, the wrong
+    size, or holding NaN/Inf values (which make every comparison false, i.e. pass)."""
+
+
 @dataclasses.dataclass
 class Run:
     """One finished run of a lab binary."""
@@ -57,33 +96,84 @@ class Run:
     stderr: str
     json: dict | None       # the --json summary, when the run succeeded
     image: np.ndarray | None  # (H, W, 3) float32 linear radiance, top row first
+    wall_seconds: float = 0.0         # measured by the grader around the whole process tree
+    cpu_seconds: float | None = None  # likewise, where it can be measured (trusted runs)
+
+
+def image_problem(image: np.ndarray, width: int | None, height: int | None) -> str | None:
+    """Why an image cannot be graded, or None."""
+    if image.ndim != 3 or image.shape[2] != 3:
+        return f"the image has shape {image.shape}, not height x width x 3"
+    if width is not None and height is not None and image.shape[:2] != (height, width):
+        return (f"the image is {image.shape[1]}x{image.shape[0]} pixels; "
+                f"{width}x{height} were asked for")
+    nan, inf = int(np.isnan(image).sum()), int(np.isinf(image).sum())
+    if nan or inf:
+        return (f"the image holds {nan} NaN and {inf} infinite values (of {image.size}): "
+                f"a non-finite pixel fails every check that reads the image")
+    return None
 
 
 def run_lab(binary: pathlib.Path | str, scene: pathlib.Path | str | None = None, *,
             width: int | None = None, height: int | None = None, spp: int | None = None,
             bounces: int | None = None, seed: int | None = None, threads: int | None = None,
-            extra: Sequence[str] = (), launcher: Sequence[str] = (), timeout: float = 600,
+            extra: Sequence[str] = (), launcher: Sequence[str] = (), timeout: float | None = None,
             check: bool = True) -> Run:
     """Render with a lab binary; returns its summary and PFM image.
 
-    `launcher` prefixes the command (e.g. mpirun ...). With check=True a non-zero exit
-    raises with the binary's stderr in the message.
+    `launcher` prefixes the command (e.g. mpirun ...). With check=True a run that did not exit
+    0 raises RunError naming the symptom (with the binary's stderr), and an image that is
+    missing, of the wrong size or not finite raises ImageError. The run goes through
+    grading/sandbox.py under the current policy(); `timeout` (seconds) lowers its wall limit.
     """
-    with tempfile.TemporaryDirectory() as tmp:
-        pfm = pathlib.Path(tmp) / "image.pfm"
-        cmd = [*launcher, str(binary), "--quiet", "--json", "--pfm", str(pfm)]
+    pol = current_policy()
+    limits = pol.limits
+    if timeout is not None and timeout < limits.wall_seconds:
+        limits = dataclasses.replace(limits, wall_seconds=timeout)
+    if scene is None and not pol.trusted:
+        scene = DEFAULT_SCENE  # the built-in default path is outside the sandbox's view
+    with Runner(trusted=pol.trusted) as r:
+        cmd = [*launcher, r.input(binary), "--quiet", "--json", "--pfm", r.scratch("image.pfm")]
         for flag, value in (("--scene", scene), ("--width", width), ("--height", height),
                             ("--spp", spp), ("--bounces", bounces), ("--seed", seed),
                             ("--threads", threads)):
             if value is not None:
-                cmd += [flag, str(value)]
+                cmd += [flag, r.input(value) if flag == "--scene" else str(value)]
         cmd += list(extra)
-        p = subprocess.run(cmd, capture_output=True, text=True, timeout=timeout)
-        if check and p.returncode != 0:
-            raise RuntimeError(f"{' '.join(cmd)} exited {p.returncode}: {p.stderr.strip()}")
-        summary = json.loads(p.stdout.strip().splitlines()[-1]) if p.returncode == 0 else None
-        image = read_pfm(pfm) if p.returncode == 0 and pfm.exists() else None
-        return Run(p.returncode, p.stdout, p.stderr, summary, image)
+        out = r.run(cmd, limits)
+        if check and out.failure:
+            raise RunError(f"{out.failure}: {' '.join(cmd)}: {out.stderr.strip()[-2000:]}")
+        ok = out.failure is None
+        summary = _summary(out.stdout) if ok else None
+        image = None
+        if ok:
+            data = r.output("image.pfm")
+            if data is not None:
+                pfm = r.root / "image.pfm"  # the grader's own copy, outside the scratch folder
+                pfm.write_bytes(data)
+                try:
+                    image = read_pfm(pfm)
+                except ValueError as e:
+                    if check:
+                        raise ImageError(f"the image is not a readable PFM: {e}") from None
+        if check:
+            if image is None:
+                raise ImageError("the program exited 0 but wrote no image")
+            problem = image_problem(image, width, height)
+            if problem:
+                raise ImageError(problem)
+        return Run(out.returncode, out.stdout, out.stderr, summary, image, out.wall_seconds,
+                   out.cpu_seconds)
+
+
+def _summary(stdout: str) -> dict | None:
+    """The --json summary: the last line of stdout, when it is a JSON object."""
+    lines = stdout.strip().splitlines()
+    try:
+        value = json.loads(lines[-1]) if lines else None
+    except ValueError:
+        return None
+    return value if isinstance(value, dict) else None
 
 
 @dataclasses.dataclass

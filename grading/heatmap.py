@@ -16,9 +16,9 @@ import zlib
 
 import numpy as np
 
-from .pfm import _atomic_write
+from .pfm import atomic_write
 
-__all__ = ["png_bytes", "write_png", "colormap", "heatmap_scale", "write_heatmap", "heatmap_png"]
+__all__ = ["png_bytes", "write_png", "colormap", "heatmap_scale", "write_heatmap"]
 
 PNG_SIGNATURE = b"\x89PNG\r\n\x1a\n"
 BLUE = np.array([40.0, 90.0, 255.0])
@@ -49,7 +49,7 @@ def png_bytes(rgb: np.ndarray) -> bytes:
 
 def write_png(path: str | os.PathLike, rgb: np.ndarray) -> None:
     """Writes `rgb` as a PNG atomically (temporary file, then os.replace)."""
-    _atomic_write(os.fspath(path), png_bytes(rgb))
+    atomic_write(os.fspath(path), png_bytes(rgb))
 
 
 def colormap(absz: np.ndarray, critical: float) -> np.ndarray:
@@ -103,9 +103,3 @@ def write_heatmap(path: str, z_map: np.ndarray, critical: float, block: int, hei
 
     write_png(path, img)
     return pw, ph
-
-
-def heatmap_png(path, image, golden, variance, test_spp, golden_spp, block: int = 8, **kw):
-    """See grading.compare.heatmap_png."""
-    from .compare import heatmap_png as _heatmap_png
-    return _heatmap_png(path, image, golden, variance, test_spp, golden_spp, block=block, **kw)

@@ -110,10 +110,10 @@ def write_pfm(path: str | os.PathLike, img) -> None:
     directory, which then replaces `path`, so readers never see a half-written image."""
     path = os.fspath(path)
     data = pfm_bytes(img)
-    _atomic_write(path, data)
+    atomic_write(path, data)
 
 
-def _atomic_write(path: str, data: bytes) -> None:
+def atomic_write(path: str, data: bytes) -> None:
     directory = os.path.dirname(os.path.abspath(path))
     fd, tmp = tempfile.mkstemp(prefix=os.path.basename(path) + ".partial-", dir=directory)
     try:

@@ -136,3 +136,92 @@ def scaled(scene: dict, factor: float) -> dict:
 
 def load(name: str) -> dict:
     return json.loads((SCENES / f"{name}.json").read_text())
+
+
+def translated(scene: dict, offset) -> dict:
+    """The same scene moved by `offset` (camera, light and every primitive): the image should
+    not change, up to float rounding at the new place."""
+    s = json.loads(json.dumps(scene))
+    add = lambda p: [c + o for c, o in zip(p, offset)]  # noqa: E731
+    s["camera"]["position"] = add(s["camera"]["position"])
+    s["camera"]["look_at"] = add(s["camera"]["look_at"])
+    if "light" in s:
+        s["light"]["position"] = add(s["light"]["position"])
+    for sp in s.get("spheres", []):
+        sp["center"] = add(sp["center"])
+    for kind in ("triangles", "quads"):
+        for prim in s.get(kind, []):
+            prim["vertices"] = [add(v) for v in prim["vertices"]]
+    return s
+
+
+# The view of floor_view: a camera 1 above the floor y = 0 looking down at 14 degrees, the
+# light 1.5 above the floor ahead. Most shadow rays leave the floor at a slant, which is
+# where an offset too small for the floor's coordinates lets them hit the floor itself.
+FLOOR_CAMERA = dict(position=[0.0, 1.0, 0.0], look_at=[0.0, 0.0, -4.0], up=[0, 1, 0], vfov=60)
+FLOOR_LIGHT = [0.5, 1.5, -3.0]
+
+
+def floor_view(half: float, albedo: float = 0.5, intensity: float = 2.0,
+               kind: str = "quad") -> dict:
+    """A diffuse floor under a point light, seen from 1 unit above it: a quad of half-size
+    `half` in the plane y = 0, or (kind "sphere") a sphere of radius `half` whose top is the
+    origin. Only the floor within a few units of the camera matters to the image, so a floor
+    of any size should render alike (floor_view_expected, one bounce)."""
+    scene = {"camera": dict(FLOOR_CAMERA),
+             "light": {"position": list(FLOOR_LIGHT), "intensity": [intensity] * 3},
+             "materials": {"floor": {"type": "diffuse", "albedo": [albedo] * 3}}}
+    if kind == "quad":
+        scene["quads"] = [{"vertices": [[-half, 0, -half], [-half, 0, half], [half, 0, half],
+                                        [half, 0, -half]], "material": "floor"}]
+    else:
+        scene["spheres"] = [{"center": [0, -half, 0], "radius": half, "material": "floor"}]
+    return scene
+
+
+def floor_view_expected(scene: dict, width: int, height: int, subsamples: int = 8):
+    """Per-pixel expected radiance of floor_view (one bounce; the scene may be scaled or
+    translated, not rotated), computed in double for the exact plane or sphere, by a midpoint
+    rule over subsamples^2 points of each pixel. Also returns, per pixel, whether every one of
+    those points sees the floor (pixels across the horizon are not smooth: compare the rest)."""
+    import numpy as np
+    cam = scene["camera"]
+    pos = np.array(cam["position"], float)
+    forward = np.array(cam["look_at"], float) - pos
+    forward /= np.linalg.norm(forward)
+    right = np.cross(forward, cam["up"])
+    right /= np.linalg.norm(right)
+    up = np.cross(right, forward)
+    half_h = math.tan(math.radians(cam["vfov"]) / 2)
+    half_w = half_h * width / height
+    offs = (np.arange(subsamples) + 0.5) / subsamples
+    xs = (np.arange(width)[:, None] + offs[None, :]).ravel()
+    ys = (np.arange(height)[:, None] + offs[None, :]).ravel()
+    gx, gy = np.meshgrid(xs, ys)
+    d = (forward + right * (-half_w + 2 * half_w * gx / width)[..., None]
+         + up * (half_h - 2 * half_h * gy / height)[..., None])
+    d /= np.linalg.norm(d, axis=-1, keepdims=True)
+    if "spheres" in scene:
+        sphere = scene["spheres"][0]
+        centre, radius = np.array(sphere["center"], float), float(sphere["radius"])
+        f = pos - centre
+        b = -(d @ f)
+        disc = radius**2 - ((f + d * b[..., None]) ** 2).sum(-1)
+        t = b - np.sqrt(np.maximum(disc, 0.0))
+        hit = (disc >= 0) & (t > 0)
+        p = pos + t[..., None] * d
+        normal = (p - centre) / radius
+    else:
+        floor_y = scene["quads"][0]["vertices"][0][1]
+        t = (floor_y - pos[1]) / np.where(d[..., 1] < 0, d[..., 1], -1.0)
+        hit = d[..., 1] < 0
+        p = pos + t[..., None] * d
+        normal = np.array([0.0, 1.0, 0.0])
+    to_light = np.array(scene["light"]["position"], float) - p
+    d2 = (to_light**2).sum(-1)
+    cos = (to_light * normal).sum(-1) / np.sqrt(d2)
+    albedo = scene["materials"]["floor"]["albedo"][0]
+    intensity = scene["light"]["intensity"][0]
+    radiance = np.where(hit, albedo / math.pi * intensity * np.maximum(cos, 0.0) / d2, 0.0)
+    shape = (height, subsamples, width, subsamples)
+    return radiance.reshape(shape).mean(axis=(1, 3)), hit.reshape(shape).all(axis=(1, 3))

@@ -1,61 +1,61 @@
 """Build variants of a CPU lab from edited sources without touching the working tree: the
 pristine skeleton (as students first receive it, whatever they have done to theirs since) and
-the deliberately broken mutants of the mutation tests."""
+the deliberately broken mutants of the mutation tests.
+
+The Makefile is the one place that knows how a lab is built (`make variant`): this module only
+lays out a folder of sources and asks it. A header in that folder stands in for the shared one
+of the same name, because the folder comes first on the include path."""
 from __future__ import annotations
 
 import importlib.util
 import pathlib
-import shlex
-import shutil
 import subprocess
 
-from grading.harness import ROOT, build
-
-# The shared driver every lab binary links: common/<name>.cpp, built as build/common/<name>.o.
-DRIVER_SOURCES = ("scene_loader", "image", "cli", "progress", "lab_main", "main")
+from grading.harness import ROOT
 
 
-def build_command() -> list[str]:
-    """The Makefile's compiler command for lab binaries (make print-build-command), without
-    its dependency-file flags, with RT_SOURCE_DIR quoted for a direct call."""
-    out = subprocess.run(["make", "-s", "-C", str(ROOT), "print-build-command"],
-                         capture_output=True, text=True, check=True).stdout
-    flags = [f for f in shlex.split(out) if not f.startswith(("-DRT_SOURCE_DIR", "-MMD", "-MP"))]
-    return flags + [f'-DRT_SOURCE_DIR="{ROOT}"']
+def lab_sources(lab: str, source_dir: str = "solution") -> dict[str, str]:
+    """The files directly in labs/<lab>/<source_dir> (not its subfolders), by name."""
+    folder = ROOT / "labs" / lab / source_dir
+    return {p.name: p.read_text() for p in sorted(folder.iterdir()) if p.is_file()}
+
+
+def build_sources(variant_lab: str, workdir: pathlib.Path, sources: dict[str, str],
+                  make_args=()) -> pathlib.Path:
+    """Write `sources` (bare file names: render.cpp, path_tracer.h, ray.h...) into a folder and
+    build them as the Makefile builds `variant_lab` (a lab folder name, or 02-simd-a for lab 02
+    Part A); `make_args` override Makefile variables (e.g. OPT, BUILD). Returns the binary."""
+    src = workdir / "src"
+    src.mkdir(parents=True, exist_ok=True)
+    for name, text in sources.items():
+        (src / name).write_text(text)
+    p = subprocess.run(["make", "-s", "-C", str(ROOT), "variant", f"VARIANT_LAB={variant_lab}",
+                        f"VARIANT={src}", *make_args], capture_output=True, text=True)
+    if p.returncode != 0:
+        raise RuntimeError(f"building a {variant_lab} variant failed:\n{(p.stdout + p.stderr)[-2000:]}")
+    return src / "lab"
 
 
 def build_variant(lab: str, workdir: pathlib.Path, overrides: dict[str, str],
-                  source_dir: str = "solution", extra_flags=()) -> pathlib.Path:
-    """Compile labs/<lab>/<source_dir>/*.cpp against copies of common/'s headers, with the
-    files named in `overrides` (bare file names: render.cpp, path_tracer.h, ray.h...) replaced
-    by the given text. Links the shared driver objects; returns the binary's path."""
-    build("lab01-ref")  # makes sure the driver objects exist
-    src = workdir / "src"
-    shutil.copytree(ROOT / "common", src, ignore=shutil.ignore_patterns("scenes", "*.cpp"))
-    for cpp in (ROOT / "labs" / lab / source_dir).glob("*"):
-        shutil.copy(cpp, src)
-    for name, text in overrides.items():
-        (src / name).write_text(text)
-    objects = [str(ROOT / "build" / "common" / f"{o}.o") for o in DRIVER_SOURCES]
-    binary = workdir / "lab"
-    sources = sorted(str(p) for p in src.glob("*.cpp"))
-    p = subprocess.run([*build_command(), *extra_flags, "-w", f"-I{src}", *sources, *objects,
-                        "-o", str(binary)], capture_output=True, text=True)
-    if p.returncode != 0:
-        raise RuntimeError(f"building a {lab} variant failed:\n{p.stderr[-2000:]}")
-    return binary
+                  source_dir: str = "solution") -> pathlib.Path:
+    """labs/<lab>/<source_dir>'s files with those named in `overrides` replaced or added."""
+    return build_sources(lab, workdir, {**lab_sources(lab, source_dir), **overrides})
 
 
 def pristine_skeleton_sources(lab: str) -> dict[str, str]:
-    """The skeleton files of a lab exactly as tools/skeletons.py generates them."""
+    """The skeleton files of a lab exactly as tools/skeletons.py generates them, by path
+    below skeleton/ (lab 02's Part A is part-a/vec3.h)."""
     spec = importlib.util.spec_from_file_location("skeletons", ROOT / "tools" / "skeletons.py")
     skeletons = importlib.util.module_from_spec(spec)
     spec.loader.exec_module(skeletons)
-    return {path.name: text for path, text in skeletons.generated_files()
-            if path.parent.parent.name == lab}
+    base = ROOT / "labs" / lab / "skeleton"
+    return {path.relative_to(base).as_posix(): text for path, text in skeletons.generated_files()
+            if path.is_relative_to(base)}
 
 
-def build_pristine_skeleton(lab: str, workdir: pathlib.Path, extra_flags=()) -> pathlib.Path:
-    """The skeleton as students receive it: the tests of its expected failures use this, so
-    `make test` stays green while a student fills in their own copy."""
-    return build_variant(lab, workdir, pristine_skeleton_sources(lab), extra_flags=extra_flags)
+def build_pristine_skeleton(lab: str, workdir: pathlib.Path) -> pathlib.Path:
+    """The skeleton as students receive it (its top-level files; lab 02's Part A has its own
+    builder in test_lab02): the tests of its expected failures use this, so `make test` stays
+    green while a student fills in their own copy."""
+    files = {name: text for name, text in pristine_skeleton_sources(lab).items() if "/" not in name}
+    return build_sources(lab, workdir, files)

@@ -18,7 +18,7 @@ Prints three tables and asserts nothing:
 3. The shared-RNG mistake: lab03-shared-rng (one generator behind `omp critical`) and
    lab03-shared-rng-race (no lock: a data race), with whether their images repeat.
 
-Timing (shared/DESIGN.md, "Timing"): render seconds as the binaries report them, best of
+Timing (DESIGN.md, "Timing"): render seconds as the binaries report them, best of
 --repeat, measured in rounds; each round runs the lab01-ref baseline and every
 configuration once, so a machine that slows down during the run slows both sides alike.
 The machine, its cores and its load average before and after are printed with the tables:
@@ -41,7 +41,7 @@ import tempfile
 
 ROOT = pathlib.Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(ROOT))
-from grading.harness import available_cores, build, run_lab  # noqa: E402
+from grading.harness import available_cores, build, cpu_has_avx2, run_lab  # noqa: E402
 
 SCHEDULES = ["static", "static,1", "dynamic,1", "dynamic,4", "guided"]
 # Private copies of the binaries (run() makes the folder, main() fills it): other people's
@@ -178,7 +178,7 @@ def main() -> int:
     targets = ["lab01-ref", "lab03-ref", "lab03-bench", "lab03-row-costs", "lab03-shared-rng",
                "lab03-shared-rng-race"]
     build(*targets)
-    simd = (ROOT / "common" / "simd_pixel_renderer.h").exists()
+    simd = cpu_has_avx2()
     if simd:
         targets += ["lab03-simd-ref", "lab02-ref"]
         build("lab03-simd-ref", "lab02-ref")

@@ -27,9 +27,8 @@ import tempfile
 
 ROOT = pathlib.Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(ROOT))
-from grading.variants import DRIVER_SOURCES, build_command  # noqa: E402
+from grading.variants import build_sources  # noqa: E402
 
-SOURCES = ["labs/01-serial/solution/render.cpp", *(f"common/{c}.cpp" for c in DRIVER_SOURCES)]
 # The two queries, kept out of line so that callgrind can count them.
 QUERIES = {
     "closest_hit": "RT_HD inline Hit closest_hit(const SceneView& scene, const Ray& ray) {",
@@ -43,21 +42,23 @@ def fail(message: str) -> None:
 
 
 def build(work: pathlib.Path) -> pathlib.Path:
-    shutil.copytree(ROOT / "common", work / "common")
-    shutil.copytree(ROOT / "labs" / "01-serial" / "solution", work / "labs/01-serial/solution")
-    tracer = work / "common" / "path_tracer.h"
-    text = tracer.read_text()
+    tracer = (ROOT / "common" / "core" / "path_tracer.h").read_text()
     for name, signature in QUERIES.items():
-        if signature not in text:
-            fail(f"common/path_tracer.h no longer declares {name} as '{signature}'; update QUERIES")
-        text = text.replace(signature, "__attribute__((noinline)) " + signature.replace("RT_HD inline ", ""))
-    tracer.write_text(text)
-    binary = work / "lab01-counted"
-    # The Makefile's command, for a target valgrind can run; -g for callgrind's line numbers.
-    command = [f for f in build_command() if not f.startswith(("-march=", "-Werror"))]
-    subprocess.run([*command, "-march=x86-64-v3", "-g", "-Icommon", *SOURCES,
-                    "-o", str(binary)], cwd=work, check=True)
-    return binary
+        if signature not in tracer:
+            fail(f"common/core/path_tracer.h no longer declares {name} as '{signature}'; "
+                 "update QUERIES")
+        tracer = tracer.replace(signature, "__attribute__((noinline)) " +
+                                signature.replace("RT_HD inline ", ""))
+    sources = {"render.cpp": (ROOT / "labs/01-serial/solution/render.cpp").read_text(),
+               "path_tracer.h": tracer}
+    # The Makefile's build, for a target valgrind can run (no AVX-512), with -g for
+    # callgrind's line numbers, into a build folder of its own.
+    opt = "-O3 -march=x86-64-v3 -g -ffp-contract=off -fno-math-errno -fno-trapping-math"
+    try:
+        return build_sources("01-serial", work, sources,
+                             make_args=[f"OPT={opt}", f"BUILD={work / 'build'}", "CI="])
+    except RuntimeError as e:
+        fail(str(e).splitlines()[0])
 
 
 def inclusive(annotated: str, function: str) -> list:

@@ -1,11 +1,12 @@
 #!/usr/bin/env bash
 # Installs what the labs need and is missing; says what it installs; safe to run again.
 # Compilers (g++, nvcc where present) come with the machine; this adds the JSON library,
-# GoogleTest, Google Benchmark, OpenMPI and the Python test packages.
+# GoogleTest, Google Benchmark, OpenMPI, bubblewrap (the grader's sandbox) and the Python test
+# packages.
 set -euo pipefail
 
 debian_packages=(g++ make nlohmann-json3-dev libgtest-dev libbenchmark-dev openmpi-bin
-                 libopenmpi-dev iproute2)
+                 libopenmpi-dev iproute2 bubblewrap)
 python_modules=(pytest numpy)
 
 missing=()

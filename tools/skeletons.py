@@ -10,9 +10,11 @@ A solution file marks what students write:
     // END SOLUTION
 
 The skeleton keeps everything outside the markers, drops the reference code and uncomments
-the "//>" lines (keeping their indentation). A lab's solution/ files become skeleton/ files of
+the "//>" lines (keeping their indentation). Comment lines that start with "//!" are for
+instructors only (how the file becomes a skeleton, where its solution lives): the skeleton
+drops them too. A lab's solution/ files become skeleton/ files of
 the same name; the shared files a lab lists in SHARED_SOURCES (code the lab's students write
-but later labs reuse, such as common/path_tracer.h) become skeleton/ files too.
+but later labs reuse, such as common/core/path_tracer.h) become skeleton/ files too.
 
     tools/skeletons.py           regenerate every skeleton
     tools/skeletons.py --check   exit 1 and name the files that differ (used by the tests)
@@ -26,14 +28,15 @@ ROOT = pathlib.Path(__file__).resolve().parent.parent
 
 # Shared files whose solution regions belong to a lab's students.
 SHARED_SOURCES = {
-    "01-serial": ["common/path_tracer.h"],
-    "02-simd": ["common/packet_tracer.h", "common/vec3_sse.h"],
+    "01-serial": ["common/core/path_tracer.h"],
+    "02-simd": ["common/simd/packet_tracer.h"],
 }
 
 BEGIN = re.compile(r"^\s*// BEGIN SOLUTION\s*$")
 SKELETON = re.compile(r"^\s*// SKELETON\s*$")
 END = re.compile(r"^\s*// END SOLUTION\s*$")
 PLACEHOLDER = re.compile(r"^(\s*)//> ?(.*)$")
+INSTRUCTOR_ONLY = re.compile(r"^\s*//!")
 
 
 class MarkerError(Exception):
@@ -58,7 +61,8 @@ def skeleton_text(text: str, name: str) -> str:
                 raise MarkerError(f"{where}: END SOLUTION without BEGIN SOLUTION")
             state = "outside"
         elif state == "outside":
-            out.append(line)
+            if not INSTRUCTOR_ONLY.match(line):
+                out.append(line)
         elif state == "skeleton":
             m = PLACEHOLDER.match(line)
             if not m:
@@ -75,13 +79,16 @@ def generated_files():
         solution = lab / "solution"
         if not solution.is_dir():
             continue
-        sources = [p for p in sorted(solution.iterdir()) if p.is_file()]
-        sources += [ROOT / s for s in SHARED_SOURCES.get(lab.name, [])]
-        for src in sources:
+        # solution/'s files keep their place below it (lab 02's part-a/vec3.h); shared files
+        # land at the top of skeleton/.
+        sources = [(p, p.relative_to(solution)) for p in sorted(solution.rglob("*")) if p.is_file()]
+        sources += [(ROOT / s, pathlib.Path(s).name) for s in SHARED_SOURCES.get(lab.name, [])]
+        for src, target in sources:
             rel = src.relative_to(ROOT)
-            header = (f"// GENERATED from {rel} by tools/skeletons.py: edit this file freely,\n"
-                      f"// it is yours. (Instructors: edit the solution and run `make skeletons`.)\n")
-            yield lab / "skeleton" / src.name, header + skeleton_text(src.read_text(), str(rel))
+            number = lab.name.split("-")[0]
+            header = (f"// Lab {number}: your copy, yours to edit. Every place to fill in is "
+                      f"marked TODO(lab{number}).\n")
+            yield lab / "skeleton" / target, header + skeleton_text(src.read_text(), str(rel))
 
 
 def main() -> int:

@@ -1,8 +1,8 @@
 # Lab 02: SIMD.
 #   Part B, 8 paths per AVX2 packet (one per lane): ./lab02 (skeleton/) and ./lab02-ref
 #   (solution/).
-#   Part A, the lab-01 renderer with the SSE Vec3 of common/vec3_sse.h: ./lab02a (with
-#   skeleton/vec3_sse.h) and ./lab02a-ref (with common/vec3_sse.h).
+#   Part A, the lab-01 renderer with an SSE Vec3: ./lab02a (with skeleton/part-a/vec3.h) and
+#   ./lab02a-ref (with solution/part-a/vec3.h), each standing in for common/core/vec3.h.
 #   ./lab02-prims, a worked example: SIMD across primitives (one ray, 8 triangles).
 LAB02 := labs/02-simd
 
@@ -12,6 +12,8 @@ ifneq ($(filter x86_64% i686% i386%,$(shell $(CXX) -dumpmachine)),)
 # render.cpp checks the CPU at run time and is built for any x86-64; render_avx2.cpp holds
 # every AVX2 instruction and is the only file built with -mavx2 -mfma (no-ops under
 # -march=native on an AVX2 machine; what lets another machine build it at all).
+# Part B's objects see lab 02's AVX2 library (common/simd/) on the include path; not their
+$(BUILD)/$(LAB02)/%.o: LAB_INCLUDES = -Icommon/simd
 $(BUILD)/$(LAB02)/skeleton/render_avx2.o $(BUILD)/$(LAB02)/solution/render_avx2.o \
 $(BUILD)/$(LAB02)/render_prims.o: CXXFLAGS += -mavx2 -mfma
 
@@ -26,19 +28,20 @@ lab02-prims: $(BUILD)/$(LAB02)/solution/render.o $(BUILD)/$(LAB02)/render_prims.
 	$(CXX) $(CXXFLAGS) $^ -o $@
 
 # ---- Part A ------------------------------------------------------------------------------
-# Every file is built with -DRT_VEC3_SSE, into an object folder of its own: Vec3 is 16 bytes
-# there, not 12, so no object of the scalar build may be linked in. The student's build
-# searches skeleton/ before common/ for vec3_sse.h (vec3.h includes it with <>).
-LAB02A_SRC := $(LIB_SRC) common/lab_main.cpp common/main.cpp
+# Every file, the shared driver too, is built with solution/part-a (or skeleton/part-a) first
+# on the include path, so its vec3.h replaces common/core/vec3.h everywhere, into an object folder
+# of its own: Vec3 is 16 bytes there, not 12, so no object of the scalar build may be linked
+# in.
+LAB02A_SRC := $(LIB_SRC) common/host/lab_main.cpp common/host/main.cpp
 
 $(BUILD)/vec3-sse-ref/%.o: %.cpp
 	@mkdir -p $(dir $@)
-	$(CXX) $(CXXFLAGS) -DRT_VEC3_SSE $(INCLUDES) -c $< -o $@
+	$(CXX) $(CXXFLAGS) -I$(LAB02)/solution/part-a $(INCLUDES) -c $< -o $@
 $(BUILD)/vec3-sse/%.o: %.cpp
 	@mkdir -p $(dir $@)
-	$(CXX) $(CXXFLAGS) -DRT_VEC3_SSE -I$(LAB02)/skeleton $(INCLUDES) -c $< -o $@
+	$(CXX) $(CXXFLAGS) -I$(LAB02)/skeleton/part-a $(INCLUDES) -c $< -o $@
 
-# render_vec3_sse.cpp is lab 01's pixel loop; the student's Part A is skeleton/vec3_sse.h.
+# render_vec3_sse.cpp is lab 01's pixel loop; the student's Part A is skeleton/part-a/vec3.h.
 LAB02A_SRC += $(LAB02)/render_vec3_sse.cpp
 lab02a-ref: $(patsubst %.cpp,$(BUILD)/vec3-sse-ref/%.o,$(LAB02A_SRC))
 	$(CXX) $(CXXFLAGS) $^ -o $@
@@ -46,6 +49,13 @@ lab02a: $(patsubst %.cpp,$(BUILD)/vec3-sse/%.o,$(LAB02A_SRC))
 	$(CXX) $(CXXFLAGS) $^ -o $@
 
 LAB_BINARIES += lab02 lab02-ref lab02a lab02a-ref lab02-prims
+
+# Variants (make variant): Part B as one AVX2 build; Part A against lab02a-ref's driver
+# objects (the same 16-byte Vec3 layout; only the operators' bodies differ).
+VARIANT_FLAGS_02-simd := -Icommon/simd -mavx2 -mfma
+VARIANT_DRIVER_02-simd := $(COMMON_OBJ)
+VARIANT_DRIVER_02-simd-a := $(patsubst %.cpp,$(BUILD)/vec3-sse-ref/%.o,$(LIB_SRC) \
+                            common/host/lab_main.cpp common/host/main.cpp)
 
 else
 

@@ -6,8 +6,8 @@
 #include "simd_geometry.h"
 #include "timer.h"
 
-RenderStats render_simd(const RenderJob& job, Image& image) {
-    const SceneView scene = job.scene.view();
+RenderStats render_avx2(const RenderJob& job, Image& image) {
+    const SceneView scene = job.scene;
     const RenderSettings& settings = job.settings;
     const Timer timer;
     const SimdScene packets(scene);  // the SoA copy

@@ -2,8 +2,8 @@
 # handout measures, all with the shared command line:
 #   lab03-bench            the solution with schedule(runtime): OMP_SCHEDULE picks the loop
 #                          schedule (tools/bench_openmp.py; the default build keeps the best)
-#   lab03-simd-ref         the solution on lab 02's AVX2 geometry (-DRT_USE_SIMD); only on
-#                          x86-64 once common/simd_pixel_renderer.h exists
+#   lab03-simd-ref         the solution on lab 02's AVX2 packet tracer (common/simd/ first on
+#                          the include path); only on x86-64
 #   lab03-shared-rng       the classic mistake: one generator shared by all threads, locked
 #   lab03-shared-rng-race  the same without the lock: a data race
 #   lab03-row-costs        lab 01's serial render, timing each row (the cost profile)
@@ -33,25 +33,25 @@ lab03-row-costs: $(LAB03_BUILD)/row_costs.o $(COMMON_OBJ)
 	$(CXX) $(CXXFLAGS) $^ -o $@ -fopenmp
 .PHONY: lab03-bench lab03-shared-rng lab03-shared-rng-race lab03-row-costs lab03-simd-ref
 
+VARIANT_FLAGS_03-openmp := -fopenmp
+VARIANT_DRIVER_03-openmp := $(COMMON_OBJ)
+VARIANT_LIBS_03-openmp := -fopenmp
+
 LAB_BINARIES += lab03 lab03-ref lab03-bench lab03-shared-rng lab03-shared-rng-race \
                 lab03-row-costs
 
-# The SIMD variant: solution/render.cpp with AVX2, entered through simd_entry.cpp (built
-# without AVX2), which checks the CPU first.
-LAB03_SIMD_MISSING := $(if $(wildcard common/simd_pixel_renderer.h),,needs \
-    common/simd_pixel_renderer.h (lab 02), which is not here yet)
-ifeq ($(filter x86_64% i686% i386%,$(shell $(CXX) -dumpmachine)),)
-LAB03_SIMD_MISSING := needs an x86-64 CPU and compiler (AVX2)
-endif
-ifeq ($(LAB03_SIMD_MISSING),)
+# The SIMD variant: solution/render.cpp with common/simd/ first on the include path (its
+# pixel_renderer.h is the AVX2 one) and -DRT_USE_SIMD (which renames its render() to
+# render_avx2), entered through simd_entry.cpp (built without AVX2), which checks the CPU.
+ifneq ($(filter x86_64% i686% i386%,$(shell $(CXX) -dumpmachine)),)
 $(LAB03_BUILD)/simd/render.o: $(LAB03)/solution/render.cpp
 	@mkdir -p $(dir $@)
-	$(CXX) $(CXXFLAGS) -DRT_USE_SIMD -mavx2 -mfma $(INCLUDES) -c $< -o $@
+	$(CXX) $(CXXFLAGS) -DRT_USE_SIMD -mavx2 -mfma $(SIMD_INCLUDES) -c $< -o $@
 lab03-simd-ref: $(LAB03_BUILD)/simd/render.o $(LAB03_BUILD)/simd_entry.o $(COMMON_OBJ)
 	$(CXX) $(CXXFLAGS) $^ -o $@ -fopenmp
 LAB_BINARIES += lab03-simd-ref
 else
 lab03-simd-ref:
-	@echo "lab03-simd-ref: $(LAB03_SIMD_MISSING)" >&2
+	@echo "lab03-simd-ref: needs an x86-64 CPU and compiler (AVX2)" >&2
 	@exit 1
 endif

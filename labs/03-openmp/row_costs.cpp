@@ -13,7 +13,7 @@
 const char* const kLabName = "03-openmp-row-costs";
 
 RenderStats render(const RenderJob& job, Image& image) {
-    const ScalarPixelRenderer pixel(job);
+    const PixelRenderer pixel(job);
     std::vector<double> row_seconds(job.settings.height);
     const Timer timer;
     for (int y = 0; y < job.settings.height; ++y) {

@@ -57,7 +57,7 @@ private:
 };
 
 RenderStats render(const RenderJob& job, Image& image) {
-    const SceneView scene = job.scene.view();
+    const SceneView scene = job.scene;
     const RenderSettings& settings = job.settings;
     const int threads = job.threads > 0 ? job.threads : omp_get_max_threads();
     const SharedLcg rng(settings.seed);  // one generator for the whole image: the mistake

@@ -1,10 +1,10 @@
 # Lab 04: MPI. Run the binaries under mpirun, e.g. `mpirun -np 2 ./lab04-ref --out a.ppm`:
 #   lab04           the student's code (labs/04-mpi/skeleton)
 #   lab04-ref       the reference solution
-#   lab04-simd-ref  the solution on lab 02's AVX2 geometry (-DRT_USE_SIMD); only on x86-64
-#                   once common/simd_pixel_renderer.h exists
+#   lab04-simd-ref  the solution on lab 02's AVX2 packet tracer (common/simd/ first on the
+#                   include path); only on x86-64
 # All three link labs/04-mpi/mpi_main.cpp (MPI around the shared driver) instead of
-# common/main.cpp. RT_MPI_DISTRIBUTION=block|interleaved|dynamic picks the distribution.
+# common/host/main.cpp. RT_MPI_DISTRIBUTION=block|interleaved|dynamic picks the distribution.
 LAB04 := labs/04-mpi
 LAB04_BUILD := $(BUILD)/$(LAB04)
 MPICXX ?= mpicxx
@@ -16,18 +16,21 @@ LAB04_MPI_CFLAGS = $(patsubst -I%,-isystem %,$(filter -I%,$(shell $(MPICXX) --sh
                    -DOMPI_SKIP_MPICXX=1
 LAB04_MPI_LIBS = $(shell $(MPICXX) --showme:link)
 $(LAB04_BUILD)/%.o: CXXFLAGS += -fopenmp $(LAB04_MPI_CFLAGS)
+# mpi_run.h (the plumbing students do not edit) is found from skeleton/ and solution/ alike.
+$(LAB04_BUILD)/%.o: LAB_INCLUDES = -I$(LAB04)
 
-LAB04_DRIVER := $(LAB04_BUILD)/mpi_main.o $(BUILD)/common/lab_main.o $(LIB_OBJ)
+LAB04_DRIVER := $(LAB04_BUILD)/mpi_main.o $(LAB04_BUILD)/mpi_run.o $(BUILD)/common/host/lab_main.o \
+                $(LIB_OBJ)
 LAB04_SKELETON_OBJ := $(patsubst %.cpp,$(BUILD)/%.o,$(wildcard $(LAB04)/skeleton/*.cpp))
 LAB04_SOLUTION_OBJ := $(patsubst %.cpp,$(BUILD)/%.o,$(wildcard $(LAB04)/solution/*.cpp))
 
-# The SIMD variant: solution/render.cpp with AVX2, entered through simd_entry.cpp (built
-# without AVX2), which checks every rank's CPU first.
+# The SIMD variant: solution/render.cpp with common/simd/ first on the include path and
+# -DRT_USE_SIMD (as lab 03's), entered through simd_entry.cpp (built without AVX2), which
+# checks every rank's CPU first.
 $(LAB04_BUILD)/simd/render.o: $(LAB04)/solution/render.cpp
 	@mkdir -p $(dir $@)
-	$(CXX) $(CXXFLAGS) -DRT_USE_SIMD -mavx2 -mfma $(INCLUDES) -c $< -o $@
-LAB04_SIMD_MISSING := $(if $(wildcard common/simd_pixel_renderer.h),,needs \
-    common/simd_pixel_renderer.h (lab 02), which is not here yet)
+	$(CXX) $(CXXFLAGS) -DRT_USE_SIMD -mavx2 -mfma -I$(LAB04) $(SIMD_INCLUDES) -c $< -o $@
+LAB04_SIMD_MISSING :=
 ifeq ($(filter x86_64% i686% i386%,$(shell $(CXX) -dumpmachine)),)
 LAB04_SIMD_MISSING := needs an x86-64 CPU and compiler (AVX2)
 endif
@@ -42,6 +45,9 @@ lab04: $(LAB04_SKELETON_OBJ) $(LAB04_DRIVER)
 lab04-ref: $(LAB04_SOLUTION_OBJ) $(LAB04_DRIVER)
 	$(CXX) $(CXXFLAGS) $^ -o $@ -fopenmp $(LAB04_MPI_LIBS)
 LAB_BINARIES += lab04 lab04-ref
+VARIANT_FLAGS_04-mpi = -fopenmp $(LAB04_MPI_CFLAGS) -I$(LAB04)
+VARIANT_DRIVER_04-mpi := $(LAB04_DRIVER)
+VARIANT_LIBS_04-mpi = -fopenmp $(LAB04_MPI_LIBS)
 ifeq ($(LAB04_SIMD_MISSING),)
 lab04-simd-ref: $(LAB04_BUILD)/simd/render.o $(LAB04_BUILD)/simd_entry.o $(LAB04_DRIVER)
 	$(CXX) $(CXXFLAGS) $^ -o $@ -fopenmp $(LAB04_MPI_LIBS)

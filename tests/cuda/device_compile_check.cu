@@ -1,6 +1,6 @@
 // Compiles the shared renderer's host+device code for the GPU: every RT_HD function a CUDA
 // lab will call must build under nvcc. Built by `make check-nvcc`; nothing here runs.
-#include "path_tracer.h"
+#include <path_tracer.h>
 
 __global__ void render_kernel(SceneView scene, Camera camera, RenderSettings settings,
                               Vec3* pixels) {

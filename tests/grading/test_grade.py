@@ -31,7 +31,8 @@ def test_skeleton_gets_nothing_and_a_heatmap(lab01_pristine_skeleton, tmp_path):
     results, table = grade(lab01_pristine_skeleton, tmp_path)
     assert results["score"] == 0, table
     assert "FAIL" in table and "total" in table
-    assert (tmp_path / "maps" / "cornell-diff.png").read_bytes().startswith(b"\x89PNG")
+    # The golden images are compared only once the hidden scene passes: its heatmap shows why.
+    assert (tmp_path / "maps" / "hidden-diff.png").read_bytes().startswith(b"\x89PNG")
 
 
 # ---- the rubrics of labs 02-04 on deliberately broken hand-ins ------------------------------
@@ -50,7 +51,7 @@ def test_lab02_scalar_hand_in_loses_only_the_speedup(lab01_ref, tmp_path):
     """Lab 01's reference handed in for lab 02: every image is right, but it is not SIMD."""
     results = grade_in_process("02", lab01_ref, tmp_path)
     passed = passed_by_check(results)
-    assert not passed.pop("speedup >= 1.5x"), describe(results)
+    assert not passed.pop("speedup"), describe(results)
     assert all(passed.values()), describe(results)
 
 
@@ -60,23 +61,28 @@ def test_lab02_reference_gets_full_marks(tmp_path):
     assert results["score"] == results["max_score"] == 100, describe(results)
 
 
-def test_lab03_shared_generator_loses_bits_and_speed(tmp_path):
+def test_lab03_shared_generator_loses_the_bits(tmp_path):
     """The classic mistake (one locked generator for all threads): the image is still right
-    statistically, but not lab 01's bits, and the threads take turns at the lock."""
+    statistically, but not lab 01's bits. What the lock costs in speed depends on the machine
+    (on one two-core AMD EPYC it still reached 1.62x where 1.49x was required), and the golden
+    images count only with the speedup shown, so only the bit check is asserted outright;
+    tools/bench_openmp.py prints the shared generator's speedup."""
     results = grade_in_process("03", build("lab03-shared-rng")[0], tmp_path)
     passed = passed_by_check(results)
-    assert not passed["bit-identical to lab 01"], describe(results)
-    assert passed["golden image 'cornell'"] and passed["golden image 'showcase'"], describe(results)
-    assert not passed["parallel speedup"], describe(results)
+    assert not passed["bitwise"], describe(results)
+    if passed["parallel-speedup"]:
+        assert passed["golden-cornell"] and passed["golden-showcase"], describe(results)
 
 
-def test_lab03_serial_hand_in_loses_only_the_speedup(lab01_ref, tmp_path):
-    """Lab 01's reference handed in for lab 03: the same bits, one core."""
+def test_lab03_serial_hand_in_earns_nothing(lab01_ref, tmp_path):
+    """Lab 01's reference handed in for lab 03 (what the lab 03 skeleton is: the same bits, one
+    core): correct, but lab 03 is about parallelism, so no correctness points without it."""
     results = grade_in_process("03", lab01_ref, tmp_path)
     skip_if_not_measurable(results)
     passed = passed_by_check(results)
-    assert not passed.pop("parallel speedup"), describe(results)
-    assert all(passed.values()), describe(results)
+    assert not passed["parallel-speedup"], describe(results)
+    assert results["score"] == 0, describe(results)
+    assert "not graded until the parallel speedup passes" in describe(results)
 
 
 def test_lab03_reference_gets_full_marks(tmp_path):

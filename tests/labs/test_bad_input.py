@@ -1,7 +1,9 @@
 """Bad input ends with exit status 2 and one line naming the file, the place and what was
-expected; no output file is created or damaged (shared/DESIGN.md, "Command line")."""
+expected; no output file is created or damaged (DESIGN.md, "Command line")."""
 import json
+import signal
 import subprocess
+import time
 
 import pytest
 
@@ -114,3 +116,25 @@ def test_output_replaced_whole(lab01_ref, tmp_path):
     assert p.returncode == 0
     assert out.read_bytes().startswith(b"PF\n8 8\n")
     assert sorted(x.name for x in tmp_path.iterdir()) == ["img.pfm"]
+
+
+@pytest.mark.parametrize("signal_number", [signal.SIGINT, signal.SIGTERM])
+def test_interrupted_render_leaves_nothing(lab01_ref, tmp_path, signal_number):
+    """Ctrl-C (or a grader's kill) during a long render: the process dies of that signal and
+    no '*.partial-*' temporary of --out/--pfm is left; an existing output stays as it was."""
+    (tmp_path / "old.ppm").write_bytes(b"keep me")
+    p = subprocess.Popen([str(lab01_ref), "--quiet", "--width", "400", "--height", "400",
+                          "--spp", "4096", "--out", str(tmp_path / "old.ppm"),
+                          "--pfm", str(tmp_path / "new.pfm")])
+    try:
+        deadline = time.monotonic() + 30
+        while len(list(tmp_path.glob("*.partial-*"))) < 2:  # both opened: rendering has begun
+            assert p.poll() is None and time.monotonic() < deadline, "no temporaries appeared"
+            time.sleep(0.01)
+        p.send_signal(signal_number)
+        assert p.wait(timeout=30) == -signal_number
+    finally:
+        p.kill()
+        p.wait()
+    assert sorted(f.name for f in tmp_path.iterdir()) == ["old.ppm"]
+    assert (tmp_path / "old.ppm").read_bytes() == b"keep me"

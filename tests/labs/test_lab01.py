@@ -82,3 +82,14 @@ def test_skeletons_in_sync():
     p = subprocess.run(["python3", str(ROOT / "tools" / "skeletons.py"), "--check"],
                        capture_output=True, text=True)
     assert p.returncode == 0, p.stderr
+
+
+def test_skeletons_carry_no_instructor_text():
+    """What students receive says nothing of solutions: no markers, no instructor-only ('//!')
+    lines, no path into a solution folder."""
+    from grading.variants import pristine_skeleton_sources
+    leaks = ["BEGIN SOLUTION", "END SOLUTION", "//!", "solution/", "skeletons.py"]
+    for lab in sorted(p.name for p in (ROOT / "labs").iterdir() if (p / "solution").is_dir()):
+        for name, text in pristine_skeleton_sources(lab).items():
+            found = [leak for leak in leaks if leak in text]
+            assert not found, f"labs/{lab}/skeleton/{name} contains {found}"

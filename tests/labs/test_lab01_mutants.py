@@ -1,7 +1,8 @@
 """Mutation tests: the checks must catch deliberately broken solutions.
 
 Each mutant is the lab-01 reference with one plausible student bug. It is built from a copy
-of the solution and common/ headers with one edit, then run through the correctness checks
+of a solution or shared file with one edit (the edited header comes first on the include
+path), then run through the correctness checks
 (grading/checks.py). A mutant must fail the checks named for it: that documents which bug
 each check catches, and proves that no check is one that cannot fail. Run with `-s` to see
 the full matrix.
@@ -23,9 +24,11 @@ CHECKS = {
     "cornell": lambda b: checks.check_golden(b, "cornell"),
     "showcase": lambda b: checks.check_golden(b, "showcase"),
     "scale": checks.check_scale_invariance,
+    "moved": checks.check_translation_invariance,
+    "large": checks.check_large_primitives,
 }
 
-# name: (file under common/ or the solution dir, original text, mutated text, checks that
+# name: (file under common/core or the solution dir, original text, mutated text, checks that
 # must catch it)
 MUTANTS = {
     "no cosine in NEE": ("path_tracer.h", "(cos_theta / (kPi * distance2))",
@@ -47,14 +50,18 @@ MUTANTS = {
                         "camera.ray_through(x + 0.5f, y + 0.5f)", ["cornell"]),
     "every sample reuses sample 0": ("path_tracer.h", "SampleStream rng(settings.seed, pixel, s)",
                                      "SampleStream rng(settings.seed, pixel, 0)", ["cornell"]),
-    "one bounce too few": ("path_tracer.h", "for (int bounce = 0; bounce < max_bounces; ++bounce)",
-                           "for (int bounce = 0; bounce < max_bounces - 1; ++bounce)",
-                           ["interior", "plane", "cornell"]),
+    "one bounce too few": ("path_tracer.h", "path.alive = path.bounce < max_bounces;",
+                           "path.alive = path.bounce + 1 < max_bounces;",
+                           ["interior", "cornell"]),
     "throughput ignores albedo": ("path_tracer.h",
-                                  "if (last) break;\n            throughput *= material.albedo;\n"
-                                  "            ray = {above, sample_cosine",
-                                  "if (last) break;\n            ray = {above, sample_cosine",
+                                  "path.throughput *= material.albedo;\n"
+                                  "            path.ray = {above, sample_cosine",
+                                  "path.ray = {above, sample_cosine",
                                   ["interior", "cornell"]),
+    "NEE from the offset point": ("path_tracer.h",
+                                  "const Vec3 to_light = scene.light.position - position;",
+                                  "const Vec3 to_light = scene.light.position - origin;",
+                                  ["moved"]),
     "uniform sampling weighted as cosine": (
         "material.h", "const float r = sqrtf(u1);", "const float r = sqrtf(1.0f - u1 * u1);",
         ["cornell"]),
@@ -68,13 +75,17 @@ MUTANTS = {
                           "float r = 0.0f, g = 0.0f, b = 0.0f;", ["millions"]),
     "no offset at all": ("ray.h", "return p + n * (scale * kRelativeOffset);",
                          "return p + n * (0.0f * scale);", ["cornell"]),
+    "offset ignores the primitive's extent": (
+        "ray.h", "const float scale = max_component(abs(p)) + distance_travelled + extent;",
+        "const float scale = max_component(abs(p)) + distance_travelled + 0.0f * extent;",
+        ["large"]),
 }
 
 
 def build_mutant(name: str, workdir: pathlib.Path) -> pathlib.Path:
     file, old, new, _ = MUTANTS[name]
     original = (ROOT / "labs" / "01-serial" / "solution" / file
-                if file == "render.cpp" else ROOT / "common" / file).read_text()
+                if file == "render.cpp" else ROOT / "common" / "core" / file).read_text()
     assert original.count(old) >= 1, f"mutant '{name}': text to mutate not found in {file}"
     return build_variant("01-serial", workdir, {file: original.replace(old, new, 1)})
 

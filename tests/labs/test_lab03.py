@@ -7,8 +7,8 @@ import os
 import pytest
 
 from grading import checks
-from grading.harness import ROOT, available_cores, build, measure_parallel, render_seconds, \
-    run_lab
+from grading.harness import ROOT, available_cores, build, cpu_has_avx2, measure_parallel, \
+    render_seconds, run_lab
 from grading.variants import build_pristine_skeleton
 
 # Small renders for the bitwise comparisons: every pixel, sample and bounce is exercised.
@@ -16,7 +16,6 @@ SMALL = dict(width=48, height=40, spp=8, seed=3)
 # The timed render: about a second serially on the course's two-core VM.
 TIMED = dict(width=256, height=256, spp=32, seed=1)
 ROUNDS = 5  # best of 5: on a shared machine, some round of each is usually undisturbed
-SIMD_HEADER = ROOT / "common" / "simd_pixel_renderer.h"
 
 
 @pytest.fixture(scope="module")
@@ -28,8 +27,7 @@ def lab03_ref():
 def lab03_skeleton(tmp_path_factory):
     """The skeleton exactly as generated from the solution, whatever a student has done to
     labs/03-openmp/skeleton/ since: its expected failures stay expected."""
-    return build_pristine_skeleton("03-openmp", tmp_path_factory.mktemp("lab03-skeleton"),
-                                   extra_flags=["-fopenmp"])
+    return build_pristine_skeleton("03-openmp", tmp_path_factory.mktemp("lab03-skeleton"))
 
 
 @pytest.fixture(scope="module")
@@ -126,11 +124,7 @@ def test_skeleton_is_serial(speedups):
 
 @pytest.fixture(scope="module")
 def lab03_simd_ref():
-    if not SIMD_HEADER.exists():
-        pytest.skip("lab03-simd-ref needs common/simd_pixel_renderer.h (lab 02's "
-                    "SimdPixelRenderer), which is not in the tree yet")
-    flags = next((line for line in open("/proc/cpuinfo") if line.startswith("flags")), "")
-    if " avx2" not in flags or " fma" not in flags:
+    if not cpu_has_avx2():
         pytest.skip("lab03-simd-ref needs a CPU with AVX2 and FMA; this one has not")
     return build("lab03-simd-ref")[0]
 

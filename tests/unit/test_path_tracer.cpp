@@ -49,6 +49,12 @@ const SampleStream kRng(0, 0, 0);
 
 Ray ray_to(Vec3 from, Vec3 to) { return {from, normalize(to - from)}; }
 
+// direct_light at floor point p (the floor is 10 units wide: its extent), the shadow ray from
+// the offset origin a path arriving from 1 unit away would use.
+Vec3 direct_light_from(const SceneView& v, Vec3 p, Vec3 n, Vec3 albedo) {
+    return direct_light(v, p, offset_ray_origin(p, n, 1.0f, 10.0f), n, albedo);
+}
+
 // rho/pi * I * cos(theta) / d^2 for a point p on the floor (normal +y).
 Vec3 expected_direct(Vec3 p, Vec3 light, Vec3 intensity, Vec3 albedo) {
     const Vec3 to = light - p;
@@ -147,11 +153,11 @@ TEST(PathTracer, PointLightOnDiffusePlaneIsExact) {
         expect_rel_near(trace_path(v, ray, kRng, 2), expected, 1e-4f);
         expect_rel_near(trace_path(v, ray, SampleStream(9, 9, 9), 5), expected, 1e-4f);
         // direct_light itself, from the point (and a normal facing the light).
-        expect_rel_near(direct_light(v, p, {0, 1, 0}, albedo), expected, 1e-5f);
+        expect_rel_near(direct_light_from(v, p, {0, 1, 0}, albedo), expected, 1e-5f);
     }
     // Directly below the light: cos = 1, d = 2.
     const Vec3 below(0.3f, 0.0f, -0.4f);
-    expect_rel_near(direct_light(v, below, {0, 1, 0}, albedo),
+    expect_rel_near(direct_light_from(v, below, {0, 1, 0}, albedo),
                     albedo * intensity * (1.0f / (kPi * 4.0f)), 1e-6f);
 }
 
@@ -162,9 +168,9 @@ TEST(PathTracer, LightBehindTheSurfaceGivesNothing) {
     const SceneView v = ts.view();
     // Seen from below, the floor's lit side faces away: black, no light leaks through.
     expect_exact(trace_path(v, ray_to({1, -1, 1}, {0.2f, 0, 0.1f}), kRng, 1), Vec3(0.0f));
-    expect_exact(direct_light(v, {0, 0, 0}, {0, -1, 0}, Vec3(0.8f)), Vec3(0.0f));
+    expect_exact(direct_light_from(v, {0, 0, 0}, {0, -1, 0}, Vec3(0.8f)), Vec3(0.0f));
     // A light exactly in the tangent plane gives cos = 0.
-    expect_exact(direct_light(v, {0, 0, 0}, {1, 0, 0}, Vec3(0.8f)), Vec3(0.0f));
+    expect_exact(direct_light_from(v, {0, 0, 0}, {1, 0, 0}, Vec3(0.8f)), Vec3(0.0f));
 }
 
 TEST(PathTracer, OccludersCastShadowsGlassIncluded) {
@@ -178,7 +184,7 @@ TEST(PathTracer, OccludersCastShadowsGlassIncluded) {
         const Ray ray = ray_to({2, 1, 2}, p);  // sees p past the sphere
         ASSERT_EQ(closest_hit(v, ray).sphere, -1);
         expect_exact(trace_path(v, ray, kRng, 1), Vec3(0.0f));
-        expect_exact(direct_light(v, p, {0, 1, 0}, Vec3(0.5f)), Vec3(0.0f));
+        expect_exact(direct_light_from(v, p, {0, 1, 0}, Vec3(0.5f)), Vec3(0.0f));
     }
     // A sphere beside the segment, or beyond the light, casts no shadow on p.
     for (const Vec3 c : {Vec3(1.5f, 1.5f, 0.1f), Vec3(0.2f, 4.0f, 0.1f)}) {
@@ -186,7 +192,7 @@ TEST(PathTracer, OccludersCastShadowsGlassIncluded) {
         ts.floor(ts.material(MaterialType::Diffuse, Vec3(0.5f)));
         ts.sphere(c, 0.3f, ts.material(MaterialType::Diffuse, Vec3(0.5f)));
         ts.light(light, Vec3(4.0f));
-        expect_rel_near(direct_light(ts.view(), p, {0, 1, 0}, Vec3(0.5f)),
+        expect_rel_near(direct_light_from(ts.view(), p, {0, 1, 0}, Vec3(0.5f)),
                         expected_direct(p, light, Vec3(4.0f), Vec3(0.5f)), 1e-5f);
     }
 }

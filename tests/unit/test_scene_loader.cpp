@@ -643,3 +643,15 @@ TEST(SceneLoaderErrors, MaterialNameWithSlashIsLocated) {
         "}\n",
         {"unknown material type"});
 }
+
+// Seeds have one range, in scene files and on the command line alike (0 .. 2^53 - 1).
+TEST(SceneLoader, SeedRangeIsTheCommandLines) {
+    const std::string top = std::to_string(kMaxSeed);
+    const Scene s = parse_scene(scene_with(kGoodSphere, "  \"render\": { \"seed\": " + top + " },\n"),
+                                kName);
+    EXPECT_EQ(s.render.seed, static_cast<uint64_t>(kMaxSeed));
+    const std::string message =
+        error_of(scene_with(kGoodSphere, "  \"render\": { \"seed\": " + std::to_string(kMaxSeed + 1) +
+                                             " },\n"));
+    EXPECT_NE(message.find("expected an integer in 0.." + top), std::string::npos) << message;
+}

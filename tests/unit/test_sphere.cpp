@@ -217,7 +217,7 @@ TEST(Sphere, NoSelfIntersectionLeavingOutward) {
                 do {
                     d = random_unit(gen);
                 } while (dot(d, n) < 0.02f);
-                const Ray ray{offset_ray_origin(p, n, u01(gen) * 10.0f * scale), d};
+                const Ray ray{offset_ray_origin(p, n, u01(gen) * 10.0f * scale, sphere_extent(s)), d};
                 if (intersect_sphere(ray, s, FLT_MAX) < FLT_MAX) ++hits;
             }
             EXPECT_EQ(hits, 0) << "scale " << scale << " centre " << centre_unit.x;
@@ -238,7 +238,7 @@ TEST(Sphere, RayLeavingInwardFindsFarSide) {
             do {
                 d = random_unit(gen);
             } while (dot(d, n) > -0.1f);
-            const Ray ray{offset_ray_origin(p, -n, 0.0f), d};
+            const Ray ray{offset_ray_origin(p, -n, 0.0f, sphere_extent(s)), d};
             const float t = intersect_sphere(ray, s, FLT_MAX);
             // Chord length from p along d is -2 (d.n) r.
             const float chord = -2.0f * dot(d, n) * s.radius;

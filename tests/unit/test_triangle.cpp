@@ -369,7 +369,7 @@ TEST(Triangle, NoSelfIntersectionAfterOffset) {
                 do {
                     d = random_unit(gen);
                 } while (dot(d, side) < 0.02f);
-                const Ray ray{offset_ray_origin(p, side, u01(gen) * scale), d};
+                const Ray ray{offset_ray_origin(p, side, u01(gen) * scale, tri.extent), d};
                 if (hit(ray, tri) < FLT_MAX) ++hits;
             }
             EXPECT_EQ(hits, 0) << "scale " << scale << " offset " << offset.z;

@@ -8,7 +8,7 @@
 const char* const kLabName = "01-serial";
 
 RenderStats render(const RenderJob& job, Image& image) {
-    const SceneView scene = job.scene.view();
+    const SceneView scene = job.scene;
     const RenderSettings& settings = job.settings;
     const Timer timer;
     // BEGIN SOLUTION

@@ -8,9 +8,9 @@
 const char* const kLabName = "02-simd";
 
 // The AVX2 pixel loop (render_avx2.cpp; render_prims.cpp in ./lab02-prims).
-RenderStats render_simd(const RenderJob& job, Image& image);
+RenderStats render_avx2(const RenderJob& job, Image& image);
 
 RenderStats render(const RenderJob& job, Image& image) {
     require_avx2("lab 02 (AVX2, 8 lanes)", cpu_model_name());
-    return render_simd(job, image);
+    return render_avx2(job, image);
 }

@@ -5,8 +5,8 @@
 #include "packet_tracer.h"
 #include "timer.h"
 
-RenderStats render_simd(const RenderJob& job, Image& image) {
-    const SceneView scene = job.scene.view();
+RenderStats render_avx2(const RenderJob& job, Image& image) {
+    const SceneView scene = job.scene;
     const RenderSettings& settings = job.settings;
     const Timer timer;
     for (int y = 0; y < settings.height; ++y) {

@@ -1,5 +1,4 @@
-// GENERATED from labs/03-openmp/solution/render.cpp by tools/skeletons.py: edit this file freely,
-// it is yours. (Instructors: edit the solution and run `make skeletons`.)
+// Lab 03: your copy, yours to edit. Every place to fill in is marked TODO(lab03).
 // Lab 03: lab 01's pixel loop, shared among the cores with OpenMP.
 //
 // Each pixel is still lab 01's render_pixel (through PixelRenderer), and its random numbers
@@ -10,7 +9,8 @@
 // Two other builds of this file (labs/03-openmp/lab.mk):
 //   -DRT_RUNTIME_SCHEDULE (lab03-bench): the loop takes its schedule from the OMP_SCHEDULE
 //       environment variable, which is how the handout's schedule table is measured.
-//   -DRT_USE_SIMD -mavx2 -mfma (lab03-simd-ref): each pixel with lab 02's AVX2 geometry.
+//   common/simd/ first on the include path, -DRT_USE_SIMD -mavx2 -mfma (lab03-simd-ref): each pixel
+//       with lab 02's AVX2 packet tracer (its pixel_renderer.h stands in for the scalar one).
 #include <omp.h>
 
 #include <string>

@@ -8,7 +8,8 @@
 // Two other builds of this file (labs/03-openmp/lab.mk):
 //   -DRT_RUNTIME_SCHEDULE (lab03-bench): the loop takes its schedule from the OMP_SCHEDULE
 //       environment variable, which is how the handout's schedule table is measured.
-//   -DRT_USE_SIMD -mavx2 -mfma (lab03-simd-ref): each pixel with lab 02's AVX2 geometry.
+//   common/simd/ first on the include path, -DRT_USE_SIMD -mavx2 -mfma (lab03-simd-ref): each pixel
+//       with lab 02's AVX2 packet tracer (its pixel_renderer.h stands in for the scalar one).
 #include <omp.h>
 
 #include <string>

@@ -27,6 +27,7 @@
 
 #include "errors.h"
 #include "lab.h"
+#include "mpi_run.h"
 #include "pixel_renderer.h"
 #include "timer.h"
 
@@ -44,17 +45,6 @@ namespace {
 
 static_assert(sizeof(Vec3) == 3 * sizeof(float), "a pixel travels as 3 MPI_FLOATs");
 
-enum class Distribution { block, interleaved, dynamic };
-const char* const kDistributionNames[] = {"block", "interleaved", "dynamic"};
-
-// The default, measured (handouts/04-mpi.md, section 9): dynamic ties at 2 ranks and is the
-// fastest at 8 and 16 (16-core Xeon, 8 ranks: 7.32x, against 7.09x interleaved and 6.57x
-// block). Blocks suffer from the unequal cost of the bands (busiest / mean 1.12 at 8 bands);
-// interleaved rows balance the work (1.003) but not the time when cores run at unequal
-// speeds (other load, other hosts, a VM's neighbours), which dynamic absorbs. Its price, two
-// small messages per row, is far below a row's thousands of paths.
-constexpr Distribution kDefaultDistribution = Distribution::dynamic;
-
 // Dynamic distribution: the work unit is one row per thread (600 units at the baseline with
 // one thread: enough to balance, few enough that messages cost nothing; with T threads, T
 // rows keep them all busy). A worker holds kPrefetch units at a time, so it never waits for
@@ -64,36 +54,12 @@ constexpr int kPrefetch = 3;
 constexpr int kTagWork = 1;    // rank 0 -> worker: {first row, row count}; count 0: stop
 constexpr int kTagResult = 2;  // worker -> rank 0: those rows' pixels, in order
 
-// This process among the others.
-struct Team {
-    int rank = 0;     // 0..size-1; rank 0 assembles the image
-    int size = 1;     // number of ranks
-    int threads = 1;  // OpenMP threads inside each rank
-};
-
 // Rows [begin, end) of the image.
 struct RowRange {
     int begin = 0;
     int end = 0;
     int count() const { return end - begin; }
 };
-
-// What one rank did, for RT_MPI_REPORT.
-struct RankReport {
-    struct Times {
-        double rows = 0;          // how many rows it rendered
-        double busy_seconds = 0;  // wall time inside its pixel loops
-        double cpu_seconds = 0;   // CPU time of its pixel loops (all threads): the work
-                                  // itself, true even when ranks share cores
-    } times;                      // doubles, so one MPI_Gather collects them
-    std::vector<int> rows;        // which rows, in the order rendered
-};
-
-double process_cpu_seconds() {
-    timespec t{};
-    clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &t);
-    return static_cast<double>(t.tv_sec) + 1e-9 * static_cast<double>(t.tv_nsec);
-}
 
 // Renders the given image rows (any order) into `out`, row after row, with the team's threads.
 void render_rows(const PixelRenderer& pixel, const std::vector<int>& rows, int width,
@@ -318,97 +284,6 @@ void dynamic_worker(const PixelRenderer& pixel, const Team& team, Image& image,
     // END SOLUTION
 }
 
-// Rank 0's choice of distribution and report, told to every rank: mpirun does not pass the
-// environment to other hosts unless asked to (-x), and the ranks must agree.
-struct RunConfig {
-    Distribution distribution = kDefaultDistribution;
-    bool report = false;  // RT_MPI_REPORT set (and not 0)
-};
-
-RunConfig run_config(const Team& team) {
-    int choice[2] = {static_cast<int>(kDefaultDistribution), 0};  // -1: not a distribution
-    const char* name = std::getenv("RT_MPI_DISTRIBUTION");
-    if (team.rank == 0) {
-        if (name && *name) {
-            choice[0] = -1;
-            for (int d = 0; d < 3; ++d) {
-                if (std::string(name) == kDistributionNames[d]) choice[0] = d;
-            }
-        }
-        const char* report = std::getenv("RT_MPI_REPORT");
-        choice[1] = report && *report && std::string(report) != "0";
-    }
-    MPI_Bcast(choice, 2, MPI_INT, 0, MPI_COMM_WORLD);
-    if (choice[0] < 0) {
-        throw InputError(std::string("RT_MPI_DISTRIBUTION: expected block, interleaved or "
-                                     "dynamic, found '") + (name ? name : "") + "'");
-    }
-    return {static_cast<Distribution>(choice[0]), choice[1] != 0};
-}
-
-// How many hosts the ranks run on (ranks that can share memory count as one host).
-int host_count() {
-    MPI_Comm host;
-    MPI_Comm_split_type(MPI_COMM_WORLD, MPI_COMM_TYPE_SHARED, 0, MPI_INFO_NULL, &host);
-    int host_rank = 0;
-    MPI_Comm_rank(host, &host_rank);
-    MPI_Comm_free(&host);
-    int leaders = host_rank == 0;
-    MPI_Allreduce(MPI_IN_PLACE, &leaders, 1, MPI_INT, MPI_SUM, MPI_COMM_WORLD);
-    return leaders;
-}
-
-// Rows as sorted ranges, "0-2,5,7-9", at most kShown of them.
-std::string row_ranges(std::vector<int> rows) {
-    constexpr int kShown = 12;
-    std::sort(rows.begin(), rows.end());
-    std::string text;
-    int shown = 0;
-    for (size_t i = 0; i < rows.size();) {
-        size_t j = i;
-        while (j + 1 < rows.size() && rows[j + 1] == rows[j] + 1) ++j;
-        if (shown++ == kShown) return text + ",...";
-        if (!text.empty()) text += ",";
-        text += std::to_string(rows[i]);
-        if (j > i) text += "-" + std::to_string(rows[j]);
-        i = j + 1;
-    }
-    return text.empty() ? "none" : text;
-}
-
-// RT_MPI_REPORT: every rank's rows and busy time, printed by rank 0 on stderr.
-void print_report(const Team& team, const RankReport& mine, double seconds) {
-    std::vector<RankReport::Times> times(team.size);
-    MPI_Gather(&mine.times, 3, MPI_DOUBLE, times.data(), 3, MPI_DOUBLE, 0, MPI_COMM_WORLD);
-    std::vector<int> counts(team.size), offsets(team.size);
-    for (int r = 0, offset = 0; r < team.size; ++r) {
-        counts[r] = static_cast<int>(times[r].rows);
-        offsets[r] = offset;
-        offset += counts[r];
-    }
-    std::vector<int> rows(team.rank == 0 ? offsets.back() + counts.back() : 0);
-    MPI_Gatherv(mine.rows.data(), static_cast<int>(mine.rows.size()), MPI_INT, rows.data(),
-                counts.data(), offsets.data(), MPI_INT, 0, MPI_COMM_WORLD);
-    if (team.rank != 0) return;
-    double busiest = 0, total = 0;
-    for (const RankReport::Times& r : times) {
-        busiest = std::max(busiest, r.cpu_seconds);
-        total += r.cpu_seconds;
-    }
-    for (int r = 0; r < team.size; ++r) {
-        const std::vector<int> its_rows(rows.begin() + offsets[r],
-                                        rows.begin() + offsets[r] + counts[r]);
-        std::fprintf(stderr,
-                     "rank %d: %5d rows, %8.3f s busy, %8.3f s CPU (%5.1f%% of the work): "
-                     "rows %s\n",
-                     r, counts[r], times[r].busy_seconds, times[r].cpu_seconds,
-                     total > 0 ? 100.0 * times[r].cpu_seconds / total : 0.0,
-                     row_ranges(its_rows).c_str());
-    }
-    std::fprintf(stderr, "render %.3f s; imbalance (busiest rank's CPU / mean): %.2f\n", seconds,
-                 total > 0 ? busiest / (total / team.size) : 1.0);
-}
-
 }  // namespace
 
 RenderStats render(const RenderJob& job, Image& image) {
@@ -440,13 +315,5 @@ RenderStats render(const RenderJob& job, Image& image) {
     }
     const double seconds = timer.seconds();
     if (config.report) print_report(team, report, seconds);
-
-    const auto plural = [](int n, const char* what) {
-        return std::to_string(n) + " " + what + (n == 1 ? "" : "s");
-    };
-    std::string device = cpu_model_name() + ", " + plural(team.size, "rank");
-    if (hosts > 1) device += " on " + plural(hosts, "host");
-    device += " x " + plural(team.threads, "thread") + ", " +
-              kDistributionNames[static_cast<int>(config.distribution)];
-    return {seconds, device};
+    return {seconds, describe_run(team, hosts, config.distribution)};
 }

@@ -1,0 +1,312 @@
+// The path tracer every lab shares: the primitive loops (closest hit, shadow test), the bounce
+// step (what happens at one hit), the path loop around it, and the per-pixel estimator.
+//
+// The bounce step is the path's logic, written once for every scalar renderer: the serial
+// path loop here (and so a CUDA megakernel) calls it between two closest-hit queries, and a
+// wavefront renderer's shading kernel calls it on paths it reads from a queue. It neither
+// finds the next hit nor traces the shadow ray: it consumes a hit and produces a shadow-ray
+// request, because a wavefront renderer runs those queries in kernels of their own.
+//
+// The path loop is written once for any Geometry: a type for which closest_hit(geometry, ray)
+// and occluded(geometry, ray, t_max) exist. Lab 01's geometry is the SceneView itself (the
+// brute-force loops below); lab 02 supplies an 8-wide AVX2 one. Likewise any Rng with
+// `float at(uint32_t dimension) const` will do; the labs use SampleStream.
+//!
+//! Lab 01 students write the regions between BEGIN/END SOLUTION; the skeleton generator
+//! (tools/skeletons.py) turns this file into labs/01-serial/skeleton/path_tracer.h.
+#pragma once
+
+#include <cfloat>
+
+#include <camera.h>
+#include <rng.h>
+#include <sample_sum.h>
+#include <scene_view.h>
+
+// The nearest surface a ray meets: which primitive and how far.
+struct Hit {
+    float t = FLT_MAX;  // distance along the ray; FLT_MAX when nothing was hit
+    int sphere = -1;    // index of the sphere hit, or -1
+    int triangle = -1;  // index of the triangle hit, or -1
+
+    RT_HD bool found() const { return sphere >= 0 || triangle >= 0; }
+};
+
+// What shading needs to know about a hit point.
+struct SurfacePoint {
+    Vec3 position;  // world-space hit point
+    Vec3 normal;    // unit geometric normal: outward for spheres, the front side for triangles
+    float extent;   // the primitive's largest |coordinate|, for offset_ray_origin (ray.h)
+    int material;   // index into the material table
+};
+
+RT_HD inline SurfacePoint surface_at(const SceneView& scene, const Ray& ray, const Hit& hit) {
+    const Vec3 p = ray.at(hit.t);
+    if (hit.sphere >= 0) {
+        const Sphere& s = scene.spheres[hit.sphere];
+        return {p, normalize(p - s.center), sphere_extent(s), s.material};
+    }
+    const Triangle& tri = scene.triangles[hit.triangle];
+    return {p, tri.normal, tri.extent, tri.material};
+}
+
+// Closest hit by brute force over every primitive: the scenes of this course are small.
+RT_HD inline Hit closest_hit(const SceneView& scene, const Ray& ray) {
+    Hit hit;
+    // BEGIN SOLUTION
+    for (int i = 0; i < scene.num_spheres; ++i) {
+        const float t = intersect_sphere(ray, scene.spheres[i], hit.t);
+        if (t < hit.t) {
+            hit.t = t;
+            hit.sphere = i;
+        }
+    }
+    const RayShear shear(ray.direction);
+    for (int i = 0; i < scene.num_triangles; ++i) {
+        const float t = intersect_triangle(ray, shear, scene.triangles[i], hit.t);
+        if (t < hit.t) {
+            hit.t = t;
+            hit.sphere = -1;
+            hit.triangle = i;
+        }
+    }
+    // SKELETON
+    //> // TODO(lab01): this finds spheres only. Loop over the triangles too (build one
+    //> // RayShear per ray, then intersect_triangle), keeping the nearest hit.
+    //> for (int i = 0; i < scene.num_spheres; ++i) {
+    //>     const float t = intersect_sphere(ray, scene.spheres[i], hit.t);
+    //>     if (t < hit.t) {
+    //>         hit.t = t;
+    //>         hit.sphere = i;
+    //>     }
+    //> }
+    // END SOLUTION
+    return hit;
+}
+
+// Whether anything blocks the ray before distance t_max. Stops at the first blocker:
+// a shadow ray needs any hit, not the closest. Glass blocks too (no caustics).
+RT_HD inline bool occluded(const SceneView& scene, const Ray& ray, float t_max) {
+    // BEGIN SOLUTION
+    for (int i = 0; i < scene.num_spheres; ++i) {
+        if (intersect_sphere(ray, scene.spheres[i], t_max) < t_max) return true;
+    }
+    const RayShear shear(ray.direction);
+    for (int i = 0; i < scene.num_triangles; ++i) {
+        if (intersect_triangle(ray, shear, scene.triangles[i], t_max) < t_max) return true;
+    }
+    return false;
+    // SKELETON
+    //> // TODO(lab01): return true when any sphere or triangle lies on the ray before t_max.
+    //> (void)scene;
+    //> (void)ray;
+    //> (void)t_max;
+    //> return false;
+    // END SOLUTION
+}
+
+// g++ calls a function as big as the bounce step out of line, and the path state then lives in
+// memory: +9% instructions per path on the Cornell box (callgrind). Inlined into the path
+// loop, the step costs 1% over the loop body it replaced.
+#if defined(__CUDACC__)
+#define RT_FORCE_INLINE __forceinline__
+#else
+#define RT_FORCE_INLINE inline __attribute__((always_inline))
+#endif
+
+// One camera path between two closest-hit queries: all that the bounce step reads and writes.
+// A wavefront renderer keeps this per path in its queues, plus the path's pixel and sample
+// numbers (they rebuild its SampleStream) and the Hit its intersection kernel found; `alive`
+// it need not store, since a path is alive while it is in a queue.
+struct PathState {
+    Ray ray;          // the ray to trace next (meaningless once the path has ended)
+    Vec3 throughput;  // product of the weights of the interactions so far
+    Vec3 radiance;    // what the path has gathered so far
+    int bounce;       // surface interactions so far: the next one is number `bounce`
+    bool alive;       // false once the path has escaped or spent its budget
+};
+
+RT_HD inline PathState start_path(const Ray& camera_ray, int max_bounces) {
+    return {camera_ray, Vec3(1.0f), Vec3(0.0f), 0, max_bounces > 0};
+}
+
+// A light sample waiting for its shadow ray: `radiance` joins the path's radiance unless
+// something blocks `ray` before `t_max`. The bounce step fills it in and a shadow query
+// decides it: in the path loop below right away, in a wavefront renderer in a kernel of its own.
+struct ShadowRay {
+    Ray ray;
+    float t_max;
+    Vec3 radiance;
+};
+
+// Next-event estimation at a diffuse point: the point light's radiance through the BRDF,
+// rho/pi * I * cos(theta) / d^2, and the shadow ray that decides it. false when the light lies
+// behind the surface (no shadow ray needed).
+// Distance and cosine are measured from the surface point itself: from the offset origin they
+// would change with the offset, which grows with |position|, so moving a whole scene away from
+// the world origin would brighten it (+39% for the sphere interior moved 1e4 radii). Only the
+// shadow ray starts at the offset origin, parallel to the surface point's direction to the
+// light, and it ends where it passes the light: t_max = d - (origin - position).wi, the
+// distance minus how far the offset moved along the ray.
+RT_HD inline bool sample_light(const SceneView& scene, Vec3 position, Vec3 origin,
+                               Vec3 facing_normal, Vec3 albedo, ShadowRay& shadow) {
+    // BEGIN SOLUTION
+    const Vec3 to_light = scene.light.position - position;
+    const float distance2 = length_squared(to_light);
+    const float distance = sqrtf(distance2);
+    const Vec3 wi = to_light * (1.0f / distance);
+    const float cos_theta = dot(facing_normal, wi);
+    if (cos_theta <= 0.0f) return false;  // light behind the surface
+    shadow.ray = {origin, wi};
+    shadow.t_max = distance - dot(origin - position, wi);
+    shadow.radiance = albedo * scene.light.intensity * (cos_theta / (kPi * distance2));
+    return true;
+    // SKELETON
+    //> // TODO(lab01): the light sample. From `position`: the direction wi and distance d to
+    //> // the light, cos(theta) with the normal; when cos(theta) > 0, a shadow ray from
+    //> // `origin` along wi ending where it passes the light, and the radiance
+    //> // albedo/pi * intensity * cos(theta) / d^2. Until then: no light at all.
+    //> (void)scene;
+    //> (void)position;
+    //> (void)origin;
+    //> (void)facing_normal;
+    //> (void)albedo;
+    //> (void)shadow;
+    //> return false;
+    // END SOLUTION
+}
+
+// What happens at one hit of the path: an escaped path picks up the background and ends; at a
+// surface, next-event estimation at diffuse ones (the shadow-ray request, weighted by the
+// throughput: returns true when it made one), then the next ray (cosine-sampled, mirrored, or
+// reflected or refracted by Fresnel) with its weight, unless the budget of max_bounces
+// interactions is spent. Reads random numbers by the path's bounce number only
+// (bounce_dimension), so every renderer that calls it draws the same ones.
+template <class Rng>
+RT_HD RT_FORCE_INLINE bool bounce_step(const SceneView& scene, const Hit& hit, const Rng& rng,
+                                       int max_bounces, PathState& path, ShadowRay& shadow) {
+    // BEGIN SOLUTION
+    if (!hit.found()) {
+        path.radiance += path.throughput * scene.background;
+        path.alive = false;
+        return false;
+    }
+    const SurfacePoint surface = surface_at(scene, path.ray, hit);
+    const Material& material = scene.materials[surface.material];
+    const Vec3 incoming = path.ray.direction;
+    const bool entering = dot(incoming, surface.normal) < 0.0f;
+    const Vec3 facing = entering ? surface.normal : -surface.normal;  // toward the ray
+    const Vec3 above = offset_ray_origin(surface.position, facing, hit.t, surface.extent);
+    const int bounce = path.bounce++;
+    path.alive = path.bounce < max_bounces;
+
+    if (material.type == MaterialType::Diffuse) {
+        const bool lit = scene.has_light && sample_light(scene, surface.position, above, facing,
+                                                         material.albedo, shadow);
+        if (lit) shadow.radiance = path.throughput * shadow.radiance;
+        if (path.alive) {
+            path.throughput *= material.albedo;
+            path.ray = {above, sample_cosine_hemisphere(facing, rng.at(bounce_dimension(bounce, 0)),
+                                                        rng.at(bounce_dimension(bounce, 1)))};
+        }
+        return lit;
+    }
+    if (!path.alive) return false;
+    if (material.type == MaterialType::Mirror) {
+        path.throughput *= material.albedo;
+        path.ray = {above, reflect(incoming, facing)};
+    } else {  // glass: reflect or refract, chosen with the Fresnel reflectance
+        const float eta = entering ? 1.0f / material.ior : material.ior;
+        float cos_t;
+        const float reflectance = fresnel_dielectric(-dot(incoming, facing), eta, cos_t);
+        if (rng.at(bounce_dimension(bounce, 0)) < reflectance) {
+            path.ray = {above, reflect(incoming, facing)};
+        } else {
+            const Vec3 below =
+                offset_ray_origin(surface.position, -facing, hit.t, surface.extent);
+            path.ray = {below, refract(incoming, facing, eta, cos_t)};
+        }
+    }
+    return false;
+    // SKELETON
+    //> // TODO(lab01): the bounce step. Escaped paths pick up the background and end; at a
+    //> // surface, request next-event estimation at diffuse ones (sample_light, weighted by
+    //> // the throughput), then continue the path (cosine-sampled, mirrored or refracted) with
+    //> // a new ray and weight, unless this was interaction number max_bounces.
+    //> // Until then: flat colour of the first surface seen, no lighting.
+    //> (void)rng;
+    //> (void)max_bounces;
+    //> (void)shadow;
+    //> path.alive = false;
+    //> path.radiance = hit.found() ? scene.materials[surface_at(scene, path.ray, hit).material].albedo
+    //>                             : scene.background;
+    //> return false;
+    // END SOLUTION
+}
+
+// Radiance arriving along a camera ray, estimated by one random path of at most
+// max_bounces surface interactions: closest hit, bounce step, and the shadow ray it asks for
+// traced at once (its radiance added if nothing blocks it), until the path ends.
+template <class Geometry, class Rng>
+RT_HD inline Vec3 trace_path(const SceneView& scene, const Geometry& geometry, Ray ray,
+                             const Rng& rng, int max_bounces) {
+    PathState path = start_path(ray, max_bounces);
+    while (path.alive) {
+        const Hit hit = closest_hit(geometry, path.ray);
+        ShadowRay shadow;
+        if (bounce_step(scene, hit, rng, max_bounces, path, shadow) &&
+            !occluded(geometry, shadow.ray, shadow.t_max)) {
+            path.radiance += shadow.radiance;
+        }
+    }
+    return path.radiance;
+}
+
+// The radiance of one light sample with its shadow ray traced: sample_light, then occluded.
+template <class Geometry>
+RT_HD inline Vec3 direct_light(const SceneView& scene, const Geometry& geometry, Vec3 position,
+                               Vec3 origin, Vec3 facing_normal, Vec3 albedo) {
+    ShadowRay shadow;
+    if (!sample_light(scene, position, origin, facing_normal, albedo, shadow)) return Vec3(0.0f);
+    return occluded(geometry, shadow.ray, shadow.t_max) ? Vec3(0.0f) : shadow.radiance;
+}
+
+// The estimate of one pixel: the mean of spp paths through uniformly jittered points of the
+// pixel (a box filter). Pixel index and sample number key the random numbers.
+template <class Geometry>
+RT_HD inline Vec3 render_pixel(const SceneView& scene, const Geometry& geometry,
+                               const Camera& camera, const RenderSettings& settings, int x, int y) {
+    const uint64_t pixel = static_cast<uint64_t>(y) * settings.width + x;
+    SampleSum sum;  // in double: a float sum drifts by ~1% past a million samples
+    // BEGIN SOLUTION
+    for (int s = 0; s < settings.spp; ++s) {
+        const SampleStream rng(settings.seed, pixel, s);
+        const Ray ray = camera.ray_through(x + rng.at(kDimPixelX), y + rng.at(kDimPixelY));
+        sum.add(trace_path(scene, geometry, ray, rng, settings.bounces));
+    }
+    return sum.mean(settings.spp);
+    // SKELETON
+    //> // TODO(lab01): average settings.spp paths, each through a random point of the pixel
+    //> // (SampleStream(settings.seed, pixel, s), dimensions kDimPixelX/kDimPixelY).
+    //> // Until then: one path through the pixel's corner.
+    //> const SampleStream rng(settings.seed, pixel, 0);
+    //> sum.add(trace_path(scene, geometry, camera.ray_through(x, y), rng, settings.bounces));
+    //> return sum.mean(1);
+    // END SOLUTION
+}
+
+// Lab 01's geometry is the scene itself: the brute-force loops above.
+RT_HD inline Vec3 direct_light(const SceneView& scene, Vec3 position, Vec3 origin,
+                               Vec3 facing_normal, Vec3 albedo) {
+    return direct_light(scene, scene, position, origin, facing_normal, albedo);
+}
+
+template <class Rng>
+RT_HD inline Vec3 trace_path(const SceneView& scene, Ray ray, const Rng& rng, int max_bounces) {
+    return trace_path(scene, scene, ray, rng, max_bounces);
+}
+
+RT_HD inline Vec3 render_pixel(const SceneView& scene, const Camera& camera,
+                               const RenderSettings& settings, int x, int y) {
+    return render_pixel(scene, scene, camera, settings, x, y);
+}

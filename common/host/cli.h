@@ -1,0 +1,28 @@
+// The command line every lab shares (DESIGN.md, "Command line").
+#pragma once
+
+#include <optional>
+#include <string>
+
+#include <scene.h>
+
+struct Options {
+    std::string scene_path;  // --scene; default common/scenes/cornell.json
+    std::optional<int> width, height, spp, bounces;  // override the scene's settings
+    std::optional<uint64_t> seed;
+    std::string ppm_path;  // --out; empty: no PPM
+    std::string pfm_path;  // --pfm; empty: no PFM
+    int threads = 0;       // --threads; 0: every core (labs without threads ignore it)
+    bool quiet = false;    // --quiet: no progress display
+    bool json = false;     // --json: one JSON object as the last line of stdout
+};
+
+// The default scene, found relative to the source tree the binary was built from.
+std::string default_scene_path();
+
+// Parses argv; throws InputError naming the flag and what it expects. `--help` prints
+// usage and exits 0.
+Options parse_options(int argc, char** argv, const char* program);
+
+// The scene's render settings with the command line's overrides applied.
+RenderSettings settings_for(const Scene& scene, const Options& options);

@@ -1,0 +1,101 @@
+#include <cmath>
+#include <cstdio>
+#include <fstream>
+#include <memory>
+#include <string>
+
+#include <cli.h>
+#include <errors.h>
+#include <lab.h>
+#include <scene_loader.h>
+
+std::string cpu_model_name() {
+    std::ifstream in("/proc/cpuinfo");
+    std::string line;
+    while (std::getline(in, line)) {
+        if (line.rfind("model name", 0) == 0) {
+            const size_t colon = line.find(':');
+            if (colon != std::string::npos) return line.substr(colon + 2);
+        }
+    }
+    return "unknown CPU";
+}
+
+static std::string json_escape(const std::string& s) {
+    std::string out;
+    for (char c : s) {
+        if (c == '"' || c == '\\') out += '\\';
+        if (static_cast<unsigned char>(c) >= 0x20) out += c;
+    }
+    return out;
+}
+
+// `setup_reported` tells lab_main whether hooks.setup_done has been called already.
+static int run(int argc, char** argv, const LabHooks& hooks, bool& setup_reported) {
+    const Options options = parse_options(argc, argv, argv[0]);
+    const Scene scene = load_scene(options.scene_path);
+    const RenderSettings settings = settings_for(scene, options);
+
+    // Open the outputs before rendering: a bad path fails in a millisecond, not after the
+    // render, and neither file appears until its bytes are complete.
+    std::unique_ptr<AtomicFile> ppm, pfm;
+    if (hooks.writes_output) {
+        if (!options.ppm_path.empty()) ppm = std::make_unique<AtomicFile>(options.ppm_path);
+        if (!options.pfm_path.empty()) pfm = std::make_unique<AtomicFile>(options.pfm_path);
+    }
+
+    Image image(settings.width, settings.height);
+    Progress progress(settings.height, hooks.writes_output && progress_wanted(options.quiet));
+    const RenderJob job{scene.view(),
+                        settings,
+                        scene.camera.for_image(settings.width, settings.height),
+                        options.threads,
+                        progress};
+    if (hooks.setup_done) {
+        setup_reported = true;
+        hooks.setup_done(true);
+    }
+    const RenderStats stats = render(job, image);
+    progress.finish();  // the bar's last line before anything else is printed
+    if (!hooks.writes_output) return 0;
+
+    if (ppm) ppm->commit(ppm_bytes(image));
+    if (pfm) pfm->commit(pfm_bytes(image));
+
+    const double paths = static_cast<double>(settings.width) * settings.height * settings.spp;
+    const double paths_per_second = stats.seconds > 0 ? paths / stats.seconds : 0.0;
+    if (options.json) {
+        std::printf(
+            "{\"lab\": \"%s\", \"scene\": \"%s\", \"width\": %d, \"height\": %d, \"spp\": %d, "
+            "\"bounces\": %d, \"seed\": %llu, \"seconds\": %.6f, \"paths_per_second\": %.1f, "
+            "\"device\": \"%s\"%s}\n",
+            kLabName, json_escape(options.scene_path).c_str(), settings.width, settings.height,
+            settings.spp, settings.bounces, static_cast<unsigned long long>(settings.seed),
+            stats.seconds, paths_per_second, json_escape(stats.device).c_str(),
+            stats.timing.empty() ? "" : (", \"timing\": \"" + json_escape(stats.timing) + "\"").c_str());
+    } else {
+        std::printf("%s: %dx%d, %d spp, %d bounces: %.3f s render, %.2f Mpaths/s on %s\n",
+                    kLabName, settings.width, settings.height, settings.spp, settings.bounces,
+                    stats.seconds, paths_per_second / 1e6, stats.device.c_str());
+    }
+    return 0;
+}
+
+int lab_main(int argc, char** argv, const LabHooks& hooks) {
+    bool setup_reported = false;
+    // A process that fails before setup_done still tells the others, so none waits forever.
+    const auto fail = [&](const char* message, int status) {
+        if (hooks.writes_output) std::fprintf(stderr, "error: %s\n", message);
+        if (hooks.setup_done && !setup_reported) hooks.setup_done(false);
+        return status;
+    };
+    try {
+        return run(argc, argv, hooks, setup_reported);
+    } catch (const InputError& e) {
+        return fail(e.what(), kExitBadInput);
+    } catch (const DeviceError& e) {
+        return fail(e.what(), kExitDeviceError);
+    } catch (const std::bad_alloc&) {
+        return fail("out of memory (is the image size or spp absurd?)", kExitBadInput);
+    }
+}

@@ -1,0 +1,77 @@
+// What the renderer's float arithmetic (common/core) can show, as the scene loader enforces
+// it: every scene it accepts renders, and nothing in it vanishes silently.
+//  - Coordinates and radii up to 1e9 in magnitude: the triangle test multiplies three
+//    coordinate differences (t_scaled in triangle.h), which stays far below FLT_MAX (3.4e38)
+//    there; past ~1e12 it overflows and triangles vanish.
+//  - Sizes (a radius, a triangle's longest edge) from 1e-9: their cubes stay far above
+//    FLT_MIN (1.2e-38); a scene of size ~1e-13 underflows and vanishes.
+//  - A size at least 2^-18 of the primitive's extent (its largest |coordinate|): ray offsets
+//    are 2^-20 of the extent and more (ray.h), so such a primitive is at least a few offsets
+//    across. Smaller, it sits below float precision at its distance from the origin.
+//  - A triangle with an area as written must keep one when its vertices are rounded to
+//    float (else its normal is zero and it is never hit). One that has no area as written is
+//    kept: it has nothing to show.
+// Each function returns what is wrong, or an empty string.
+#pragma once
+
+#include <cmath>
+#include <cstdio>
+#include <string>
+
+#include <triangle.h>
+
+constexpr double kMaxCoordinate = 1e9;
+constexpr float kMinSize = 1e-9f;  // a float: a size written as 1e-9 rounds to it, not below
+constexpr double kMinRelativeSize = 1.0 / (1 << 18);
+
+inline std::string format_number(double x) {
+    char text[32];
+    std::snprintf(text, sizeof text, "%.3g", x);
+    return text;
+}
+
+inline std::string coordinate_problem(double x) {
+    if (std::fabs(x) <= kMaxCoordinate) return "";
+    return "expected a coordinate within +-1e9 (beyond it the renderer's float arithmetic "
+           "overflows): scale the scene down or move it nearer the origin";
+}
+
+// `what` names the size ("a radius", ...) at the start of the message.
+inline std::string size_problem(const char* what, double size, double extent) {
+    if (size < kMinSize)
+        return std::string(what) + " of " + format_number(size) +
+               " is below 1e-9, too small for the renderer's float arithmetic: scale the scene up";
+    if (size < kMinRelativeSize * extent)
+        return std::string(what) + " of " + format_number(size) +
+               " is too small for float precision that far from the origin (coordinates up to " +
+               format_number(extent) + "): move the scene nearer the origin or make it larger";
+    return "";
+}
+
+inline std::string sphere_problem(const Sphere& s) {
+    if (s.radius > kMaxCoordinate)
+        return "a radius of " + format_number(s.radius) +
+               " is above 1e9, too large for the renderer's float arithmetic: scale the scene down";
+    return size_problem("a radius", s.radius, sphere_extent(s));
+}
+
+// `written`: the vertices as the file gives them, before rounding to float; `tri`: as built.
+inline std::string triangle_problem(const double (&written)[3][3], const Triangle& tri) {
+    double e1[3], e2[3];
+    for (int axis = 0; axis < 3; ++axis) {
+        e1[axis] = written[1][axis] - written[0][axis];
+        e2[axis] = written[2][axis] - written[0][axis];
+    }
+    const double cx = e1[1] * e2[2] - e1[2] * e2[1];
+    const double cy = e1[2] * e2[0] - e1[0] * e2[2];
+    const double cz = e1[0] * e2[1] - e1[1] * e2[0];
+    if (cx == 0.0 && cy == 0.0 && cz == 0.0) return "";  // no area as written: nothing to show
+    const double longest = std::fmax(length(tri.v1 - tri.v0),
+                                     std::fmax(length(tri.v2 - tri.v1), length(tri.v0 - tri.v2)));
+    const std::string size = size_problem("a triangle with a longest edge", longest, tri.extent);
+    if (!size.empty()) return size;
+    if (is_black(tri.normal))
+        return "the triangle collapses to a line when its vertices are rounded to float: make it "
+               "larger or move it nearer the origin";
+    return "";
+}

@@ -1,0 +1,338 @@
+#include <scene_loader.h>
+
+#include <cerrno>
+#include <cmath>
+#include <cstring>
+#include <fstream>
+#include <map>
+#include <sstream>
+#include <utility>
+#include <vector>
+
+#include <errors.h>
+#include <json_with_positions.h>
+#include <scene_limits.h>
+
+using nlohmann::json;
+
+namespace {
+
+// Walks the DOM with knowledge of where each value sits in the text.
+class SceneReader {
+public:
+    SceneReader(const std::string& name, const std::string& text,
+                const std::map<std::string, size_t>& offsets)
+        : name_(name), text_(text), offsets_(offsets) {}
+
+    [[noreturn]] void fail(const std::string& pointer, const std::string& what) const {
+        auto it = offsets_.find(pointer);
+        const size_t offset = it == offsets_.end() ? 0 : it->second;
+        throw InputError(name_ + ":" + line_column(text_, offset) + ": " +
+                         (pointer.empty() ? std::string("top level") : pointer) + ": " + what);
+    }
+
+    // Rejects keys outside `allowed`, naming the first unknown one.
+    void check_keys(const json& obj, const std::string& pointer,
+                    std::initializer_list<const char*> allowed) const {
+        if (!obj.is_object()) fail(pointer, "expected an object, found " + type_of(obj));
+        for (auto it = obj.begin(); it != obj.end(); ++it) {
+            bool known = false;
+            std::string list;
+            for (const char* a : allowed) {
+                known = known || it.key() == a;
+                list += std::string(list.empty() ? "" : ", ") + "\"" + a + "\"";
+            }
+            if (!known)
+                fail_key(pointer + "/" + pointer_token(it.key()),
+                         "unknown key \"" + it.key() + "\" (expected one of " + list + ")");
+        }
+    }
+
+    [[noreturn]] void fail_key(const std::string& pointer, const std::string& what) const {
+        auto it = offsets_.find(pointer + "#key");
+        throw InputError(name_ + ":" +
+                         line_column(text_, it == offsets_.end() ? 0 : it->second) + ": " + what);
+    }
+
+    const json& require(const json& obj, const std::string& pointer, const char* key) const {
+        if (!obj.contains(key)) fail(pointer, std::string("missing required key \"") + key + "\"");
+        return obj.at(key);
+    }
+
+    float number(const json& v, const std::string& pointer) const {
+        if (!v.is_number()) fail(pointer, "expected a number, found " + type_of(v));
+        const double d = v.get<double>();
+        if (!std::isfinite(d) || std::fabs(d) > 3.0e38)
+            fail(pointer, "expected a finite number within float range");
+        return static_cast<float>(d);
+    }
+
+    Vec3 vec3(const json& v, const std::string& pointer) const {
+        if (!v.is_array() || v.size() != 3)
+            fail(pointer, "expected an array of 3 numbers, found " + type_of(v));
+        return {number(v[0], pointer + "/0"), number(v[1], pointer + "/1"),
+                number(v[2], pointer + "/2")};
+    }
+
+    Vec3 non_negative_vec3(const json& v, const std::string& pointer) const {
+        const Vec3 r = vec3(v, pointer);
+        if (r.x < 0 || r.y < 0 || r.z < 0) fail(pointer, "expected components >= 0");
+        return r;
+    }
+
+    Vec3 albedo(const json& v, const std::string& pointer) const {
+        const Vec3 r = non_negative_vec3(v, pointer);
+        if (r.x > 1 || r.y > 1 || r.z > 1)
+            fail(pointer, "expected an albedo with components in [0, 1] (energy conservation)");
+        return r;
+    }
+
+    long long integer(const json& v, const std::string& pointer, long long lo,
+                      long long hi) const {
+        if (!v.is_number_integer())
+            fail(pointer, "expected an integer, found " + type_of(v));
+        const long long x = v.get<long long>();
+        if (x < lo || x > hi)
+            fail(pointer, "expected an integer in " + std::to_string(lo) + ".." +
+                              std::to_string(hi) + ", found " + v.dump());
+        return x;
+    }
+
+    static std::string type_of(const json& v) {
+        switch (v.type()) {
+            case json::value_t::null: return "null";
+            case json::value_t::boolean: return "a boolean";
+            case json::value_t::string: return "a string";
+            case json::value_t::array: return "an array of " + std::to_string(v.size());
+            case json::value_t::object: return "an object";
+            default: return "a number";
+        }
+    }
+
+private:
+    const std::string& name_;
+    const std::string& text_;
+    const std::map<std::string, size_t>& offsets_;
+};
+
+// A point of the scene, within what the renderer's float arithmetic handles (scene_limits.h).
+Vec3 read_position(const SceneReader& r, const json& v, const std::string& pointer) {
+    const Vec3 p = r.vec3(v, pointer);
+    for (int axis = 0; axis < 3; ++axis) {
+        const std::string problem = coordinate_problem(p[axis]);
+        if (!problem.empty()) r.fail(pointer + "/" + std::to_string(axis), problem);
+    }
+    return p;
+}
+
+// The triangle of vertices a, b, c of a primitive's "vertices", refused if it would not
+// render (scene_limits.h).
+Triangle read_triangle(const SceneReader& r, const json& obj, const std::string& p,
+                       const std::vector<Vec3>& v, int a, int b, int c, int material) {
+    const Triangle tri = make_triangle(v[a], v[b], v[c], material);
+    double written[3][3];
+    const int corners[3] = {a, b, c};
+    for (int k = 0; k < 3; ++k) {
+        for (int axis = 0; axis < 3; ++axis)
+            written[k][axis] = obj["vertices"][corners[k]][axis].get<double>();
+    }
+    const std::string problem = triangle_problem(written, tri);
+    if (!problem.empty()) r.fail(p + "/vertices", problem);
+    return tri;
+}
+
+// The parts of a scene file, one reader each, in the order of the format's description.
+
+void read_camera(const SceneReader& r, const json& root, CameraSpec& camera) {
+    const json& cam = r.require(root, "", "camera");
+    r.check_keys(cam, "/camera", {"position", "look_at", "up", "vfov"});
+    camera.position = read_position(r, r.require(cam, "/camera", "position"), "/camera/position");
+    camera.look_at = read_position(r, r.require(cam, "/camera", "look_at"), "/camera/look_at");
+    if (cam.contains("up")) camera.up = r.vec3(cam["up"], "/camera/up");
+    if (cam.contains("vfov")) {
+        camera.vfov_degrees = r.number(cam["vfov"], "/camera/vfov");
+        if (!(camera.vfov_degrees > 0.0f && camera.vfov_degrees < 180.0f))
+            r.fail("/camera/vfov", "expected a field of view in degrees, in (0, 180)");
+    }
+    const Vec3 forward = camera.look_at - camera.position;
+    if (length_squared(forward) == 0.0f)
+        r.fail("/camera/look_at", "expected a point different from the camera position");
+    if (length_squared(cross(forward, camera.up)) == 0.0f)
+        r.fail("/camera/up", "expected an up vector not parallel to the viewing direction");
+}
+
+void read_light(const SceneReader& r, const json& root, Scene& scene) {
+    if (!root.contains("light")) return;
+    const json& light = root["light"];
+    r.check_keys(light, "/light", {"position", "intensity"});
+    scene.has_light = true;
+    scene.light.position =
+        read_position(r, r.require(light, "/light", "position"), "/light/position");
+    scene.light.intensity =
+        r.non_negative_vec3(r.require(light, "/light", "intensity"), "/light/intensity");
+}
+
+Material read_material(const SceneReader& r, const json& m, const std::string& p) {
+    if (!m.is_object()) r.fail(p, "expected an object, found " + SceneReader::type_of(m));
+    const json& type = r.require(m, p, "type");
+    Material mat{MaterialType::Diffuse, Vec3(0.0f), 1.0f};
+    if (type == "diffuse" || type == "mirror") {
+        r.check_keys(m, p, {"type", "albedo"});
+        mat.type = type == "diffuse" ? MaterialType::Diffuse : MaterialType::Mirror;
+        mat.albedo = r.albedo(r.require(m, p, "albedo"), p + "/albedo");
+    } else if (type == "glass") {
+        r.check_keys(m, p, {"type", "ior"});
+        mat.type = MaterialType::Glass;
+        mat.ior = r.number(r.require(m, p, "ior"), p + "/ior");
+        if (!(mat.ior >= 1.0f && mat.ior <= 5.0f))
+            r.fail(p + "/ior", "expected an index of refraction in [1, 5]");
+    } else {
+        r.fail(p + "/type", "unknown material type " + type.dump() +
+                                " (expected \"diffuse\", \"mirror\" or \"glass\")");
+    }
+    return mat;
+}
+
+// Fills scene.materials and scene.material_names; returns each name's index.
+std::map<std::string, int> read_materials(const SceneReader& r, const json& root, Scene& scene) {
+    const json& materials = r.require(root, "", "materials");
+    if (!materials.is_object() || materials.empty())
+        r.fail("/materials", "expected an object of named materials, found " +
+                                 SceneReader::type_of(materials));
+    std::map<std::string, int> index;
+    for (auto it = materials.begin(); it != materials.end(); ++it) {
+        index[it.key()] = static_cast<int>(scene.materials.size());
+        scene.materials.push_back(
+            read_material(r, it.value(), "/materials/" + pointer_token(it.key())));
+        scene.material_names.push_back(it.key());
+    }
+    return index;
+}
+
+// Reads the primitives of a scene file: their lists, vertices and material names.
+class PrimitiveReader {
+public:
+    PrimitiveReader(const SceneReader& r, const json& root, std::map<std::string, int> materials)
+        : r_(r), root_(root), materials_(std::move(materials)) {}
+
+    // The array under `key`, or an empty one when the file has none.
+    const json& list(const char* key) const {
+        static const json empty = json::array();
+        if (!root_.contains(key)) return empty;
+        const json& v = root_[key];
+        if (!v.is_array())
+            r_.fail(std::string("/") + key, "expected an array, found " + SceneReader::type_of(v));
+        return v;
+    }
+
+    int material(const json& obj, const std::string& p) const {
+        const json& name = r_.require(obj, p, "material");
+        if (!name.is_string())
+            r_.fail(p + "/material", "expected a material name, found " + SceneReader::type_of(name));
+        const auto found = materials_.find(name.get<std::string>());
+        if (found == materials_.end())
+            r_.fail(p + "/material", "unknown material " + name.dump() +
+                                         " (not defined under \"materials\")");
+        return found->second;
+    }
+
+    std::vector<Vec3> vertices(const json& obj, const std::string& p, size_t count) const {
+        const json& v = r_.require(obj, p, "vertices");
+        if (!v.is_array() || v.size() != count)
+            r_.fail(p + "/vertices", "expected an array of " + std::to_string(count) +
+                                         " points, found " + SceneReader::type_of(v));
+        std::vector<Vec3> points;
+        for (size_t k = 0; k < count; ++k)
+            points.push_back(read_position(r_, v[k], p + "/vertices/" + std::to_string(k)));
+        return points;
+    }
+
+private:
+    const SceneReader& r_;
+    const json& root_;
+    const std::map<std::string, int> materials_;  // material name -> index
+};
+
+void read_spheres(const SceneReader& r, const PrimitiveReader& prims, Scene& scene) {
+    const json& spheres = prims.list("spheres");
+    for (size_t i = 0; i < spheres.size(); ++i) {
+        const std::string p = "/spheres/" + std::to_string(i);
+        r.check_keys(spheres[i], p, {"center", "radius", "material"});
+        Sphere s{};
+        s.center = read_position(r, r.require(spheres[i], p, "center"), p + "/center");
+        s.radius = r.number(r.require(spheres[i], p, "radius"), p + "/radius");
+        if (!(s.radius > 0.0f)) r.fail(p + "/radius", "expected a radius > 0");
+        const std::string problem = sphere_problem(s);
+        if (!problem.empty()) r.fail(p + "/radius", problem);
+        s.material = prims.material(spheres[i], p);
+        scene.spheres.push_back(s);
+    }
+}
+
+// Triangles, then quads (each as the two triangles v0 v1 v2 and v0 v2 v3).
+void read_triangles(const SceneReader& r, const PrimitiveReader& prims, Scene& scene) {
+    const json& triangles = prims.list("triangles");
+    for (size_t i = 0; i < triangles.size(); ++i) {
+        const std::string p = "/triangles/" + std::to_string(i);
+        r.check_keys(triangles[i], p, {"vertices", "material"});
+        const auto v = prims.vertices(triangles[i], p, 3);
+        scene.triangles.push_back(
+            read_triangle(r, triangles[i], p, v, 0, 1, 2, prims.material(triangles[i], p)));
+    }
+    const json& quads = prims.list("quads");
+    for (size_t i = 0; i < quads.size(); ++i) {
+        const std::string p = "/quads/" + std::to_string(i);
+        r.check_keys(quads[i], p, {"vertices", "material"});
+        const auto v = prims.vertices(quads[i], p, 4);
+        const int m = prims.material(quads[i], p);
+        scene.triangles.push_back(read_triangle(r, quads[i], p, v, 0, 1, 2, m));
+        scene.triangles.push_back(read_triangle(r, quads[i], p, v, 0, 2, 3, m));
+    }
+}
+
+void read_render_settings(const SceneReader& r, const json& root, RenderSettings& s) {
+    if (!root.contains("render")) return;
+    const json& rs = root["render"];
+    r.check_keys(rs, "/render", {"width", "height", "spp", "bounces", "seed"});
+    const auto read = [&](const char* key, long long lo, long long hi) {
+        return r.integer(rs[key], std::string("/render/") + key, lo, hi);
+    };
+    if (rs.contains("width")) s.width = static_cast<int>(read("width", 1, kMaxImageSide));
+    if (rs.contains("height")) s.height = static_cast<int>(read("height", 1, kMaxImageSide));
+    if (rs.contains("spp")) s.spp = static_cast<int>(read("spp", 1, kMaxSpp));
+    if (rs.contains("bounces")) s.bounces = static_cast<int>(read("bounces", 1, kMaxBounces));
+    if (rs.contains("seed")) s.seed = static_cast<uint64_t>(read("seed", 0, kMaxSeed));
+}
+
+}  // namespace
+
+Scene parse_scene(const std::string& text, const std::string& name) {
+    const JsonWithPositions parsed = parse_json_with_positions(text, name);
+    const json& root = parsed.root;
+    const SceneReader r(name, text, parsed.offsets);
+    if (!parsed.duplicate_key_pointer.empty())
+        r.fail_key(parsed.duplicate_key_pointer, "duplicate key \"" + parsed.duplicate_key + "\"");
+    r.check_keys(root, "", {"camera", "background", "light", "materials", "spheres", "triangles",
+                            "quads", "render"});
+
+    Scene scene;
+    scene.name = name;
+    read_camera(r, root, scene.camera);
+    if (root.contains("background"))
+        scene.background = r.non_negative_vec3(root["background"], "/background");
+    read_light(r, root, scene);
+    const PrimitiveReader prims(r, root, read_materials(r, root, scene));
+    read_spheres(r, prims, scene);
+    read_triangles(r, prims, scene);
+    read_render_settings(r, root, scene.render);
+    return scene;
+}
+
+Scene load_scene(const std::string& path) {
+    std::ifstream in(path, std::ios::binary);
+    if (!in) throw InputError(path + ": cannot open scene file: " + std::strerror(errno));
+    std::ostringstream ss;
+    ss << in.rdbuf();
+    if (in.bad()) throw InputError(path + ": cannot read scene file");
+    return parse_scene(ss.str(), path);
+}

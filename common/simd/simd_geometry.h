@@ -1,0 +1,145 @@
+// Lab 02, a worked example: SIMD across primitives. One ray is tested against 8 primitives per
+// AVX2 instruction, over the structure-of-arrays packets of simd_scene.h, and the shared path
+// loop of path_tracer.h does the rest (it is generic over its geometry: passing a
+// SimdSceneView instead of a SceneView makes it call the overloads below).
+//
+// It is exact: per lane the arithmetic is the scalar code's, so every distance and every hit
+// is lab 01's and the image is lab 01's, bit for bit. And it gains little (./lab02-prims
+// measures it): only closest_hit and occluded are vectorised, about two thirds of lab 01's
+// time; and even those gain little in a scene of 11 primitives, where a packet runs the full
+// test whenever any of its 8 triangles passes the plane cull (the scalar loop rejects most
+// triangles after the cull alone), 6 of 16 triangle lanes and 7 of 8 sphere lanes are
+// padding, and each packet ends in a horizontal minimum. Part B's packet tracer
+// (packet_tracer.h) vectorises the whole path instead, 8 rays per instruction.
+#pragma once
+
+#include <path_tracer.h>
+#include <simd8.h>
+#include <simd_scene.h>
+
+// One ray in all 8 lanes, with the per-ray constants of the watertight test: computed once
+// per ray, used for every packet.
+struct BroadcastRay {
+    RayShear shear;      // axis permutation and shear (triangle.h)
+    Vec3x8 origin;       // the same in every lane
+    Vec3x8 direction;
+    Float8 sx, sy, sz;   // the shear constants
+
+    explicit BroadcastRay(const Ray& r)
+        : shear(r.direction), origin(r.origin), direction(r.direction),
+          sx(shear.sx), sy(shear.sy), sz(shear.sz) {}
+};
+
+inline Vec3x8 load3(const float (&rows)[3][kSimdWidth]) {
+    return {Float8::load(rows[0]), Float8::load(rows[1]), Float8::load(rows[2])};
+}
+
+// intersect_sphere (sphere.h) for one ray against 8 spheres.
+inline Float8 intersect_spheres8(const BroadcastRay& r, const SpherePacket& p, Float8 t_max) {
+    const Vec3x8 f = r.origin - load3(p.center);
+    const Float8 b = -dot(f, r.direction);
+    const Vec3x8 perpendicular = f + r.direction * b;
+    const Float8 r2 = Float8::load(p.radius2);
+    const Float8 disc = r2 - length_squared(perpendicular);
+    const Mask8 crosses = disc >= 0.0f;
+    if (none(crosses)) return t_max;
+    const Float8 q = b + copysign(sqrt(disc), b);
+    const Float8 c = length_squared(f) - r2;
+    const Float8 t_a = c / q;
+    const Float8 t_b = q;
+    const Float8 t_near = min(t_a, t_b);
+    const Float8 t_far = max(t_a, t_b);
+    const Mask8 near_ok = (t_near > 0.0f) & (t_near < t_max);
+    const Mask8 far_ok = (t_far > 0.0f) & (t_far < t_max);
+    return select(crosses, select(near_ok, t_near, select(far_ok, t_far, t_max)), t_max);
+}
+
+// intersect_triangle (triangle.h) for one ray against 8 triangles. The axis permutation is
+// the ray's, the same in every lane, so it picks rows of the packet, not lanes.
+inline Float8 intersect_triangles8(const BroadcastRay& r, const TrianglePacket& p, Float8 t_max) {
+    const Vec3x8 normal = load3(p.normal);
+    const Float8 denom = dot(normal, r.direction);
+    const Float8 num = Float8::load(p.plane_offset) - dot(normal, r.origin);
+    const Mask8 not_behind{_mm256_cmp_ps((num * denom).v, _mm256_setzero_ps(), _CMP_NLE_UQ)};
+    const Mask8 not_beyond{
+        _mm256_cmp_ps(abs(num).v, (t_max * 1.00001f * abs(denom)).v, _CMP_NGE_UQ)};
+    const Mask8 candidates = not_behind & not_beyond;
+    if (none(candidates)) return t_max;
+
+    const int kx = r.shear.kx, ky = r.shear.ky, kz = r.shear.kz;
+    const Float8 o[3] = {r.origin.x, r.origin.y, r.origin.z};
+    const Float8 az = Float8::load(p.vertex[0][kz]) - o[kz];
+    const Float8 bz = Float8::load(p.vertex[1][kz]) - o[kz];
+    const Float8 cz = Float8::load(p.vertex[2][kz]) - o[kz];
+    const Float8 ax = (Float8::load(p.vertex[0][kx]) - o[kx]) - r.sx * az;
+    const Float8 ay = (Float8::load(p.vertex[0][ky]) - o[ky]) - r.sy * az;
+    const Float8 bx = (Float8::load(p.vertex[1][kx]) - o[kx]) - r.sx * bz;
+    const Float8 by = (Float8::load(p.vertex[1][ky]) - o[ky]) - r.sy * bz;
+    const Float8 cx = (Float8::load(p.vertex[2][kx]) - o[kx]) - r.sx * cz;
+    const Float8 cy = (Float8::load(p.vertex[2][ky]) - o[ky]) - r.sy * cz;
+    Float8 u = cx * by - cy * bx;  // never fused: watertight
+    Float8 v = ax * cy - ay * cx;
+    Float8 w = bx * ay - by * ax;
+    const Mask8 on_edge = candidates & ((u == 0.0f) | (v == 0.0f) | (w == 0.0f));
+    if (any(on_edge)) redo_edges_exactly(on_edge, ax, ay, bx, by, cx, cy, u, v, w);  // rare
+    const Mask8 any_negative = (u < 0.0f) | (v < 0.0f) | (w < 0.0f);
+    const Mask8 any_positive = (u > 0.0f) | (v > 0.0f) | (w > 0.0f);
+    const Float8 det = u + v + w;
+    const Float8 t_scaled = u * (r.sz * az) + v * (r.sz * bz) + w * (r.sz * cz);
+    const Float8 sign = copysign(1.0f, det);
+    const Float8 t_signed = t_scaled * sign;
+    const Float8 det_abs = det * sign;
+    const Mask8 hit = and_not(candidates, any_negative & any_positive) & (det != 0.0f) &
+                      (t_signed > 0.0f) & (t_signed < t_max * det_abs);
+    if (none(hit)) return t_max;
+    return select(hit, t_scaled / det, t_max);
+}
+
+// The lane holding the smallest t among `hit_bits` (lanes outside hold t_max, larger than
+// any hit); the lowest such lane on a tie, as lab 01's loop keeps the first of equal hits.
+// The one horizontal operation of this method: min with halves, pairs, neighbours swapped.
+inline int nearest_lane(Float8 t, int hit_bits) {
+    __m256 m = _mm256_min_ps(t.v, _mm256_permute2f128_ps(t.v, t.v, 1));
+    m = _mm256_min_ps(m, _mm256_shuffle_ps(m, m, _MM_SHUFFLE(1, 0, 3, 2)));
+    m = _mm256_min_ps(m, _mm256_shuffle_ps(m, m, _MM_SHUFFLE(2, 3, 0, 1)));
+    return __builtin_ctz(static_cast<unsigned>((t == Float8(m)).bits() & hit_bits));
+}
+
+// closest_hit (path_tracer.h) over every packet: 8 primitives per test, then the nearest lane.
+inline Hit closest_hit(const SimdSceneView& scene, const Ray& ray) {
+    Hit hit;
+    const BroadcastRay r(ray);
+    for (int i = 0; i < scene.num_sphere_packets; ++i) {
+        const Float8 t_max = hit.t;
+        const Float8 t = intersect_spheres8(r, scene.spheres[i], t_max);
+        const int hits = (t < t_max).bits();
+        if (hits == 0) continue;
+        const int lane = nearest_lane(t, hits);
+        hit.t = t.lane(lane);
+        hit.sphere = i * kSimdWidth + lane;
+    }
+    for (int i = 0; i < scene.num_triangle_packets; ++i) {
+        const Float8 t_max = hit.t;
+        const Float8 t = intersect_triangles8(r, scene.triangles[i], t_max);
+        const int hits = (t < t_max).bits();
+        if (hits == 0) continue;
+        const int lane = nearest_lane(t, hits);
+        hit.t = t.lane(lane);
+        hit.sphere = -1;
+        hit.triangle = i * kSimdWidth + lane;
+    }
+    return hit;
+}
+
+// occluded (path_tracer.h): stops at the first packet with a hit.
+inline bool occluded(const SimdSceneView& scene, const Ray& ray, float t_max) {
+    const BroadcastRay r(ray);
+    const Float8 limit = t_max;
+    for (int i = 0; i < scene.num_sphere_packets; ++i) {
+        if (any(intersect_spheres8(r, scene.spheres[i], limit) < limit)) return true;
+    }
+    for (int i = 0; i < scene.num_triangle_packets; ++i) {
+        if (any(intersect_triangles8(r, scene.triangles[i], limit) < limit)) return true;
+    }
+    return false;
+}

@@ -1,0 +1,44 @@
+"""Compiling a submission's sources in the sandbox. The compiler reads what it is told to:
+a render.cpp with `#include "/path/to/labs/01-serial/solution/render.cpp"` would otherwise
+hand in the solution, and compile errors would print any file the grader can read. So the
+build runs under bubblewrap too, seeing of the repository only what building a lab variant
+needs: the Makefile and the labs' make fragments, common/ (the shared sources and headers),
+the lab folders' own top-level files and the built driver objects in build/, read-only; no
+solutions, no references, no golden data, no grader.
+
+The Makefile stays the one place that knows how a lab is built (`make variant`); the driver
+objects must be up to date beforehand (building lab01-ref, and lab04-ref for lab 04, does
+that), as the sandbox cannot write build/.
+"""
+from __future__ import annotations
+
+import pathlib
+
+from grading.harness import ROOT
+from grading.sandbox import Limits, Runner
+
+COMPILE_LIMITS = Limits(wall_seconds=300, cpu_seconds=600, output_bytes=1 << 20)
+
+
+def visible_tree() -> list[pathlib.Path]:
+    """The parts of the repository a variant build reads."""
+    paths = [ROOT / "Makefile", ROOT / "cuda.mk", ROOT / "grading" / "grading.mk",
+             ROOT / "common", ROOT / "build"]
+    for lab in sorted((ROOT / "labs").iterdir()):
+        paths += [f for f in sorted(lab.iterdir()) if f.is_file()]  # lab.mk, shared drivers
+    return [p for p in paths if p.exists()]
+
+
+def build_in_sandbox(variant_lab: str, src: pathlib.Path) -> tuple[pathlib.Path | None, str]:
+    """Build the sources in `src` as `variant_lab` (e.g. 01-serial) into src/lab:
+    (binary, "") or (None, the compiler's output)."""
+    with Runner(trusted=False) as r:
+        for path in visible_tree():
+            r.bind(path)
+        r.bind(src, writable=True)
+        out = r.run(["make", "-s", "-C", str(ROOT), "variant", f"VARIANT_LAB={variant_lab}",
+                     f"VARIANT={src.resolve()}"], COMPILE_LIMITS)
+    binary = src / "lab"
+    if out.failure is None and binary.is_file():
+        return binary, ""
+    return None, f"{out.failure}\n{out.stdout}{out.stderr}"

@@ -1,0 +1,79 @@
+"""A Gradescope autograder bundle for one lab: the repository (the grader, the references'
+sources, the golden data) with Gradescope's two entry points at the top of the zip.
+
+    make gradescope LAB=01            -> build/gradescope-lab01.zip
+
+Gradescope unpacks the zip into /autograder/source, runs setup.sh once when it builds the
+image (packages, bubblewrap, the reference binaries) and run_autograder for every
+submission, which finds the student's files in /autograder/submission and must leave
+/autograder/results/results.json. The grader runs the student's binary in its sandbox; the
+solutions in the image stay out of the sandbox's view. AUTOGRADER_ROOT (default /autograder)
+lets a test run the bundle in a scratch folder laid out the same way.
+"""
+from __future__ import annotations
+
+import argparse
+import pathlib
+import subprocess
+import sys
+import zipfile
+
+from grading.grade import RUBRICS
+from grading.harness import ROOT
+
+SETUP = """#!/usr/bin/env bash
+# Gradescope runs this once, as root, when it builds the autograder image.
+set -euo pipefail
+cd "$(dirname "$0")"
+bash tools/install_deps.sh
+make -s lab01-ref lab04-ref
+"""
+
+RUN = """#!/usr/bin/env bash
+# Gradescope runs this for every submission. The grader writes results.json whatever happens;
+# if even Python cannot start, this still leaves one saying so.
+root="${{AUTOGRADER_ROOT:-/autograder}}"
+cd "$root/source"
+mkdir -p "$root/results"
+python3 -m grading.grade {lab} --sources "$root/submission" \\
+    --results "$root/results/results.json" --heatmaps "$root/results/heatmaps"
+status=$?
+if [ ! -s "$root/results/results.json" ]; then
+    printf '{{"score": 0, "output": "the grader failed (status %s) before writing results", "tests": []}}\\n' \\
+        "$status" > "$root/results/results.json"
+fi
+exit 0
+"""
+
+
+def repository_files() -> list[str]:
+    """Tracked and untracked-but-not-ignored files: what a checkout of the tree holds."""
+    out = subprocess.run(["git", "-C", str(ROOT), "ls-files", "-co", "--exclude-standard", "-z"],
+                         capture_output=True, check=True).stdout
+    return sorted(f for f in out.decode().split("\0") if f and (ROOT / f).is_file())
+
+
+def bundle(lab: str, out: pathlib.Path) -> pathlib.Path:
+    out.parent.mkdir(parents=True, exist_ok=True)
+    with zipfile.ZipFile(out, "w", zipfile.ZIP_DEFLATED) as z:
+        for f in repository_files():
+            z.write(ROOT / f, f)
+        for name, text in (("setup.sh", SETUP), ("run_autograder", RUN.format(lab=lab))):
+            info = zipfile.ZipInfo(name)
+            info.external_attr = 0o755 << 16  # executable once unpacked
+            z.writestr(info, text)
+    return out
+
+
+def main(argv=None) -> int:
+    p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    p.add_argument("lab", choices=sorted(RUBRICS))
+    p.add_argument("--out", type=pathlib.Path)
+    a = p.parse_args(argv)
+    out = bundle(a.lab, a.out or ROOT / "build" / f"gradescope-lab{a.lab}.zip")
+    print(f"wrote {out}")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

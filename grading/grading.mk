@@ -1,0 +1,14 @@
+# The grader's make targets (make grade, gradescope, release, grade-batch).
+# `make grade` itself is in the Makefile; grading/README.md explains the grader.
+
+.PHONY: gradescope grade-batch
+
+# make gradescope LAB=NN: the Gradescope autograder zip for lab NN in build/.
+gradescope:
+	$(PYTHON) -m grading.gradescope $(LAB)
+
+# make grade-batch LAB=NN SUBMISSIONS=DIR [REPORT=DIR]: one folder per student, graded in the
+# sandbox; REPORT (default grades/) gets each results.json, grades.csv and report.html.
+grade-batch:
+	@test -n "$(SUBMISSIONS)" || { echo "grade-batch: needs SUBMISSIONS=DIR" >&2; exit 2; }
+	$(PYTHON) -m grading.batch $(LAB) $(SUBMISSIONS) --out $(or $(REPORT),grades)

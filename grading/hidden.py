@@ -1,0 +1,99 @@
+"""A hidden scene: the golden scenes' images are in the repository, so a submission could
+recognise a golden render and print the stored image. A hidden scene is made at grading time
+from a secret (a random one per grade unless the instructor fixes it to regrade), its golden
+data rendered there and then by the trusted lab-01 reference, so there is nothing to copy.
+
+The scene is the Cornell box with its light moved and dimmed or brightened, its camera
+nudged and its colours changed, all drawn from the secret. Its golden data follow
+tools/make_golden.py (K renders with distinct seeds: their mean, and their spread times n as
+the variance of one path), only smaller, so that it takes about a second on two cores; with
+K = 32 estimated variances, grading/compare.py's false-failure bound grows by about 1.1x.
+"""
+from __future__ import annotations
+
+import concurrent.futures
+import dataclasses
+import hashlib
+import os
+import pathlib
+import secrets
+import tempfile
+
+import numpy as np
+
+from grading import scenes
+from grading.compare import compare
+from grading.harness import RunPolicy, available_cores, policy, run_lab
+
+SIZE = 32          # pixels a side
+BOUNCES = 4
+RENDERS = 32       # K
+SPP_PER_RENDER = 64  # n
+TEST_SPP = 64
+
+
+def new_secret() -> str:
+    return secrets.token_hex(16)
+
+
+def hidden_scene(secret: str) -> dict:
+    """The Cornell box varied by `secret`: the same secret, the same scene."""
+    rng = np.random.default_rng(int.from_bytes(hashlib.sha256(secret.encode()).digest()[:8], "little"))
+    s = scenes.load("cornell")
+    s.pop("render", None)
+    light = s["light"]
+    light["position"] = [float(np.clip(c + rng.uniform(-0.25, 0.25), 0.1, 0.95))
+                         for c in light["position"]]
+    light["intensity"] = [c * float(rng.uniform(0.6, 1.6)) for c in light["intensity"]]
+    cam = s["camera"]
+    cam["position"] = [c + float(rng.uniform(-0.08, 0.08)) for c in cam["position"]]
+    cam["vfov"] = float(cam["vfov"] * rng.uniform(0.9, 1.1))
+    for m in s["materials"].values():
+        if m.get("type") == "diffuse":
+            m["albedo"] = [float(np.clip(a * rng.uniform(0.6, 1.4), 0.02, 0.9)) for a in m["albedo"]]
+    return s
+
+
+@dataclasses.dataclass
+class HiddenGolden:
+    scene: pathlib.Path
+    mean: np.ndarray
+    variance: np.ndarray
+    golden_spp: int
+
+
+def make_golden(reference, scene_path: pathlib.Path) -> HiddenGolden:
+    """Golden data of the hidden scene from the trusted reference (outside the sandbox)."""
+    seeds = range(2_000_000, 2_000_000 + RENDERS)
+    with policy(RunPolicy(trusted=True)), \
+            concurrent.futures.ThreadPoolExecutor(max(1, available_cores())) as pool:
+        images = list(pool.map(
+            lambda seed: run_lab(reference, scene_path, width=SIZE, height=SIZE, bounces=BOUNCES,
+                                 spp=SPP_PER_RENDER, seed=seed, threads=1).image, seeds))
+    stack = np.stack([i.astype(np.float64) for i in images])
+    return HiddenGolden(scene_path, stack.mean(axis=0).astype(np.float32),
+                        (stack.var(axis=0, ddof=1) * SPP_PER_RENDER).astype(np.float32),
+                        RENDERS * SPP_PER_RENDER)
+
+
+def check_hidden(binary, reference, secret: str, *, launcher=(), threads=None,
+                 heatmap_dir: pathlib.Path | None = None):
+    """The submission's render of the hidden scene against golden data made just now."""
+    from grading.checks import CheckResult, image_checked
+
+    @image_checked("hidden scene")
+    def run() -> CheckResult:
+        with tempfile.TemporaryDirectory() as tmp:
+            path = scenes.write_scene(pathlib.Path(tmp) / "scene.json", hidden_scene(secret))
+            g = make_golden(reference, path)
+            image = run_lab(binary, path, width=SIZE, height=SIZE, bounces=BOUNCES, spp=TEST_SPP,
+                            seed=7, launcher=launcher, threads=threads).image
+        heatmap = heatmap_dir / "hidden-diff.png" if heatmap_dir else None
+        report = compare(image, TEST_SPP, g.mean, g.variance, g.golden_spp, heatmap_path=heatmap)
+        return CheckResult("hidden scene", report.passed, report.summary())
+    return run()
+
+
+def secret_from_environment() -> str:
+    """GRADING_SECRET fixes the hidden scene (to regrade a batch alike); else a new one."""
+    return os.environ.get("GRADING_SECRET") or new_secret()

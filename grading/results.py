@@ -1,0 +1,118 @@
+"""results.json in Gradescope's format, kept complete at every moment of a grade.
+
+Every test of the rubric is in the file from the start ("not graded yet"), the file is
+rewritten atomically after each test, and a refused, interrupted or failed grade is written
+too: whatever happens to the grader, the instructor finds a results.json that says what
+happened.
+"""
+from __future__ import annotations
+
+import dataclasses
+import json
+import os
+import pathlib
+import tempfile
+import time
+
+# Gradescope shows the output of a test as is; a submission's stderr must not make it huge.
+MAX_OUTPUT_CHARS = 4000
+
+
+@dataclasses.dataclass
+class Test:
+    id: str
+    label: str
+    max_score: int
+    score: int = 0
+    output: str = "not graded yet"
+    seconds: float = 0.0
+    finished: bool = False
+    ok: bool = False       # the check passed (a 0-point gate passes without points)
+    regrade: bool = False  # the machine could not measure it: points provisional
+
+    @property
+    def passed(self) -> bool:
+        return self.finished and self.ok
+
+    def finish(self, score: int, output: str, seconds: float = 0.0, regrade: bool = False,
+               ok: bool = False):
+        """`ok`: the check ran and passed; a test not graded (refused, interrupted, gated) is
+        never ok, whatever its points."""
+        self.score, self.output, self.seconds = score, clip(output), seconds
+        self.finished, self.regrade, self.ok = True, regrade, ok
+
+    def as_dict(self) -> dict:
+        return {"name": self.label, "score": self.score, "max_score": self.max_score,
+                "status": "passed" if self.passed else "failed", "output": self.output,
+                "execution_time": round(self.seconds, 3), "visibility": "visible",
+                "extra_data": {"check": self.id, "regrade": self.regrade}}
+
+
+def clip(text: str, limit: int = MAX_OUTPUT_CHARS) -> str:
+    return text if len(text) <= limit else text[:limit] + f" ... [{len(text) - limit} characters cut]"
+
+
+class Results:
+    def __init__(self, path: pathlib.Path | None = None):
+        self.path = path
+        self.tests: list[Test] = []
+        self.notes: list[str] = []
+        self.refused = False
+        self.start = time.perf_counter()
+
+    def add(self, test: Test) -> None:
+        if not any(t.id == test.id for t in self.tests):
+            self.tests.append(test)
+
+    def add_all(self, tests) -> None:
+        for t in tests:
+            self.add(t)
+        self.changed()
+
+    def test(self, id: str) -> Test:
+        return next(t for t in self.tests if t.id == id)
+
+    def refuse(self, reason: str, detail: str = "") -> None:
+        """Nothing was graded (no sandbox, no binary, a compile error): every test scores 0
+        and says why; `detail` (the compiler's errors) goes to the top-level output."""
+        self.refused = True
+        self.notes.append(clip(f"{reason}:\n{detail}" if detail else reason))
+        for t in self.tests:
+            if not t.finished:
+                t.finish(0, f"not graded: {reason}")
+        self.changed()
+
+    def interrupt(self, reason: str) -> None:
+        self.notes.append(reason)
+        for t in self.tests:
+            if not t.finished:
+                t.finish(0, f"not graded: {reason}")
+        self.changed()
+
+    def complete(self, seconds: float) -> None:
+        regrade = [t.label for t in self.tests if t.regrade]
+        if regrade:
+            self.notes.append("marked for regrade (the machine was too busy to measure; points "
+                              "provisional): " + ", ".join(regrade))
+        self.changed()
+
+    def as_dict(self) -> dict:
+        return {"score": sum(t.score for t in self.tests),
+                "max_score": sum(t.max_score for t in self.tests),
+                "execution_time": round(time.perf_counter() - self.start, 3),
+                "output": "\n".join(self.notes), "visibility": "visible",
+                "tests": [t.as_dict() for t in self.tests]}
+
+    def changed(self) -> None:
+        if self.path:
+            self.write()
+
+    def write(self) -> None:
+        """Atomically: a reader sees the old file or the new one, never half of one."""
+        if not self.path:
+            return
+        folder = self.path.parent.resolve()
+        folder.mkdir(parents=True, exist_ok=True)
+        with tempfile.NamedTemporaryFile("w", dir=folder, delete=False, suffix=".partial") as f:
+            json.dump(self.as_dict(), f, indent=2)
+        os.replace(f.name, self.path)

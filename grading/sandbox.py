@@ -1,0 +1,370 @@
+"""Running a submission's processes where they can do no harm, and measuring them from outside.
+
+A submission is hostile until proven otherwise: it may hang, fork children that outlive it,
+flood its output, fill the disk, read other students' code or the golden data, open sockets or
+lie about its own speed. Every process the grader starts from a submission goes through
+`Runner.run`, which
+
+- (untrusted, the default) runs it under bubblewrap: as an unprivileged user, in its own user,
+  PID, network, IPC and mount namespaces, seeing read-only exactly the files it was given, the
+  system's libraries and MPI's files, and writing only to a scratch folder of its own;
+- applies resource limits inside (CPU seconds, memory, file size, processes, open files);
+- kills the whole process tree when the wall-clock limit passes, when an output stream exceeds
+  its cap, or when the grader itself dies (`--die-with-parent`; the PID namespace dies with its
+  first process, so no grandchild survives);
+- reads at most `Limits.output_bytes` of stdout and of stderr and says when it cut them;
+- measures wall-clock and CPU time itself, from outside the sandbox.
+
+`--trusted` (students grading their own code at home, where bubblewrap may be missing) runs the
+same commands without the sandbox, still with the limits, the caps and the timing.
+"""
+from __future__ import annotations
+
+import dataclasses
+import os
+import pathlib
+import select
+import shutil
+import signal
+import stat
+import subprocess
+import tempfile
+import time
+from typing import Sequence
+
+NOBODY = 65534
+# The sandbox's fixed layout: inputs appear read-only under /job, the scratch folder is the
+# working directory and the only writable place besides a small /tmp.
+JOB, SCRATCH = "/job", "/scratch"
+
+
+@dataclasses.dataclass(frozen=True)
+class Limits:
+    wall_seconds: float = 60.0           # the whole process tree, measured by the grader
+    cpu_seconds: int = 240               # RLIMIT_CPU, per process
+    memory_bytes: int | None = 4 << 30   # RLIMIT_AS, per process (None: unlimited, for CUDA)
+    file_bytes: int = 256 << 20          # RLIMIT_FSIZE: the largest file it may write
+    scratch_bytes: int = 512 << 20       # what it may leave in scratch (checked after the run)
+    tmp_bytes: int = 256 << 20           # size of the sandbox's /tmp (a tmpfs)
+    processes: int = 256                 # RLIMIT_NPROC: threads count, so MPI and OpenMP fit
+    open_files: int = 1024               # RLIMIT_NOFILE
+    output_bytes: int = 1 << 20          # kept of stdout and of stderr, each
+
+
+@dataclasses.dataclass
+class Outcome:
+    """What the grader saw of one run."""
+    returncode: int | None      # as the kernel reported it (negative: a signal); see failure
+    stdout: str                 # decoded leniently: a stray byte is U+FFFD, never an error
+    stderr: str
+    wall_seconds: float         # measured by the grader around the whole tree
+    cpu_seconds: float | None   # user + system time of the tree, when the grader can know
+                                # it: trusted runs only (bubblewrap's monitor does not reap
+                                # the sandbox, so its rusage holds nothing of it)
+    killed: str | None = None   # why the grader killed it, e.g. "timed out after 60 s"
+    cut: tuple[str, ...] = ()   # streams cut at the output cap
+
+    @property
+    def failure(self) -> str | None:
+        """One phrase naming what went wrong, or None for a clean exit 0."""
+        if self.killed:
+            return self.killed
+        if self.returncode == 0:
+            return None
+        return describe_exit(self.returncode)
+
+
+SIGNAL_NAMES = {
+    signal.SIGSEGV: "segmentation fault", signal.SIGBUS: "bus error",
+    signal.SIGFPE: "floating-point exception", signal.SIGILL: "illegal instruction",
+    signal.SIGABRT: "aborted", signal.SIGKILL: "killed", signal.SIGXCPU: "CPU time limit exceeded",
+    signal.SIGXFSZ: "file size limit exceeded", signal.SIGTERM: "terminated",
+}
+
+
+def describe_exit(returncode: int) -> str:
+    """'segmentation fault (signal 11)' rather than 'exited -11'. Inside the sandbox a shell
+    reports a signal as 128 + its number, so both spellings are decoded."""
+    sig = -returncode if returncode < 0 else returncode - 128 if 128 < returncode < 160 else 0
+    if sig:
+        try:
+            name = SIGNAL_NAMES.get(signal.Signals(sig)) or signal.Signals(sig).name
+        except ValueError:
+            name = f"signal {sig}"
+        return f"{name} (signal {sig})"
+    return f"exited with status {returncode}"
+
+
+def decode(data: bytes) -> str:
+    return data.decode("utf-8", errors="replace")
+
+
+def bwrap_path() -> str | None:
+    return shutil.which("bwrap")
+
+
+_probe_result: list[str | None] = []
+
+
+def probe() -> str | None:
+    """None when the sandbox works here, else one line saying why not (checked once)."""
+    if not _probe_result:
+        _probe_result.append(_probe())
+    return _probe_result[0]
+
+
+def _probe() -> str | None:
+    if not bwrap_path():
+        return "bubblewrap (bwrap) is not installed: run `make deps`"
+    if not shutil.which("prlimit"):
+        return "prlimit (util-linux) is not installed"
+    try:
+        with Runner(trusted=False) as r:
+            out = r.run(["/bin/sh", "-c", "exit 0"], Limits(wall_seconds=20))
+    except OSError as e:
+        return f"bubblewrap cannot start: {e}"
+    if out.returncode != 0:
+        return f"bubblewrap cannot create its namespaces here: {out.stderr.strip()[:200]}"
+    return None
+
+
+def system_mounts() -> list[str]:
+    """Read-only system files a dynamically linked program (and mpirun) needs, whether /lib is
+    a folder or merged into /usr. Nothing of /root, /home, /work or the grader's tree."""
+    args = ["--ro-bind", "/usr", "/usr"]
+    for top in ("/bin", "/sbin", "/lib", "/lib32", "/lib64", "/libx32"):
+        if os.path.islink(top):
+            args += ["--symlink", os.readlink(top), top]
+        elif os.path.isdir(top):
+            args += ["--ro-bind", top, top]
+    for path in ("/etc/alternatives", "/etc/ld.so.cache", "/etc/ld.so.conf",
+                 "/etc/ld.so.conf.d", "/etc/openmpi", "/etc/localtime",
+                 "/sys/devices/system/cpu", "/sys/devices/system/node"):
+        args += ["--ro-bind-try", path, path]  # hwloc (mpirun) reads the CPU topology
+    return args
+
+
+def _threads_of(uid: int) -> int:
+    """Tasks (threads) this uid runs now: RLIMIT_NPROC counts all of them, so a non-root grader
+    sets the limit above what it already uses."""
+    count = 0
+    for entry in os.scandir("/proc"):
+        if entry.name.isdigit():
+            try:
+                if entry.stat().st_uid == uid:
+                    count += len(os.listdir(f"/proc/{entry.name}/task"))
+            except OSError:
+                pass
+    return count
+
+
+class Runner:
+    """Runs commands of one check: inputs staged once, each run in a fresh scratch folder.
+
+        with Runner(trusted=False) as r:
+            exe = r.input(binary)                 # the path to use in the command
+            out = r.run([exe, "--pfm", r.scratch("image.pfm")], limits)
+            data = r.output("image.pfm")          # bytes or None, read after the run
+    """
+
+    def __init__(self, trusted: bool):
+        self.trusted = trusted
+        self.root = pathlib.Path(tempfile.mkdtemp(prefix="grading-"))
+        os.chmod(self.root, 0o755)  # the unprivileged sandbox user must reach staged inputs
+        self.inputs: dict[str, pathlib.Path] = {}
+        self.binds: list[tuple[str, bool]] = []  # (path, writable), mounted at the same path
+        self._scratch: pathlib.Path | None = None
+        self.drop_to_nobody = not trusted and os.geteuid() == 0
+
+    def __enter__(self):
+        return self
+
+    def __exit__(self, *exc):
+        shutil.rmtree(self.root, ignore_errors=True)
+
+    # ---- what the command may see ---------------------------------------------------------
+    def input(self, path: os.PathLike | str) -> str:
+        """Make a file readable to the command; returns its path as the command sees it. In the
+        sandbox it is a private copy (the original's folder may be closed to the sandbox user,
+        and the submission must not be able to change what later runs see)."""
+        path = pathlib.Path(path).resolve()
+        if self.trusted:
+            return str(path)
+        name = f"{len(self.inputs)}-{path.name}"
+        staged = self.root / "inputs" / name
+        staged.parent.mkdir(mode=0o755, exist_ok=True)
+        shutil.copyfile(path, staged)
+        os.chmod(staged, 0o555 if os.access(path, os.X_OK) else 0o444)
+        self.inputs[f"{JOB}/{name}"] = staged
+        return f"{JOB}/{name}"
+
+    def bind(self, path: os.PathLike | str, writable: bool = False) -> str:
+        """Show a file or folder at its own path, without copying (a build needs the tree's
+        layout). Read-only unless `writable`; a writable one is handed to the sandbox user."""
+        path = str(pathlib.Path(path).resolve())
+        if writable and self.drop_to_nobody:
+            for dirpath, dirs, files in os.walk(path):
+                for name in [dirpath, *(os.path.join(dirpath, f) for f in dirs + files)]:
+                    os.lchown(name, NOBODY, NOBODY)
+        self.binds.append((path, writable))
+        return path
+
+    def scratch(self, name: str = "") -> str:
+        """A path in the run's scratch folder, as the command sees it."""
+        base = SCRATCH if not self.trusted else str(self._scratch_dir())
+        return f"{base}/{name}" if name else base
+
+    def _scratch_dir(self) -> pathlib.Path:
+        if self._scratch is None:
+            self._scratch = self.root / "scratch"
+            self._scratch.mkdir(mode=0o700)
+            if self.drop_to_nobody:
+                os.chown(self._scratch, NOBODY, NOBODY)
+        return self._scratch
+
+    def output(self, name: str, limit: int = 256 << 20) -> bytes | None:
+        """A regular file the run left in scratch (never through a symlink), or None."""
+        try:
+            fd = os.open(self._scratch_dir() / name, os.O_RDONLY | os.O_NOFOLLOW | os.O_NONBLOCK)
+        except OSError:
+            return None
+        with os.fdopen(fd, "rb") as f:
+            if not stat.S_ISREG(os.fstat(fd).st_mode):
+                return None
+            return f.read(limit + 1)[:limit + 1]
+
+    # ---- running --------------------------------------------------------------------------
+    def command(self, argv: Sequence[str], limits: Limits, env: dict[str, str]) -> list[str]:
+        """The full command line: bubblewrap (unless trusted), then prlimit, then argv."""
+        nproc = limits.processes
+        if not self.drop_to_nobody and os.geteuid() != 0:
+            nproc += _threads_of(os.geteuid())
+        inner = [shutil.which("prlimit") or "prlimit", f"--cpu={limits.cpu_seconds}",
+                 f"--fsize={limits.file_bytes}", f"--nofile={limits.open_files}", "--core=0"]
+        if limits.memory_bytes:
+            inner.append(f"--as={limits.memory_bytes}")
+        if os.geteuid() != 0 or self.drop_to_nobody:  # root ignores RLIMIT_NPROC anyway
+            inner.append(f"--nproc={nproc}")
+        inner += ["--", *argv]
+        if self.trusted:
+            return inner
+        scratch = self._scratch_dir()
+        cmd = [bwrap_path() or "bwrap", "--unshare-all", "--unshare-user",
+               "--uid", str(NOBODY), "--gid", str(NOBODY), "--die-with-parent", "--new-session",
+               "--cap-drop", "ALL", *system_mounts(), "--proc", "/proc", "--dev", "/dev",
+               "--size", str(limits.tmp_bytes), "--tmpfs", "/tmp",
+               "--bind", str(scratch), SCRATCH, "--chdir", SCRATCH, "--clearenv"]
+        for inside, outside in self.inputs.items():
+            cmd += ["--ro-bind", str(outside), inside]
+        for path, writable in self.binds:
+            cmd += ["--bind" if writable else "--ro-bind", path, path]
+        cmd += ["--remount-ro", "/"]  # bubblewrap's root is a tmpfs: no files may go there
+        for key, value in {"PATH": "/usr/local/bin:/usr/bin:/bin", "HOME": SCRATCH,
+                           "TMPDIR": "/tmp", "LANG": "C.UTF-8", **env}.items():
+            cmd += ["--setenv", key, value]
+        return cmd + ["--", *inner]
+
+    def run(self, argv: Sequence[str], limits: Limits = Limits(),
+            env: dict[str, str] | None = None) -> Outcome:
+        env = dict(env or {})
+        if self.trusted:  # as before the sandbox: the caller's environment and folder
+            full_env, cwd = {**os.environ, **env}, None
+        else:
+            full_env, cwd = None, self.root
+        cmd = self.command(argv, limits, env)
+        user = dict(user=NOBODY, group=NOBODY, extra_groups=[]) if self.drop_to_nobody else {}
+        start = time.perf_counter()
+        p = subprocess.Popen(cmd, stdin=subprocess.DEVNULL, stdout=subprocess.PIPE,
+                             stderr=subprocess.PIPE, env=full_env, cwd=cwd,
+                             start_new_session=True, **user)
+        outcome = _supervise(p, start, limits)
+        if not self.trusted:
+            outcome.cpu_seconds = None
+        if outcome.killed is None and outcome.returncode == 0:
+            used = _tree_size(self._scratch_dir())
+            if used > limits.scratch_bytes:
+                outcome.killed = (f"left {used / 2**20:.0f} MiB in its scratch folder "
+                                  f"(allowed {limits.scratch_bytes / 2**20:.0f} MiB)")
+        return outcome
+
+
+def _tree_size(folder: pathlib.Path) -> int:
+    total = 0
+    for dirpath, _, files in os.walk(folder):
+        for f in files:
+            try:
+                total += os.lstat(os.path.join(dirpath, f)).st_size
+            except OSError:
+                pass
+    return total
+
+
+def _kill_tree(p: subprocess.Popen) -> None:
+    """SIGKILL the process group. In the sandbox that kills bubblewrap, whose PID namespace
+    takes every descendant with it, even those that left the group."""
+    try:
+        os.killpg(p.pid, signal.SIGKILL)
+    except (ProcessLookupError, PermissionError):
+        pass
+
+
+def _supervise(p: subprocess.Popen, start: float, limits: Limits) -> Outcome:
+    """Read both streams up to the cap and wait for the exit within the wall limit. The
+    rusage holds the whole tree's CPU time in trusted mode only (see Outcome.cpu_seconds)."""
+    deadline = start + limits.wall_seconds
+    streams = {p.stdout.fileno(): ("stdout", bytearray()), p.stderr.fileno(): ("stderr", bytearray())}
+    for fd in streams:
+        os.set_blocking(fd, False)
+    pidfd = os.pidfd_open(p.pid)
+    killed, cut, exited_at, status, usage = None, [], None, None, None
+    try:
+        open_fds = set(streams)
+        while True:
+            timeout = deadline - time.perf_counter()
+            if timeout <= 0 and killed is None and exited_at is None:
+                killed = f"timed out after {limits.wall_seconds:g} s (wall clock)"
+                _kill_tree(p)
+            wait_on = list(open_fds) + ([pidfd] if exited_at is None else [])
+            if not wait_on:
+                break
+            # After the exit, give stragglers (trusted mode: children keep pipes open) 1 s.
+            limit = max(timeout, 0.05) if exited_at is None else max(exited_at + 1 - time.perf_counter(), 0)
+            ready, _, _ = select.select(wait_on, [], [], limit)
+            if not ready and exited_at is not None:
+                _kill_tree(p)
+                break
+            for fd in ready:
+                if fd == pidfd:
+                    _, status, usage = os.wait4(p.pid, 0)
+                    exited_at = time.perf_counter()
+                    _kill_tree(p)  # anything left in the group (trusted mode) goes too
+                    continue
+                try:
+                    chunk = os.read(fd, 1 << 16)
+                except BlockingIOError:
+                    continue
+                if not chunk:
+                    open_fds.discard(fd)
+                    continue
+                name, buf = streams[fd]
+                room = limits.output_bytes - len(buf)
+                buf += chunk[:max(room, 0)]
+                if len(chunk) > room and name not in cut:
+                    cut.append(name)
+                    if killed is None:
+                        killed = (f"wrote more than {limits.output_bytes // 1024} KiB on {name}: "
+                                  f"output cut there and the program stopped")
+                        _kill_tree(p)
+    finally:
+        if exited_at is None:  # interrupted (SIGTERM, Ctrl-C): the tree must not outlive us
+            _kill_tree(p)
+            _, status, usage = os.wait4(p.pid, 0)
+        os.close(pidfd)
+        p.stdout.close()
+        p.stderr.close()
+    end = exited_at or time.perf_counter()
+    p.returncode = os.waitstatus_to_exitcode(status) if status is not None else None
+    cpu = usage.ru_utime + usage.ru_stime if usage else 0.0
+    (_, out), (_, err) = streams.values()
+    return Outcome(p.returncode, decode(bytes(out)), decode(bytes(err)), end - start, cpu,
+                   killed, tuple(cut))

@@ -1,0 +1,130 @@
+#!/usr/bin/env python3
+"""The compiler's resource report of lab 05's kernels as a table (`make kernel-report`).
+
+Reads the log of `nvcc -Xptxas -v` (registers, stack frame, spills, shared and constant
+memory per kernel) and adds the theoretical occupancy each kernel's registers allow at its
+block size, for the architecture it was compiled for. Needs no GPU.
+
+    kernel_report.py PTXAS.LOG --arch sm_90 [--out REPORT.md] [--json REPORT.json]
+"""
+from __future__ import annotations
+
+import argparse
+import json
+import re
+import shutil
+import subprocess
+import sys
+
+# Per-multiprocessor limits (CUDA programming guide, "Compute capabilities"): registers,
+# warps, blocks, shared memory per SM in bytes, register allocation unit per warp.
+LIMITS = {
+    75: dict(regs=65536, warps=32, blocks=16, smem=65536, unit=256),
+    80: dict(regs=65536, warps=64, blocks=32, smem=167936, unit=256),
+    86: dict(regs=65536, warps=48, blocks=16, smem=102400, unit=256),
+    89: dict(regs=65536, warps=48, blocks=24, smem=102400, unit=256),
+    90: dict(regs=65536, warps=64, blocks=32, smem=233472, unit=256),
+}
+
+ENTRY = re.compile(r"Compiling entry function '([^']+)' for '(sm_\d+)'")
+FRAME = re.compile(r"(\d+) bytes stack frame, (\d+) bytes spill stores, (\d+) bytes spill loads")
+USED = re.compile(r"Used (\d+) registers")
+SMEM = re.compile(r"(\d+) bytes smem")
+CMEM = re.compile(r"(\d+) bytes cmem\[(\d+)\]")
+
+
+def demangle(names: list[str]) -> dict[str, str]:
+    if not names or shutil.which("c++filt") is None:
+        return {n: n for n in names}
+    out = subprocess.run(["c++filt"], input="\n".join(names), capture_output=True,
+                         text=True).stdout.splitlines()
+    return dict(zip(names, out)) if len(out) == len(names) else {n: n for n in names}
+
+
+def parse(log: str) -> list[dict]:
+    kernels, current = [], None
+    for line in log.splitlines():
+        if m := ENTRY.search(line):
+            current = dict(mangled=m.group(1), arch=m.group(2), registers=0, stack=0,
+                           spill_stores=0, spill_loads=0, smem=0, cmem={})
+            kernels.append(current)
+        elif current is None:
+            continue
+        elif m := FRAME.search(line):
+            current.update(stack=int(m[1]), spill_stores=int(m[2]), spill_loads=int(m[3]))
+        elif m := USED.search(line):
+            current["registers"] = int(m[1])
+            if s := SMEM.search(line):
+                current["smem"] = int(s[1])
+            current["cmem"] = {int(b): int(n) for n, b in CMEM.findall(line)}
+    names = demangle([k["mangled"] for k in kernels])
+    for k in kernels:
+        k["name"] = names[k["mangled"]]
+        k["block_threads"] = block_threads(k["name"])
+    return kernels
+
+
+def block_threads(name: str) -> int:
+    """render_kernel<T, memory, BLOCK, ...>; the benchmark's plain kernel uses 16x16."""
+    if m := re.search(r"render_kernel<(\d+), [^,]+, (\d+),", name):
+        return int(m[2])
+    return 256
+
+
+def occupancy(registers: int, block: int, smem: int, arch: int) -> float:
+    """Fraction of the SM's warp slots that resident blocks of this kernel can fill."""
+    lim = LIMITS.get(arch, LIMITS[90])
+    warps_per_block = -(-block // 32)
+    regs_per_warp = -(-max(registers, 1) * 32 // lim["unit"]) * lim["unit"]
+    by_regs = (lim["regs"] // regs_per_warp) // warps_per_block
+    by_warps = lim["warps"] // warps_per_block
+    by_smem = lim["smem"] // (smem + 1024) if smem else lim["blocks"]
+    blocks = min(by_regs, by_warps, lim["blocks"], by_smem)
+    return blocks * warps_per_block / lim["warps"]
+
+
+def short(name: str) -> str:
+    name = name.replace("(SceneMemory)0", "global").replace("(SceneMemory)1", "constant")
+    name = name.replace("(SceneMemory)2", "shared").replace("SceneMemory::", "")
+    return re.sub(r"^void |\(.*\)$", "", name)
+
+
+def main() -> int:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("log")
+    parser.add_argument("--arch", default="sm_90")
+    parser.add_argument("--out")
+    parser.add_argument("--json")
+    args = parser.parse_args()
+    kernels = parse(open(args.log).read())
+    if not kernels:
+        print(f"kernel-report: no kernels found in {args.log}", file=sys.stderr)
+        return 1
+    arch = int(args.arch.removeprefix("sm_"))
+    seen, rows = set(), []
+    for k in kernels:
+        if k["mangled"] in seen:  # the same kernel compiled in two files
+            continue
+        seen.add(k["mangled"])
+        k["occupancy"] = occupancy(k["registers"], k["block_threads"], k["smem"], arch)
+        rows.append(k)
+    lines = [f"Kernel resources for {args.arch} (nvcc -Xptxas -v); occupancy is the theoretical",
+             "fraction of warp slots the registers allow at the kernel's block size "
+             "(shared memory for the scene, when used, is dynamic and not counted).", "",
+             "| kernel | block | registers | spill stores (B) | spill loads (B) | stack (B) "
+             "| static smem (B) | occupancy |", "|---|---:|---:|---:|---:|---:|---:|---:|"]
+    for k in rows:
+        lines.append(f"| `{short(k['name'])}` | {k['block_threads']} | {k['registers']} | "
+                     f"{k['spill_stores']} | {k['spill_loads']} | {k['stack']} | {k['smem']} | "
+                     f"{k['occupancy']:.0%} |")
+    text = "\n".join(lines) + "\n"
+    if args.out:
+        open(args.out, "w").write(text)
+    if args.json:
+        json.dump(rows, open(args.json, "w"), indent=1)
+    print(text, end="")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,97 @@
+// The scene as one block of 16-byte words (materials, then spheres, then triangles), so that
+// a single copy puts it in any of the GPU's memories, and the SceneView the shared core reads
+// from it wherever it lies: global memory, the constant bank or a block's shared memory.
+#pragma once
+
+#include <cuda_runtime.h>
+
+#include <cstring>
+#include <vector>
+
+#include <scene_view.h>
+
+// Where the kernel reads the scene from. Every thread of a warp reads the same primitive at
+// the same time (the core's loops run over all primitives in order), so each memory serves
+// a warp's read as one broadcast; they differ in latency and in how much scene fits.
+enum class SceneMemory {
+    Global,    // device memory through the L1 cache: any size
+    Constant,  // the constant bank and its cache: up to kConstantPoolBytes
+    Shared,    // copied into each block's shared memory at its start: up to the block limit
+};
+
+// Where each array starts in the pool, in 16-byte words, and the scene's small fields.
+struct SceneLayout {
+    int num_spheres = 0, num_triangles = 0, num_materials = 0;
+    int material_word = 0, sphere_word = 0, triangle_word = 0;  // in this order
+    int words = 0;  // the whole pool
+    PointLight light{};
+    bool has_light = false;
+    Vec3 background{0.0f};
+
+    size_t bytes() const { return static_cast<size_t>(words) * sizeof(float4); }
+
+    // The core's view of a pool that starts at `pool`, in whichever memory that is. Inlined
+    // into the kernel, the compiler sees where the pointers came from and uses that memory's
+    // own load instructions (LDC for constant, LDS for shared).
+    __host__ __device__ SceneView view(const float4* pool) const {
+        return {reinterpret_cast<const Sphere*>(pool + sphere_word),     num_spheres,
+                reinterpret_cast<const Triangle*>(pool + triangle_word), num_triangles,
+                reinterpret_cast<const Material*>(pool + material_word), num_materials,
+                light,                                                   has_light,
+                background};
+    }
+};
+
+inline int words_for(size_t bytes) { return static_cast<int>((bytes + 15) / 16); }
+
+// The layout of a scene's pool (`scene`: its arrays on the host).
+inline SceneLayout layout_of(const SceneView& scene) {
+    SceneLayout l;
+    l.num_spheres = scene.num_spheres;
+    l.num_triangles = scene.num_triangles;
+    l.num_materials = scene.num_materials;
+    l.material_word = 0;
+    l.sphere_word = l.material_word + words_for(scene.num_materials * sizeof(Material));
+    l.triangle_word = l.sphere_word + words_for(scene.num_spheres * sizeof(Sphere));
+    l.words = l.triangle_word + words_for(scene.num_triangles * sizeof(Triangle));
+    l.light = scene.light;
+    l.has_light = scene.has_light;
+    l.background = scene.background;
+    return l;
+}
+
+// The pool's bytes on the host, ready to copy.
+inline std::vector<float4> pack(const SceneView& scene, const SceneLayout& l) {
+    std::vector<float4> pool(l.words > 0 ? l.words : 1, float4{0, 0, 0, 0});
+    const auto put = [&](int word, const void* data, size_t bytes) {
+        if (bytes) std::memcpy(pool.data() + word, data, bytes);
+    };
+    put(l.material_word, scene.materials, scene.num_materials * sizeof(Material));
+    put(l.sphere_word, scene.spheres, scene.num_spheres * sizeof(Sphere));
+    put(l.triangle_word, scene.triangles, scene.num_triangles * sizeof(Triangle));
+    return pool;
+}
+
+// The constant bank's copy: 48 KiB of the 64 KiB a program may use (about 850 triangles),
+// leaving room for the constants the compiler places there itself.
+constexpr size_t kConstantPoolBytes = 48 * 1024;
+__constant__ float4 constant_pool[kConstantPoolBytes / sizeof(float4)];
+
+inline bool fits_constant(const SceneLayout& l) { return l.bytes() <= kConstantPoolBytes; }
+
+// The scene as one block of the kernel sees it, given the pool in global memory. For
+// Shared, the block's threads first copy the pool into `shared` together; every thread of
+// the block must call this, before any of them returns.
+template <SceneMemory kMemory>
+__device__ inline SceneView scene_in(const SceneLayout& layout, const float4* global_pool,
+                                     float4* shared) {
+    if constexpr (kMemory == SceneMemory::Constant) {
+        return layout.view(constant_pool);
+    } else if constexpr (kMemory == SceneMemory::Shared) {
+        for (int i = threadIdx.x; i < layout.words; i += blockDim.x) shared[i] = global_pool[i];
+        __syncthreads();
+        return layout.view(shared);
+    } else {
+        return layout.view(global_pool);
+    }
+}

@@ -1,0 +1,121 @@
+// Lab 05: your copy, yours to edit. Every place to fill in is marked TODO(lab05).
+// The megakernel: every thread traces whole camera paths, first ray to last bounce, with the
+// shared core (trace_path, or the bounce_step it loops over), so the GPU image is lab 01's
+// estimator with lab 01's random numbers. The threads of one pixel split its samples between
+// them and add their partial sums in a fixed order, so the image is reproducible bit for bit.
+#pragma once
+
+#include <cstdint>
+
+#include <path_tracer.h>
+
+#include "scene_pool.cuh"
+
+// What one launch renders: rows [first_row, first_row + rows) of the image, into `pixels`
+// (rows x width, row-major). A large image is rendered as several such bands.
+struct KernelArgs {
+    SceneLayout layout;         // where the scene's arrays lie in the pool
+    const float4* scene_pool;   // the pool in global memory (also the source of the copies)
+    Camera camera;              // for the whole image
+    RenderSettings settings;    // width, height, spp, bounces, seed
+    int first_row;              // the band's first image row
+    int rows;                   // the band's height
+    Vec3* pixels;               // the band's pixels in device memory
+};
+
+// The camera ray and random numbers of sample s of pixel (x, y): what the core's render_pixel
+// uses for it.
+struct CameraSample {
+    SampleStream rng;
+    Ray ray;
+};
+__device__ inline CameraSample camera_sample(const KernelArgs& args, int x, int y, uint64_t pixel,
+                                             int s) {
+    const SampleStream rng(args.settings.seed, pixel, static_cast<uint64_t>(s));
+    return {rng, args.camera.ray_through(x + rng.at(kDimPixelX), y + rng.at(kDimPixelY))};
+}
+
+// One thread's samples of pixel (x, y): s = first, first + stride, ... below spp, one after
+// the other, each path traced to its end by the core's trace_path. Simple, but a warp's lanes
+// wait for each other at every sample: a lane whose path escapes after one bounce idles
+// while another's bounces on, so each sample costs the warp its longest path.
+__device__ inline SampleSum trace_samples(const SceneView& scene, const KernelArgs& args, int x,
+                                          int y, uint64_t pixel, int first, int stride) {
+    SampleSum sum;  // in double, as render_pixel's
+    // TODO(lab05): trace samples first, first + stride, ... below args.settings.spp with
+    // camera_sample and trace_path, adding each path's radiance to sum.
+    (void)scene;
+    (void)x;
+    (void)y;
+    (void)pixel;
+    (void)first;
+    (void)stride;
+    return sum;
+}
+
+// The same samples, the same paths, the same sum, but by bounces: each iteration of the loop
+// is one bounce of the lane's current path (the core's closest_hit, bounce_step and shadow
+// query, as in trace_path's loop), and a lane whose path has ended starts its next sample in
+// the same iteration ("path regeneration"). The warp's lanes then stay busy until each has
+// run out of samples: a warp costs about its longest lane's total of bounces rather than the
+// sum over samples of the longest path. The image is bit for bit trace_samples' (the same
+// operations on each path, the samples added in the same order).
+__device__ inline SampleSum trace_samples_regenerating(const SceneView& scene,
+                                                       const KernelArgs& args, int x, int y,
+                                                       uint64_t pixel, int first, int stride) {
+    SampleSum sum;
+    // TODO(lab05, for speed, once trace_samples works): the same samples, but one bounce
+    // per loop iteration (closest_hit, bounce_step, occluded, as trace_path's loop does),
+    // starting the lane's next sample as soon as its path ends. Until then: trace_samples.
+    sum = trace_samples(scene, args, x, y, pixel, first, stride);
+    return sum;
+}
+
+// The total of the partial sums of kLanes neighbouring lanes (kLanes a power of two, at most
+// a warp), by a butterfly of shuffles: after step k every lane holds the sum of its group of
+// 2^k lanes. Every lane of the warp must call it. The order of the additions depends on lane
+// numbers only, and a + b == b + a exactly, so all kLanes lanes end with the same bits on
+// every run.
+template <int kLanes>
+__device__ inline SampleSum sum_across_lanes(SampleSum sum) {
+    static_assert(kLanes >= 1 && kLanes <= 32 && (kLanes & (kLanes - 1)) == 0,
+                  "a pixel's threads must be a power of two within one warp");
+#pragma unroll
+    for (int offset = kLanes / 2; offset > 0; offset /= 2) {
+        sum.r += __shfl_xor_sync(0xffffffffu, sum.r, offset);
+        sum.g += __shfl_xor_sync(0xffffffffu, sum.g, offset);
+        sum.b += __shfl_xor_sync(0xffffffffu, sum.b, offset);
+    }
+    return sum;
+}
+
+// kThreadsPerPixel threads per pixel, neighbours in one warp; thread k of a pixel traces its
+// samples k, k + kThreadsPerPixel, k + 2 kThreadsPerPixel, ... (the counts differ by at most
+// one), by bounces (kRegenerate) or by whole paths. kMemory: where the scene is read from
+// (scene_pool.cuh). __launch_bounds__ tells the compiler the block size; kMaxRegisters caps
+// the registers per thread (255, the hardware's most, caps nothing), so that more threads fit
+// on a multiprocessor, at the price of spills.
+template <int kThreadsPerPixel, SceneMemory kMemory, int kBlockThreads, bool kRegenerate = true,
+          int kMaxRegisters = 255>
+__global__ void __launch_bounds__(kBlockThreads) __maxnreg__(kMaxRegisters)
+    render_kernel(const KernelArgs args) {
+    extern __shared__ float4 shared_pool[];  // used only when kMemory is Shared
+    const SceneView scene = scene_in<kMemory>(args.layout, args.scene_pool, shared_pool);
+    const int width = args.settings.width;
+    // TODO(lab05): the kernel. Give each thread its share of the band's work: from
+    // blockIdx.x, kBlockThreads and threadIdx.x, its pixel (x, y) and the first of that
+    // pixel's samples it traces (kThreadsPerPixel threads per pixel, trace_samples); skip
+    // what lies past the band's last pixel; combine the pixel's partial sums
+    // (sum_across_lanes) and store sum.mean(spp) once per pixel in args.pixels
+    // (band-relative index). Until then: one thread per image row walks the row's pixels,
+    // one path each.
+    const int row = static_cast<int>(blockIdx.x * kBlockThreads + threadIdx.x);
+    if (row >= args.rows) return;
+    const int y = args.first_row + row;
+    for (int x = 0; x < width; ++x) {
+        const uint64_t pixel = static_cast<uint64_t>(y) * width + x;
+        const CameraSample c = camera_sample(args, x, y, pixel, 0);
+        args.pixels[static_cast<long long>(row) * width + x] =
+            trace_path(scene, c.ray, c.rng, args.settings.bounces);
+    }
+}

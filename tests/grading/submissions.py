@@ -1,0 +1,144 @@
+"""Hostile and broken "submissions" for the grader's tests: each is one executable file, which
+is all the grader runs. Most are shell scripts; those that must render correctly carry a copy
+of the lab-01 reference inside themselves (the sandbox shows a submission nothing of the
+repository, so a script cannot just exec ./lab01-ref) and unpack it into their scratch folder.
+"""
+from __future__ import annotations
+
+import pathlib
+import subprocess
+
+from grading.harness import ROOT
+
+REFERENCE = ROOT / "lab01-ref"
+
+
+def script(folder: pathlib.Path, body: str, name: str = "lab") -> pathlib.Path:
+    path = folder / name
+    path.write_text("#!/bin/sh\n" + body)
+    path.chmod(0o755)
+    return path
+
+
+def carrying_reference(folder: pathlib.Path, body: str, name: str = "lab") -> pathlib.Path:
+    """A script whose payload is the lab-01 reference: `body` runs after `./ref` (the
+    unpacked reference) exists in the working folder, with the script's arguments in "$@"."""
+    payload = REFERENCE.read_bytes()
+    head = (f"tail -c {len(payload)} \"$0\" > ./ref && chmod +x ./ref || exit 99\n"
+            f"{body}\nexit $?\n")
+    path = folder / name
+    path.write_bytes(b"#!/bin/sh\n" + head.encode() + payload)
+    path.chmod(0o755)
+    return path
+
+
+# Sets $pfm and $scene to the values of --pfm and --scene in the arguments.
+FIND_ARGS = """pfm=""; scene=""; prev=""
+for a in "$@"; do
+  [ "$prev" = "--pfm" ] && pfm="$a"
+  [ "$prev" = "--scene" ] && scene="$a"
+  prev="$a"
+done
+"""
+
+# Overwrites the first float of the PFM named by $pfm with a NaN (little-endian 0x7fc00000).
+POISON_FIRST_PIXEL = """offset=$(head -n 3 "$pfm" | wc -c)
+printf '\\000\\000\\300\\177' | dd of="$pfm" bs=1 seek="$offset" conv=notrunc 2>/dev/null
+"""
+
+
+def nan_pixel(folder, only_in_scaled_scenes=False) -> pathlib.Path:
+    """The reference with one NaN pixel in its image (in every run, or only in the scaled scenes
+    of the scale-invariance check, whose files are named scaled-*.json)."""
+    condition = 'case "$scene" in *scaled-*) true;; *) false;; esac' if only_in_scaled_scenes \
+        else "true"
+    return carrying_reference(folder, f"""{FIND_ARGS}./ref "$@" || exit $?
+if {condition}; then
+{POISON_FIRST_PIXEL}fi""")
+
+
+def lying_about_seconds(folder) -> pathlib.Path:
+    """Serial and correct, but reports a render time of a millisecond."""
+    return carrying_reference(folder, """./ref "$@" > ./out || exit $?
+sed 's/"seconds": [0-9.e+-]*/"seconds": 0.001/' ./out""")
+
+
+def exec_reference(folder) -> pathlib.Path:
+    """The one-line wrapper: the reference's path is compiled into every build."""
+    return script(folder, f'exec "{REFERENCE}" "$@"\n')
+
+
+def hang_with_grandchild(folder, marker: str) -> pathlib.Path:
+    """Forks a grandchild that keeps stdout open and would overwrite results later, then hangs."""
+    return script(folder, f"""(sh -c 'sleep {marker}; echo late > results.json' &)
+sleep {marker}
+""")
+
+
+def crash(folder) -> pathlib.Path:
+    return script(folder, 'kill -SEGV $$\n')
+
+
+def flood(folder, stream: str, size: int) -> pathlib.Path:
+    redirect = ">&2" if stream == "stderr" else ""
+    return script(folder, f"head -c {size} /dev/zero | tr '\\0' x {redirect}\n")
+
+
+def non_utf8_stderr(folder) -> pathlib.Path:
+    """Correct, but says something on stderr that is not UTF-8."""
+    return carrying_reference(folder, """printf 'warning: \\377\\376 odd bytes\\n' >&2
+./ref "$@" """)
+
+
+def spy(folder, targets: dict[str, pathlib.Path]) -> pathlib.Path:
+    """Correct, but first tries to read solutions and golden data, to overwrite golden data
+    and to write outside its scratch folder; prints 'SPY <what>' on stderr for each success."""
+    lines = []
+    for what, path in targets.items():
+        if what.startswith("write"):
+            lines.append(f'(echo tampered > "{path}") 2>/dev/null && echo "SPY {what}" >&2')
+        else:
+            lines.append(f'cat "{path}" >/dev/null 2>&1 && echo "SPY {what}" >&2')
+    return carrying_reference(folder, "\n".join(lines) + '\n./ref "$@"')
+
+
+SOCKET_CLIENT = r"""
+#include <arpa/inet.h>
+#include <cstdio>
+#include <cstdlib>
+#include <netinet/in.h>
+#include <sys/socket.h>
+#include <unistd.h>
+// Connects to 127.0.0.1:PORT (argv[1]) and exits 0 if that worked, 3 if not.
+int main(int argc, char** argv) {
+    int s = socket(AF_INET, SOCK_STREAM, 0);
+    if (s < 0) { std::perror("socket"); return 3; }
+    sockaddr_in a{};
+    a.sin_family = AF_INET;
+    a.sin_port = htons(static_cast<unsigned short>(std::atoi(argc > 1 ? argv[1] : "1")));
+    a.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
+    if (connect(s, reinterpret_cast<sockaddr*>(&a), sizeof a) != 0) { std::perror("connect"); return 3; }
+    std::puts("connected");
+    return 0;
+}
+"""
+
+
+def socket_client(folder) -> pathlib.Path:
+    src = folder / "client.cpp"
+    src.write_text(SOCKET_CLIENT)
+    subprocess.run(["g++", "-O1", "-o", str(folder / "client"), str(src)], check=True)
+    return folder / "client"
+
+
+def golden_copier(folder) -> pathlib.Path:
+    """Recognises the golden scenes by name and prints the stored golden images; anything else
+    it cannot render."""
+    import base64
+    from grading.harness import GOLDEN
+    cases = []
+    for scene in ("cornell", "showcase"):
+        data = base64.b64encode((GOLDEN / scene / "golden.pfm").read_bytes()).decode()
+        cases.append(f'  *{scene}.json) base64 -d > "$pfm" <<END\n{data}\nEND\n  ;;')
+    return script(folder, FIND_ARGS + 'case "$scene" in\n' + "\n".join(cases) +
+                  '\n  *) exit 1;;\nesac\necho \'{"lab": "copy", "seconds": 0.001}\'\n')

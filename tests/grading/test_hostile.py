@@ -1,0 +1,260 @@
+"""The grader against a catalogue of broken and hostile submissions (tests/grading/
+submissions.py): each loses the points it should, with a message naming the symptom, and
+leaves the grader, the repository and the machine as they were."""
+import hashlib
+import json
+import os
+import pathlib
+import signal
+import subprocess
+import sys
+import time
+
+import pytest
+
+from grading import sandbox
+from grading.grade import describe, grade, passed_by_check
+from grading.harness import GOLDEN, ROOT
+from tests.grading import submissions as sub
+
+
+@pytest.fixture(autouse=True)
+def needs_sandbox():
+    reason = sandbox.probe()
+    if reason:  # `make deps` installs bubblewrap; without it the grader grades nothing
+        pytest.fail(f"the grader's sandbox is not available here: {reason}")
+
+
+def outputs(results) -> list[str]:
+    return [t["output"] for t in results["tests"]]
+
+
+def survivors(marker: str) -> list[str]:
+    """Processes whose command line holds `marker` (a sleep length no one else uses)."""
+    found = []
+    for entry in pathlib.Path("/proc").iterdir():
+        if entry.name.isdigit():
+            try:
+                cmdline = (entry / "cmdline").read_bytes().replace(b"\0", b" ").decode()
+            except OSError:
+                continue
+            if marker in cmdline:
+                found.append(f"{entry.name}: {cmdline}")
+    return found
+
+
+def tree_digest(folder: pathlib.Path) -> str:
+    h = hashlib.sha256()
+    for f in sorted(folder.rglob("*")):
+        if f.is_file():
+            h.update(str(f).encode() + f.read_bytes())
+    return h.hexdigest()
+
+
+def test_exec_the_reference_wrapper_scores_nothing(tmp_path):
+    results = grade("01", sub.exec_reference(tmp_path), tmp_path)
+    assert results["score"] == 0, describe(results)
+    assert all("exited with status 127" in o or "not graded" in o for o in outputs(results)), \
+        describe(results)
+    # Trusted (make grade at home), where the repository is in view, the same wrapper works:
+    # the sandbox is what stops it.
+    assert grade("01", sub.exec_reference(tmp_path), tmp_path, trusted=True)["score"] == 100
+
+
+def test_lying_about_seconds_earns_no_speed(tmp_path):
+    """Serial, correct, and reporting a render time of 1 ms: the grader's own clock decides."""
+    results = grade("02", sub.lying_about_seconds(tmp_path), tmp_path)
+    passed = passed_by_check(results)
+    assert passed["golden-cornell"] and passed["golden-showcase"], describe(results)
+    assert not passed["speedup"], describe(results)
+    speedup = next(t["output"] for t in results["tests"] if t["extra_data"]["check"] == "speedup")
+    assert "wall clock measured by the grader" in speedup, speedup
+
+
+def test_one_nan_pixel_fails_every_image_check(tmp_path):
+    results = grade("01", sub.nan_pixel(tmp_path), tmp_path)
+    assert results["score"] == 0, describe(results)
+    for t in results["tests"]:
+        assert "1 NaN" in t["output"] or t["output"].startswith("not graded until"), describe(results)
+
+
+def test_nan_only_in_the_scaled_scenes_fails_the_scale_check(tmp_path):
+    results = grade("01", sub.nan_pixel(tmp_path, only_in_scaled_scenes=True), tmp_path)
+    passed = passed_by_check(results)
+    assert not passed.pop("scale"), describe(results)
+    assert all(passed.values()), describe(results)
+    assert results["score"] == 90
+
+
+def test_copying_the_golden_images_earns_nothing(tmp_path):
+    """The golden images are in the repository; the hidden scene, made from a secret at
+    grading time, is not, and the golden images count only when it passes."""
+    results = grade("01", sub.golden_copier(tmp_path), tmp_path)
+    assert results["score"] == 0, describe(results)
+    golden = next(t for t in results["tests"] if t["extra_data"]["check"] == "golden-cornell")
+    assert golden["output"] == "not graded until the hidden scene passes", describe(results)
+
+
+def test_the_hidden_scene_depends_on_the_secret():
+    from grading.hidden import hidden_scene
+    assert hidden_scene("a") == hidden_scene("a") != hidden_scene("b")
+
+
+def test_a_hang_with_a_grandchild_is_killed_tree_and_all(tmp_path):
+    marker = "987651"
+    start = time.perf_counter()
+    results = grade("01", sub.hang_with_grandchild(tmp_path, marker), tmp_path, run_seconds=1)
+    took = time.perf_counter() - start
+    assert results["score"] == 0, describe(results)
+    assert all("timed out after 1 s" in o or "not graded" in o for o in outputs(results)), \
+        describe(results)
+    assert took < 30, f"grading a hanging program took {took:.0f} s"
+    assert not survivors(marker), survivors(marker)
+
+
+def test_a_crash_is_named(tmp_path):
+    results = grade("01", sub.crash(tmp_path), tmp_path)
+    assert results["score"] == 0
+    assert "segmentation fault" in results["tests"][0]["output"], describe(results)
+
+
+def test_non_utf8_stderr_does_not_cost_points(tmp_path):
+    results = grade("01", sub.non_utf8_stderr(tmp_path), tmp_path)
+    assert results["score"] == 100, describe(results)
+
+
+def test_the_sandbox_hides_solutions_golden_data_and_the_repository(tmp_path):
+    """A spy that tries to read solutions and golden data, to overwrite the golden data and to
+    write into the repository and /tmp: nothing of it works, and it still renders correctly."""
+    targets = {
+        "read solution": ROOT / "labs" / "01-serial" / "solution" / "render.cpp",
+        "read golden": GOLDEN / "cornell" / "golden.pfm",
+        "read grader": ROOT / "grading" / "grade.py",
+        "write golden": GOLDEN / "cornell" / "meta.json",
+        "write repository": ROOT / "spy-was-here",
+        "write tmp outside": tmp_path / "spy-was-here",
+    }
+    before = tree_digest(GOLDEN)
+    meta = targets["write golden"].read_bytes()
+    binary = sub.spy(tmp_path, targets)
+    from grading.harness import RunPolicy, policy, run_lab
+    try:
+        with policy(RunPolicy(trusted=False)):
+            run = run_lab(binary, width=8, height=8, spp=1)
+        assert "SPY" not in run.stderr, run.stderr
+        results = grade("01", binary, tmp_path)
+        assert results["score"] == 100, describe(results)
+        assert tree_digest(GOLDEN) == before
+        assert not (ROOT / "spy-was-here").exists() and not (tmp_path / "spy-was-here").exists()
+    finally:  # had the sandbox leaked, the golden data must still be whole for other tests
+        if targets["write golden"].read_bytes() != meta:
+            targets["write golden"].write_bytes(meta)
+        (ROOT / "spy-was-here").unlink(missing_ok=True)
+    # The same spy, trusted, reads the solution: the test would see a leak.
+    with policy(RunPolicy(trusted=True)):
+        trusted = run_lab(binary, width=8, height=8, spp=1)
+    assert "SPY read solution" in trusted.stderr, trusted.stderr
+    targets["write golden"].write_bytes(meta)  # the trusted spy did overwrite it
+    (ROOT / "spy-was-here").unlink(missing_ok=True)
+
+
+@pytest.mark.parametrize("stream", ["stdout", "stderr"])
+def test_an_output_flood_is_cut(tmp_path, stream):
+    """1 GiB on stdout or 10 MiB on stderr: the grader keeps 1 MiB, stops the program, says
+    so, stays small itself and writes a small results.json."""
+    size = (1 << 30) if stream == "stdout" else 10 << 20
+    binary = sub.flood(tmp_path, stream, size)
+    out = tmp_path / "results.json"
+    p = subprocess.Popen([sys.executable, "-m", "grading.grade", "01", "--binary", str(binary),
+                          "--results", str(out), "--heatmaps", str(tmp_path / "maps")],
+                         cwd=ROOT, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE)
+    _, status, usage = os.wait4(p.pid, 0)
+    p.returncode = os.waitstatus_to_exitcode(status)
+    assert p.returncode == 0, p.stderr.read()
+    results = json.loads(out.read_text())
+    assert results["score"] == 0
+    assert f"wrote more than 1024 KiB on {stream}" in results["tests"][0]["output"], describe(results)
+    assert out.stat().st_size < 100_000, out.stat().st_size
+    assert usage.ru_maxrss < 400_000, f"the grader grew to {usage.ru_maxrss // 1024} MiB"
+
+
+def test_no_network(tmp_path):
+    import socket
+    client = sub.socket_client(tmp_path)
+    with socket.socket() as server:
+        server.bind(("127.0.0.1", 0))
+        server.listen()
+        port = str(server.getsockname()[1])
+        with sandbox.Runner(trusted=False) as r:
+            inside = r.run([r.input(client), port])
+        with sandbox.Runner(trusted=True) as r:
+            outside = r.run([r.input(client), port])
+    assert inside.returncode == 3 and "connect" in inside.stderr, (inside.returncode, inside.stderr)
+    assert outside.returncode == 0, outside.stderr  # the client does work: the test can fail
+
+
+def test_a_compile_error_still_writes_results(tmp_path):
+    src = tmp_path / "src"
+    src.mkdir()
+    (src / "render.cpp").write_text("int broken( { return 0 }\n")
+    out = tmp_path / "results.json"
+    p = subprocess.run([sys.executable, "-m", "grading.grade", "01", "--sources", str(src),
+                        "--results", str(out)], cwd=ROOT, capture_output=True, text=True,
+                       timeout=300)
+    assert p.returncode == 1, p.stderr
+    results = json.loads(out.read_text())
+    assert results["score"] == 0
+    assert "does not compile" in results["output"] and "error:" in results["output"], results
+    assert all("does not compile" in o for o in outputs(results))
+
+
+def test_including_the_solution_does_not_compile(tmp_path):
+    """The compiler runs in the sandbox too: a render.cpp that #includes the solution (its
+    path is compiled into every build) finds nothing there. Trusted, it would compile."""
+    from grading.grade import build_lab
+    solution = ROOT / "labs" / "01-serial" / "solution" / "render.cpp"
+    (tmp_path / "render.cpp").write_text(f'#include "{solution}"\n')
+    binary, errors = build_lab("01", tmp_path, trusted=False)
+    assert binary is None and "No such file or directory" in errors, errors
+    binary, errors = build_lab("01", tmp_path, trusted=True)
+    assert binary is not None, errors
+
+
+def test_an_interrupted_grader_leaves_complete_results_and_no_processes(tmp_path):
+    marker = "987652"
+    binary = sub.hang_with_grandchild(tmp_path, marker)
+    out = tmp_path / "results.json"
+    p = subprocess.Popen([sys.executable, "-m", "grading.grade", "01", "--binary", str(binary),
+                          "--results", str(out), "--run-seconds", "60"], cwd=ROOT,
+                         stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True)
+    deadline = time.time() + 60
+    while not survivors(marker) and time.time() < deadline:  # the submission runs
+        time.sleep(0.1)
+    assert survivors(marker), "the hanging submission never started"
+    p.send_signal(signal.SIGTERM)
+    assert p.wait(timeout=30) == 130, p.stderr.read()
+    results = json.loads(out.read_text())
+    assert results["score"] == 0 and "interrupted" in results["output"], results
+    assert all(t["status"] == "failed" for t in results["tests"])
+    time.sleep(0.5)
+    assert not survivors(marker), survivors(marker)
+
+
+def test_no_sandbox_no_grading(tmp_path, monkeypatch):
+    """Where bubblewrap is missing the grader refuses untrusted code, in one line, and still
+    writes results; --trusted (make grade, your own code) grades without it."""
+    monkeypatch.setattr(sandbox, "probe", lambda: "bubblewrap (bwrap) is not installed")
+    results = grade("01", sub.REFERENCE, tmp_path)
+    assert results["score"] == 0 and results["output"].startswith("refusing"), results["output"]
+    assert "\n" not in results["output"]
+    trusted = grade("01", sub.REFERENCE, tmp_path, trusted=True)
+    assert trusted["score"] == 100, describe(trusted)
+
+
+def test_a_missing_binary_still_writes_results(tmp_path):
+    out = tmp_path / "results.json"
+    p = subprocess.run([sys.executable, "-m", "grading.grade", "01", "--binary",
+                        str(tmp_path / "nothing"), "--results", str(out)], cwd=ROOT,
+                       capture_output=True, text=True, timeout=120)
+    assert p.returncode == 2 and "no such binary" in p.stderr
+    assert json.loads(out.read_text())["score"] == 0

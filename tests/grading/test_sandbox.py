@@ -1,0 +1,63 @@
+"""grading/sandbox.py on its own: what a sandboxed process may touch, and its limits."""
+import pytest
+
+from grading import sandbox
+from grading.sandbox import Limits, Runner, describe_exit
+
+
+@pytest.fixture(autouse=True)
+def needs_sandbox():
+    reason = sandbox.probe()
+    if reason:
+        pytest.fail(f"the grader's sandbox is not available here: {reason}")
+
+
+def sh(script: str, limits: Limits = Limits(wall_seconds=10), **runner):
+    with Runner(trusted=False, **runner) as r:
+        return r.run(["/bin/sh", "-c", script], limits)
+
+
+def test_only_scratch_and_tmp_are_writable():
+    out = sh("for p in /job/x /usr/x /x /etc/x /proc/x /scratch/ok /tmp/ok; do "
+             "(echo > $p) 2>/dev/null && echo wrote $p; done; id -u")
+    assert out.stdout.split() == ["wrote", "/scratch/ok", "wrote", "/tmp/ok", "65534"], out
+
+
+def test_it_sees_only_its_inputs(tmp_path):
+    secret = tmp_path / "secret.txt"
+    secret.write_text("x")
+    given = tmp_path / "given.txt"
+    given.write_text("y")
+    with Runner(trusted=False) as r:
+        inside = r.input(given)
+        out = r.run(["/bin/sh", "-c", f"ls /job; cat {inside}; cat {secret}; ls /root /home"])
+    assert out.stdout.split() == ["0-given.txt", "y"], out
+
+
+def test_file_size_limit_is_named():
+    out = sh("head -c 2000000 /dev/zero > big", Limits(wall_seconds=10, file_bytes=1 << 20))
+    assert "file size limit exceeded" in out.failure, out
+
+
+def test_what_is_left_in_scratch_is_limited():
+    out = sh("for i in 1 2 3; do head -c 600000 /dev/zero > f$i; done",
+             Limits(wall_seconds=10, scratch_bytes=1 << 20))
+    assert out.failure and "left 2 MiB in its scratch folder" in out.failure, out
+
+
+def test_process_limit():
+    out = sh("for i in $(seq 40); do sleep 3 & done; wait", Limits(wall_seconds=10, processes=20))
+    assert "fork" in out.stderr.lower(), out
+
+
+def test_wall_limit_counts_from_outside():
+    out = sh("sleep 30", Limits(wall_seconds=0.5))
+    assert out.failure == "timed out after 0.5 s (wall clock)"
+    assert 0.5 <= out.wall_seconds < 3
+
+
+@pytest.mark.parametrize("code, name", [(-11, "segmentation fault (signal 11)"),
+                                        (139, "segmentation fault (signal 11)"),
+                                        (134, "aborted (signal 6)"), (3, "exited with status 3")])
+def test_exit_statuses_are_named(code, name):
+    assert describe_exit(code) == name

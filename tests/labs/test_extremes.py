@@ -1,0 +1,86 @@
+"""Scenes far from the origin, primitives far larger than the view, and the whole float range
+the scene loader accepts: each renders as its plain version does, within the noise, or is
+refused at load with one line that says what to do (common/host/scene_limits.h).
+
+What makes it hold (common/core): light measured from the surface point, not from the offset
+ray origin (path_tracer.h's sample_light); ray offsets that grow with the primitive's own
+coordinates, not only with the hit point's (ray.h); triangle normals computed in double
+(triangle.h). Lab 02 runs the same checks on its references (test_lab02.py).
+"""
+import pytest
+
+from grading import checks, scenes
+from grading.compare import compare
+from grading.harness import golden, run_lab
+
+
+def test_translation_invariance(lab01_ref):
+    """The sphere interior and a lit floor, moved by up to 1e4 times their size."""
+    result = checks.check_translation_invariance(lab01_ref)
+    assert result.passed, str(result)
+
+
+def test_large_primitives(lab01_ref):
+    """Floors (quads and spheres) of half-size up to 1e5, seen from 1 unit above."""
+    result = checks.check_large_primitives(lab01_ref)
+    assert result.passed, str(result)
+
+
+@pytest.mark.parametrize("factor", [1e-4, 1e5])
+@pytest.mark.parametrize("half", [10.0, 1e4])
+def test_floor_of_any_size_at_any_scale(lab01_ref, factor, half):
+    """The lit floor scaled as a whole by 1e-4 or 1e5 (up to the loader's 1e9 coordinates),
+    with a floor 10 or 1e4 times the camera's height: closed form per pixel."""
+    err = checks.render_floor(lab01_ref, scenes.scaled(scenes.floor_view(half), factor))
+    assert err.mean() < 1.5e-2, f"mean relative error {err.mean():.2e}"
+
+
+def test_cornell_moved_far_matches_golden(lab01_ref, tmp_path):
+    """The Cornell box (1 unit wide) moved 1000 of its sizes from the origin is the golden
+    image's scene still: the noise-aware comparison passes. (Farther out the ray offsets,
+    20 float ulps of the coordinates, reach ~1% of the box and its corners lighten: at 5000
+    sizes the comparison fails. Measured; the light is not the cause, it is measured from
+    the surface point.)"""
+    g = golden("cornell")
+    scene = scenes.translated(scenes.load("cornell"), [1e3, -0.7e3, 0.3e3])
+    path = scenes.write_scene(tmp_path / "moved.json", scene)
+    spp = checks.GOLDEN_TEST_SPP
+    run = run_lab(lab01_ref, path, width=g.meta["width"], height=g.meta["height"], spp=spp,
+                  bounces=g.meta["bounces"], seed=7)
+    report = compare(run.image, spp, g.mean, g.variance, g.meta["golden_spp"])
+    assert report.passed, report.summary()
+
+
+SCALES = [10.0**k for k in range(-14, 15, 2)]
+
+
+def test_every_scale_renders_or_is_refused(lab01_ref, tmp_path):
+    """The Cornell box scaled by 1e-14 .. 1e14 (its light by the factor squared): either the
+    image is the unscaled one (same seed, so almost the same paths: the scale check's
+    criterion) or the loader refuses the file with one line naming the limit. Nothing in
+    between: no scale at which walls silently vanish. The refused ends are the float range's:
+    the loader accepts at least 1e-8 .. 1e8."""
+    base_scene = scenes.load("cornell")
+
+    def render(scene, name):
+        path = scenes.write_scene(tmp_path / name, scene)
+        return run_lab(lab01_ref, path, width=32, height=32, spp=8, bounces=4, seed=3,
+                       check=False)
+
+    base = render(base_scene, "base.json").image
+    refused = []
+    for factor in SCALES:
+        run = render(scenes.scaled(base_scene, factor), f"scaled-{factor:g}.json")
+        if run.returncode != 0:
+            lines = run.stderr.strip().splitlines()
+            assert run.returncode == 2 and len(lines) == 1, (factor, run.stderr)
+            assert lines[0].startswith("error:") and ("1e9" in lines[0] or "1e-9" in lines[0])
+            refused.append(factor)
+            continue
+        mean_err = abs(float(run.image.mean()) / float(base.mean()) - 1.0)
+        bad = float(((abs(run.image - base) / (abs(base) + 1e-3)) > 0.05).mean())
+        assert mean_err < 0.01 and bad < 0.02, (
+            f"scale {factor:g} was accepted but renders differently: mean off by "
+            f"{mean_err:.2%}, {bad:.2%} of pixel values off by > 5%")
+    assert all(f < 1e-8 or f > 1e8 for f in refused), f"refused {refused}"
+    assert SCALES[0] in refused and SCALES[-1] in refused, f"refused only {refused}"

@@ -1,0 +1,218 @@
+"""Lab 05 (CUDA megakernel).
+
+Host-side tests run wherever nvcc is (CI has it, and no GPU): the CUDA targets build, a
+machine without nvcc gets one line from them, the skeleton matches its solution, the
+compiler's report lists the kernels, bad input and a missing GPU give one line and a
+non-zero exit. GPU tests (the `gpu` fixture) render: every correctness check of the CPU
+labs, agreement with lab 01, finite pixels at the baseline, reproducibility, banded renders,
+the skeleton's visible failure. Without a GPU they skip and say why."""
+import json
+import os
+import re
+import subprocess
+
+import numpy as np
+import pytest
+
+from cuda_env import gpu_name, missing_gpu
+from grading import checks
+from grading.compare import compare
+from grading.harness import ROOT, build, golden, run_lab
+
+LAB = "05-cuda-mega"
+
+
+def make(*args, **kwargs):
+    return subprocess.run(["make", "-s", "-C", str(ROOT), *args], capture_output=True,
+                          text=True, timeout=900, **kwargs)
+
+
+# ---- host side: the build --------------------------------------------------------------
+
+def test_without_nvcc_the_targets_fail_with_one_line():
+    """No toolkit: each CUDA target says so in one line and fails; other targets still work."""
+    for target in ("lab05", "lab05-ref", "kernel-report"):
+        p = make(target, "NVCC=/no/such/nvcc")
+        assert p.returncode != 0, target
+        lines = p.stderr.strip().splitlines()
+        assert lines and "needs the CUDA toolkit" in lines[0], p.stderr
+        assert len([l for l in lines if not l.startswith("make")]) == 1, p.stderr
+    assert make("-n", "lab01-ref", "NVCC=/no/such/nvcc").returncode == 0
+
+
+def test_targets_build_with_nvcc(lab05_ref, lab05):
+    assert os.access(lab05_ref, os.X_OK) and os.access(lab05, os.X_OK)
+
+
+def test_architectures(nvcc):
+    """Machine code for the GPU present, or for sm_75..sm_90 plus PTX where there is none."""
+    command = make("print-cuda-build-command").stdout
+    codes = set(re.findall(r"code=(sm_\d+|compute_\d+)", command))
+    if missing_gpu():
+        assert codes == {"sm_75", "sm_80", "sm_86", "sm_89", "sm_90", "compute_90"}, command
+    else:
+        caps = subprocess.run(["nvidia-smi", "--query-gpu=compute_cap", "--format=csv,noheader"],
+                              capture_output=True, text=True).stdout.split()
+        assert codes == {"sm_" + c.replace(".", "") for c in caps}, command
+
+
+def test_skeleton_in_sync():
+    """The committed skeleton is exactly what tools/skeletons.py makes from the solution."""
+    from grading.variants import pristine_skeleton_sources
+    expected = pristine_skeleton_sources(LAB)
+    assert set(expected) == {"megakernel.cuh", "render.cu"}
+    for name, text in expected.items():
+        assert (ROOT / "labs" / LAB / "skeleton" / name).read_text() == text, name
+
+
+def test_kernel_report(nvcc):
+    """The compiler's report lists the reference kernel within its register cap (64) with a
+    small stack frame for the spills, and the same shape uncapped with no spills."""
+    p = make("kernel-report")
+    assert p.returncode == 0, p.stderr
+    report = (ROOT / "build" / "kernel-report.md").read_text()
+
+    def row(kernel):
+        line = next(l for l in report.splitlines() if f"`{kernel}`" in l)
+        cells = [c.strip() for c in line.strip("|").split("|")]
+        return int(cells[2]), int(cells[3]) + int(cells[4]), int(cells[5])  # regs, spills, stack
+
+    registers, _, stack = row("render_kernel<16, shared, 64, true, 64>")
+    assert 16 <= registers <= 64 and stack <= 64, (registers, stack)
+    registers, spilled, _ = row("render_kernel<16, shared, 64, true, 255>")
+    assert registers > 64 and spilled == 0, (registers, spilled)
+
+
+# ---- host side: errors before and without the GPU --------------------------------------
+
+def test_no_gpu_is_one_line(lab05_ref, tmp_path):
+    """With no GPU visible (CUDA_VISIBLE_DEVICES empty; CI has none at all): one line, exit
+    status 3 (the machine's fault, not the input's: that is 2), no output file."""
+    out = tmp_path / "out.pfm"
+    env = {**os.environ, "CUDA_VISIBLE_DEVICES": ""}
+    p = subprocess.run([str(lab05_ref), "--quiet", "--width", "8", "--height", "8", "--spp", "1",
+                        "--pfm", str(out)], capture_output=True, text=True, env=env, timeout=60)
+    assert p.returncode == 3, (p.returncode, p.stderr)
+    lines = p.stderr.strip().splitlines()
+    assert len(lines) == 1 and lines[0].startswith("error: GPU: "), p.stderr
+    assert "CUDA" in lines[0]
+    assert p.stdout == "" and not out.exists()
+
+
+@pytest.mark.parametrize("case", ["malformed json", "negative radius", "undefined material"])
+def test_bad_scene(lab05_ref, tmp_path, case):
+    from test_bad_input import GOOD, SCENE_ERRORS, assert_one_line_error, run, scene_with
+    transform, fragments = SCENE_ERRORS[case]
+    path = scene_with(tmp_path, transform(json.dumps(GOOD, indent=2)))
+    assert_one_line_error(run(lab05_ref, "--scene", str(path)), str(path), *fragments)
+
+
+@pytest.mark.parametrize("flags, fragment", [
+    (["--width", "0"], "--width: expected an integer in 1..16384"),
+    (["--spp", "-3"], "--spp: expected an integer"),
+])
+def test_bad_flags(lab05_ref, flags, fragment):
+    from test_bad_input import assert_one_line_error, run
+    assert_one_line_error(run(lab05_ref, *flags), fragment)
+
+
+# ---- on the GPU ------------------------------------------------------------------------
+
+@pytest.mark.parametrize("check", [
+    checks.check_sphere_interior,
+    checks.check_million_samples,
+    checks.check_lit_plane,
+    checks.check_glass_slab,
+    lambda b: checks.check_golden(b, "cornell"),
+    lambda b: checks.check_golden(b, "showcase"),
+    checks.check_scale_invariance,
+    checks.check_translation_invariance,
+    checks.check_large_primitives,
+    checks.check_reproducible,
+], ids=["sphere-interior", "million-samples", "lit-plane", "glass-pane", "golden-cornell",
+        "golden-showcase", "scale", "translation", "large-primitives", "reproducible"])
+def test_reference_passes(gpu, lab05_ref, check):
+    result = check(lab05_ref)
+    assert result.passed, str(result)
+
+
+def test_agrees_with_lab01(gpu, lab05_ref):
+    """Lab 01's image is the same estimator: with other seeds the two pass the noise-aware
+    comparison against each other (lab 01's render standing in for the golden image, with the
+    golden per-path variance); with the same seed they draw the same random numbers, so the
+    pixels agree far inside the noise (only fused multiply-adds and the order of the per-pixel
+    sum differ)."""
+    lab01_ref = build("lab01-ref")[0]
+    g = golden("cornell")
+    size = dict(width=g.meta["width"], height=g.meta["height"], bounces=g.meta["bounces"])
+    cpu = run_lab(lab01_ref, g.scene, spp=256, seed=21, **size).image
+    gpu_image = run_lab(lab05_ref, g.scene, spp=64, seed=22, **size).image
+    report = compare(gpu_image, 64, cpu, g.variance, 256)
+    assert report.passed, report.summary()
+
+    same_cpu = run_lab(lab01_ref, g.scene, spp=64, seed=22, **size).image
+    rel = np.abs(gpu_image - same_cpu) / (np.abs(same_cpu) + 1e-3)
+    assert float(np.median(rel)) < 1e-4 and float((rel > 1e-2).mean()) < 0.02, \
+        (float(np.median(rel)), float((rel > 1e-2).mean()))
+
+
+def test_baseline_is_finite_and_summarised(gpu, lab05_ref):
+    """The report's baseline (600x600, 512 spp, 4 bounces): no NaN or Inf anywhere, and the
+    summary names the GPU and times the kernel only (well under the process's wall time)."""
+    import time
+    start = time.perf_counter()
+    run = run_lab(lab05_ref)
+    wall = time.perf_counter() - start
+    assert run.image.shape == (600, 600, 3)
+    assert np.isfinite(run.image).all(), f"{(~np.isfinite(run.image)).sum()} non-finite values"
+    assert run.image.mean() > 0
+    assert gpu_name() in run.json["device"], run.json
+    assert 0 < run.json["seconds"] < wall
+    assert "kernel only" in run.json["timing"], run.json  # the JSON says what seconds covers
+
+
+def test_bands_match_one_launch(gpu, lab05_ref):
+    """An image larger than the memory allowed for it renders in bands, bit for bit the same
+    (RT_LAB05_BAND_BYTES forces bands here: 7 rows of 40 pixels per band, the last shorter)."""
+    settings = dict(width=40, height=45, spp=8, seed=4)
+    whole = run_lab(lab05_ref, **settings).image
+    os.environ["RT_LAB05_BAND_BYTES"] = str(7 * 40 * 12)
+    try:
+        banded = run_lab(lab05_ref, **settings).image
+    finally:
+        del os.environ["RT_LAB05_BAND_BYTES"]
+    assert banded.tobytes() == whole.tobytes()
+
+
+def test_band_too_small_is_one_line(gpu, lab05_ref):
+    env = {**os.environ, "RT_LAB05_BAND_BYTES": "100"}  # less than one row
+    p = subprocess.run([str(lab05_ref), "--quiet", "--width", "64", "--height", "8", "--spp",
+                        "1"], capture_output=True, text=True, env=env, timeout=60)
+    assert p.returncode == 3  # the device's limit, not bad input
+    lines = p.stderr.strip().splitlines()
+    assert len(lines) == 1 and "not enough free device memory" in lines[0], p.stderr
+
+
+@pytest.fixture(scope="module")
+def lab05_pristine_skeleton(nvcc, tmp_path_factory):
+    """The skeleton as generated from the solution, built as `make lab05` builds it."""
+    from grading.variants import pristine_skeleton_sources
+    folder = tmp_path_factory.mktemp("lab05-skeleton")
+    for name, text in pristine_skeleton_sources(LAB).items():
+        (folder / name).write_text(text)
+    p = make("cuda-variant", f"VARIANT={folder}")
+    assert p.returncode == 0, p.stdout + p.stderr
+    return folder / "lab"
+
+
+def test_skeleton_is_visibly_incomplete(gpu, lab05_pristine_skeleton):
+    """Until students fill it in, the skeleton builds and renders, but not the right image:
+    the spheres only, one path per pixel."""
+    skeleton = lab05_pristine_skeleton
+    assert not checks.check_golden(skeleton, "cornell").passed
+    image = run_lab(skeleton, width=32, height=32, spp=4).image
+    assert image is not None and image.max() > 0
+
+
+def test_students_build_runs(gpu, lab05):
+    assert run_lab(lab05, width=8, height=8, spp=1).image.shape == (8, 8, 3)
