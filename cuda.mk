@@ -1,4 +1,4 @@
-# CUDA labs (05-07): the nvcc rules. Included by the Makefile after the labs' lab.mk files.
+# CUDA labs (05-07): the nvcc rules. Included by the Makefile before the labs' lab.mk files (labs 06 and 07 use cuda_lab).
 #
 #   make lab05 / lab05-ref       lab 05's student build / reference (labs/05-cuda-mega)
 #   make lab05-bench             the kernel shapes the handout measures (labs/05-cuda-mega/bench.cu)
@@ -80,12 +80,15 @@ lab05-ref-fast-math: $(LAB05_BUILD)/fast-math/render.o $(COMMON_OBJ)
 lab05-ref-no-fma: $(LAB05_BUILD)/no-fma/render.o $(COMMON_OBJ)
 	$(NVCC) $(CUDA_ARCH) $^ -o $@
 
-# A lab-05 build from a folder of edited sources (the pristine skeleton, a mutant):
-# `make cuda-variant VARIANT=DIR` compiles DIR/*.cu with DIR first on the include path, then
-# the lab's folder, and links the shared driver into DIR/lab.
+# A CUDA lab built from a folder of edited sources (the pristine skeleton, a mutant), as
+# `make variant` does for the CPU labs: `make cuda-variant VARIANT_LAB=05-cuda-mega
+# VARIANT=DIR` compiles DIR/*.cu with DIR first on the include path, then the folders the
+# lab's own build uses (VARIANT_INCLUDES_<lab>), and links the shared driver into DIR/lab.
+VARIANT_INCLUDES_05-cuda-mega := -I$(LAB05)
 cuda-variant: $(COMMON_OBJ)
-	@test -n "$(VARIANT)" || { echo "cuda-variant: needs VARIANT=DIR" >&2; exit 2; }
-	$(NVCC) $(NVCCFLAGS) $(CUDA_ARCH) -I$(VARIANT) -I$(LAB05) $(INCLUDES) \
+	@test -n "$(VARIANT)" -a -n "$(VARIANT_INCLUDES_$(VARIANT_LAB))" || \
+	    { echo "cuda-variant: needs VARIANT=DIR and VARIANT_LAB=<a CUDA lab folder>" >&2; exit 2; }
+	$(NVCC) $(NVCCFLAGS) $(CUDA_ARCH) -I$(VARIANT) $(VARIANT_INCLUDES_$(VARIANT_LAB)) $(INCLUDES) \
 	    $(sort $(wildcard $(VARIANT)/*.cu)) $(COMMON_OBJ) -o $(VARIANT)/lab
 
 # The benchmark has its own main; it links the library part of common/host only.
@@ -102,16 +105,23 @@ lab05-bench-fast-math: $(LAB05_BUILD)/fast-math/bench.o $(LIB_OBJ)
 LAB_BINARIES += $(LAB05_TARGETS)
 labs: $(LAB05_TARGETS)
 
-# The compiler's resource report (ptxas -v) for every kernel of the reference and the
-# benchmark, for one architecture: the GPU present, else sm_90. Writes build/kernel-report.md.
+# The compiler's resource report (ptxas -v) for every kernel of the GPU references and
+# lab 05's benchmark (the course report's Table 1 for our kernels), for one architecture: the
+# GPU present, else sm_90. Writes build/kernel-report.md. Each source gets the include path
+# its own build uses.
 KERNEL_REPORT_ARCH = $(if $(CUDA_GPU_CAPS),sm_$(firstword $(CUDA_GPU_CAPS)),sm_90)
+KERNEL_REPORT_NVCC = $(NVCC) -std=c++17 -O3 -arch=$(KERNEL_REPORT_ARCH) -Xptxas -v
 kernel-report:
 	@mkdir -p $(BUILD)/kernel-report
-	@for src in $(LAB05)/solution/render.cu $(LAB05)/bench.cu; do \
-	    $(NVCC) -std=c++17 -O3 -arch=$(KERNEL_REPORT_ARCH) -Xptxas -v -I$(LAB05)/solution \
-	        -I$(LAB05) $(INCLUDES) -c $$src -o $(BUILD)/kernel-report/$$(basename $$src .cu).o \
-	        2>&1 || exit 1; \
-	done > $(BUILD)/kernel-report/ptxas.log
+	@{ $(KERNEL_REPORT_NVCC) -I$(LAB05)/solution -I$(LAB05) $(INCLUDES) \
+	       -c $(LAB05)/solution/render.cu -o $(BUILD)/kernel-report/lab05.o && \
+	   $(KERNEL_REPORT_NVCC) -I$(LAB05)/solution -I$(LAB05) $(INCLUDES) \
+	       -c $(LAB05)/bench.cu -o $(BUILD)/kernel-report/lab05-bench.o && \
+	   $(KERNEL_REPORT_NVCC) -Ilabs/06-cuda-split/solution $(VARIANT_INCLUDES_06-cuda-split) \
+	       $(INCLUDES) -c labs/06-cuda-split/solution/render.cu -o $(BUILD)/kernel-report/lab06.o && \
+	   $(KERNEL_REPORT_NVCC) -Ilabs/07-soa/solution $(VARIANT_INCLUDES_07-soa) \
+	       $(INCLUDES) -c labs/07-soa/solution/render.cu -o $(BUILD)/kernel-report/lab07.o; \
+	 } > $(BUILD)/kernel-report/ptxas.log 2>&1 || { cat $(BUILD)/kernel-report/ptxas.log; exit 1; }
 	@$(PYTHON) $(LAB05)/kernel_report.py $(BUILD)/kernel-report/ptxas.log \
 	    --arch $(KERNEL_REPORT_ARCH) --out $(BUILD)/kernel-report.md
 endif

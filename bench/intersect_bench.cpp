@@ -28,7 +28,7 @@ std::vector<Ray> sample_rays(size_t n) {
         if (!hit.found()) continue;
         const SurfacePoint s = surface_at(view, primary, hit);
         const Vec3 facing = dot(primary.direction, s.normal) < 0 ? s.normal : -s.normal;
-        rays.push_back({offset_ray_origin(s.position, facing, hit.t),
+        rays.push_back({offset_ray_origin(s.position, facing, hit.t, s.extent),
                         sample_cosine_hemisphere(facing, rng.at(2), rng.at(3))});
     }
     return rays;

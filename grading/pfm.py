@@ -1,6 +1,6 @@
 """Reading and writing colour PFM images (the renderer's linear float32 output format).
 
-Layout, as written by common/image.cpp:
+Layout, as written by common/host/image.cpp:
 
     b"PF\\n<width> <height>\\n<scale>\\n" followed by width*height*3 float32 values,
 

@@ -1,14 +1,17 @@
 #!/usr/bin/env bash
 # Everything the CUDA labs need a GPU for, in one call (`make gpu-check OUT=DIR`):
 #   1. the machine: GPU, driver, nvcc, host compiler;
-#   2. build every CUDA target for the GPU present (plus lab 01's reference);
+#   2. build every CUDA target for the GPU present (plus lab 01's reference): labs 05-07;
 #   3. the compiler's resource report (make kernel-report) and the scene loads in the SASS;
 #   4. the GPU tests (pytest), for real;
 #   5. the benchmark: every kernel shape of lab05-bench on the baseline, CUDA events, best and
 #      median of 5 after a warm-up; process time against kernel time;
 #   6. accuracy of --use_fast_math and --fmad=false against the golden image and lab 01;
-#   7. divergence and occupancy from Nsight Compute's counters, where ncu can read them.
+#   7. divergence and occupancy from Nsight Compute's counters, where ncu can read them;
+#   8. the wavefront labs (06, 07): labs/06-cuda-split/measure.sh, into DIR/wavefront.tar.gz.
 # Writes DIR/gpu-check.json (everything) and DIR/summary.md (the tables), plus the logs.
+# GPU_CHECK_SKIP="sanitizer ncu" leaves those steps out (a short lease: their results change
+# only when the kernels do).
 #
 #   tools/gpu_check.sh DIR          run it (on the GPU machine)
 #   tools/gpu_check.sh --prepare    here, before sending the tree to a machine without the
@@ -68,7 +71,7 @@ fi
 jobs=$(nproc)
 start=$(date +%s)
 run_step build make -j"$jobs" lab01-ref lab05 lab05-ref lab05-bench lab05-bench-fast-math \
-    lab05-ref-fast-math lab05-ref-no-fma
+    lab05-ref-fast-math lab05-ref-no-fma lab06 lab06-ref lab06-bench lab07 lab07-ref lab07-bench
 say "build took $(( $(date +%s) - start )) s"
 
 # ---- 3. the compiler's report -----------------------------------------------------------
@@ -83,8 +86,9 @@ if command -v cuobjdump >/dev/null && [ -x lab05-bench ]; then
 fi
 
 # ---- 4. the GPU tests -------------------------------------------------------------------
-say "tests: pytest tests/labs/test_lab05.py tests/labs/test_device_code.py"
-python3 -m pytest -q -rs -p no:cacheprovider tests/labs/test_lab05.py tests/labs/test_device_code.py \
+gpu_tests="tests/labs/test_lab05.py tests/labs/test_lab06.py tests/labs/test_lab07.py tests/labs/test_device_code.py"
+say "tests: pytest $gpu_tests"
+python3 -m pytest -q -rs -p no:cacheprovider $gpu_tests \
     --junitxml=/tmp/gpu-check-junit.xml > "$out/pytest.txt" 2>&1
 step[tests]=$([ $? -eq 0 ] && echo ok || echo failed)
 tail -3 "$out/pytest.txt" | tee -a "$log"
@@ -100,7 +104,8 @@ fi
 
 # The memory checker on a small render: no out-of-bounds access, no uninitialised read, no
 # race on the shared-memory copy of the scene (lab05-bench's scene-shared shape).
-if command -v compute-sanitizer >/dev/null && [ -x lab05-ref ]; then
+skipped() { [[ " ${GPU_CHECK_SKIP:-} " == *" $1 "* ]] && { step[$1]=skipped; say "$1: skipped (GPU_CHECK_SKIP)"; }; }
+if ! skipped sanitizer && command -v compute-sanitizer >/dev/null && [ -x lab05-ref ]; then
     say "compute-sanitizer: memcheck and initcheck on lab05-ref, racecheck on scene-shared"
     { compute-sanitizer --tool memcheck --error-exitcode 3 ./lab05-ref --quiet --width 48 --height 40 --spp 4 &&
       compute-sanitizer --tool initcheck --error-exitcode 3 ./lab05-ref --quiet --width 48 --height 40 --spp 4 &&
@@ -110,7 +115,7 @@ if command -v compute-sanitizer >/dev/null && [ -x lab05-ref ]; then
 fi
 
 ncu_bin=$(command -v ncu || ls /opt/nvidia/nsight-compute/*/ncu /usr/local/cuda/bin/ncu 2>/dev/null | head -1)
-if [ -n "$ncu_bin" ] && [ -x lab05-bench ]; then
+if ! skipped ncu && [ -n "$ncu_bin" ] && [ -x lab05-bench ]; then
     say "counters: $ncu_bin on lab05-bench (64 spp, one timed run per shape)"
     metrics=smsp__thread_inst_executed_per_inst_executed.ratio,smsp__thread_inst_executed_pred_on_per_inst_executed.ratio,sm__warps_active.avg.pct_of_peak_sustained_active,smsp__issue_active.avg.pct_of_peak_sustained_active,smsp__inst_executed.sum,smsp__thread_inst_executed.sum,smsp__sass_thread_inst_executed_op_integer_pred_on.sum,smsp__sass_thread_inst_executed_op_fp32_pred_on.sum,smsp__sass_thread_inst_executed_op_fp64_pred_on.sum,sm__pipe_fma_cycles_active.avg.pct_of_peak_sustained_active,sm__inst_executed_pipe_alu.avg.pct_of_peak_sustained_active,gpu__time_duration.sum
     ncu_run() {  # ncu_run LABEL BENCH-ARGS...: one CSV per run, merged into the JSON below
@@ -307,9 +312,19 @@ if result["kernel_report"]:
 print("\n".join(md[:60]))
 EOF
 
+# ---- 8. the wavefront labs --------------------------------------------------------------
+if [ -x lab07-bench ]; then
+    say "wavefront: labs/06-cuda-split/measure.sh (AoS, SoA and the megakernel on four scenes)"
+    [[ " ${GPU_CHECK_SKIP:-} " == *" ncu "* ]] && export WAVEFRONT_STEPS=${WAVEFRONT_STEPS:-bench tables}
+    WAVEFRONT_REPEAT=${WAVEFRONT_REPEAT:-2} bash labs/06-cuda-split/measure.sh /tmp/gpu-check-wavefront >> "$log" 2>&1 \
+        && step[wavefront]=ok || step[wavefront]=failed
+    cp /tmp/gpu-check-wavefront/wavefront.md "$out/" 2>/dev/null
+    tar -C /tmp -czf "$out/wavefront.tar.gz" gpu-check-wavefront
+fi
+
 status=0
 for s in "${!step[@]}"; do
     say "step $s: ${step[$s]}"
-    [ "${step[$s]}" = ok ] || status=1
+    [ "${step[$s]}" = ok ] || [ "${step[$s]}" = skipped ] || status=1
 done
 exit $status

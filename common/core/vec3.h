@@ -1,5 +1,5 @@
 // Three-component float vector: points, directions and RGB radiance alike.
-// Lab 02 Part A's SSE Vec3 (labs/02-simd/solution/vec3.h) stands in for this file by coming
+// Lab 02 Part A's SSE Vec3 (labs/02-simd/solution/part-a/vec3.h) stands in for this file by coming
 // first on the include path.
 #pragma once
 

@@ -11,7 +11,7 @@
 //                          the generator's cache line bounces between cores, and the image
 //                          changes from run to run.
 //
-// The fix is lab 01's counter-based SampleStream (common/rng.h): no state, so nothing to
+// The fix is lab 01's counter-based SampleStream (common/core/rng.h): no state, so nothing to
 // share. See solution/render.cpp.
 #include <omp.h>
 

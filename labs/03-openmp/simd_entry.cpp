@@ -1,7 +1,7 @@
 // The entry of lab03-simd-ref, built without AVX2: it checks the CPU, then calls the render()
 // of solution/render.cpp, which is built with -DRT_USE_SIMD -mavx2 -mfma and renamed
 // render_avx2 there. So a CPU without AVX2 gets one clear line instead of an illegal
-// instruction (common/cpu_features.h).
+// instruction (common/host/cpu_features.h).
 #include "cpu_features.h"
 #include "lab.h"
 

@@ -1,4 +1,4 @@
-// Entry point of lab 04's binaries: MPI around the shared driver (common/lab_main.cpp).
+// Entry point of lab 04's binaries: MPI around the shared driver (common/host/lab_main.cpp).
 // Every rank parses the flags, loads the scene and renders; only rank 0 opens the output
 // files, writes them and prints the summary or the error line. Not a student file.
 #include <mpi.h>

@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""The compiler's resource report of lab 05's kernels as a table (`make kernel-report`).
+"""The compiler's resource report of the CUDA labs' kernels as a table (`make kernel-report`).
 
 Reads the log of `nvcc -Xptxas -v` (registers, stack frame, spills, shared and constant
 memory per kernel) and adds the theoretical occupancy each kernel's registers allow at its

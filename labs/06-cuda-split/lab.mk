@@ -7,11 +7,9 @@ LAB06 := labs/06-cuda-split
 LAB06_TARGETS := lab06 lab06-ref lab06-bench
 # Real files, not phony: a test that asks make for a binary that is up to date must not get it
 # relinked under another test that is running it ("Text file busy").
-.PHONY: lab06-variant
-
 ifeq ($(HAVE_NVCC),)
 .PHONY: $(LAB06_TARGETS)
-$(LAB06_TARGETS) lab06-variant:
+$(LAB06_TARGETS):
 	@echo "$@: needs the CUDA toolkit ($(NVCC) not found)" >&2
 	@exit 1
 else
@@ -26,13 +24,8 @@ $(BUILD)/$(LAB06)/bench.o: LAB_INCLUDES = -I$(LAB06)/solution -I$(LAB06) \
 lab06-bench: $(BUILD)/$(LAB06)/bench.o $(LIB_OBJ)
 	$(NVCC) $(CUDA_ARCH) $^ -o $@
 
-# A lab-06 build from a folder of edited sources (the pristine skeleton, a mutant):
-# `make lab06-variant VARIANT=DIR` compiles DIR/*.cu with DIR first on the include path, then
-# the lab's folders, and links the shared driver into DIR/lab.
-lab06-variant: $(COMMON_OBJ)
-	@test -n "$(VARIANT)" || { echo "lab06-variant: needs VARIANT=DIR" >&2; exit 2; }
-	$(NVCC) $(NVCCFLAGS) $(CUDA_ARCH) -I$(VARIANT) -I$(LAB06) -Ilabs/05-cuda-mega $(INCLUDES) \
-	    $(sort $(wildcard $(VARIANT)/*.cu)) $(COMMON_OBJ) -o $(VARIANT)/lab
+# Its variants (make cuda-variant VARIANT_LAB=06-cuda-split) see the same folders.
+VARIANT_INCLUDES_06-cuda-split := -I$(LAB06) -Ilabs/05-cuda-mega
 endif
 
 LAB_BINARIES += $(LAB06_TARGETS)

@@ -8,11 +8,9 @@ LAB07_TARGETS := lab07 lab07-ref lab07-bench
 LAB07_SHARED := -Ilabs/06-cuda-split/solution -Ilabs/06-cuda-split -Ilabs/05-cuda-mega
 # Real files, not phony: a test that asks make for a binary that is up to date must not get it
 # relinked under another test that is running it ("Text file busy").
-.PHONY: lab07-variant
-
 ifeq ($(HAVE_NVCC),)
 .PHONY: $(LAB07_TARGETS)
-$(LAB07_TARGETS) lab07-variant:
+$(LAB07_TARGETS):
 	@echo "$@: needs the CUDA toolkit ($(NVCC) not found)" >&2
 	@exit 1
 else
@@ -29,11 +27,8 @@ $(BUILD)/$(LAB07)/bench.o: labs/06-cuda-split/bench.cu
 lab07-bench: $(BUILD)/$(LAB07)/bench.o $(LIB_OBJ)
 	$(NVCC) $(CUDA_ARCH) $^ -o $@
 
-# A lab-07 build from a folder of edited sources: `make lab07-variant VARIANT=DIR`.
-lab07-variant: $(COMMON_OBJ)
-	@test -n "$(VARIANT)" || { echo "lab07-variant: needs VARIANT=DIR" >&2; exit 2; }
-	$(NVCC) $(NVCCFLAGS) $(CUDA_ARCH) -I$(VARIANT) -I$(LAB07) $(LAB07_SHARED) $(INCLUDES) \
-	    $(sort $(wildcard $(VARIANT)/*.cu)) $(COMMON_OBJ) -o $(VARIANT)/lab
+# Its variants (make cuda-variant VARIANT_LAB=07-soa) see the same folders.
+VARIANT_INCLUDES_07-soa := -I$(LAB07) $(LAB07_SHARED)
 endif
 
 LAB_BINARIES += $(LAB07_TARGETS)

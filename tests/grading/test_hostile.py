@@ -5,6 +5,7 @@ import hashlib
 import json
 import os
 import pathlib
+import shutil
 import signal
 import subprocess
 import sys
@@ -258,3 +259,20 @@ def test_a_missing_binary_still_writes_results(tmp_path):
                        capture_output=True, text=True, timeout=120)
     assert p.returncode == 2 and "no such binary" in p.stderr
     assert json.loads(out.read_text())["score"] == 0
+
+
+def test_no_sandbox_is_one_line_from_the_command_line(tmp_path):
+    """bubblewrap hidden from PATH: one error line, exit 2, and a results.json saying so."""
+    bin_dir = tmp_path / "bin"
+    bin_dir.mkdir()
+    for tool in ("make", "prlimit", "git", "g++"):  # what the grader may call, bwrap aside
+        found = shutil.which(tool)
+        if found:
+            (bin_dir / tool).symlink_to(found)
+    out = tmp_path / "results.json"
+    p = subprocess.run([sys.executable, "-m", "grading.grade", "01", "--binary",
+                        str(sub.REFERENCE), "--results", str(out)], cwd=ROOT, capture_output=True,
+                       text=True, timeout=120, env={**os.environ, "PATH": str(bin_dir)})
+    assert p.returncode == 2, p.stderr
+    assert p.stderr.count("\n") == 1 and "bubblewrap (bwrap) is not installed" in p.stderr, p.stderr
+    assert json.loads(out.read_text())["output"].startswith("refusing")

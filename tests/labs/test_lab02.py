@@ -200,7 +200,7 @@ def test_part_a_skeleton_is_correct_but_scalar(lab02a_pristine_skeleton):
 
 
 def test_part_a_students_build_runs(lab02a):
-    """`make lab02a` builds the student's copy (skeleton/vec3_sse.h) and it runs."""
+    """`make lab02a` builds the student's copy (skeleton/part-a/vec3.h) and it runs."""
     assert run_lab(lab02a, width=8, height=8, spp=1).json["lab"] == "02-simd-a"
 
 

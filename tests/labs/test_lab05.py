@@ -200,7 +200,7 @@ def lab05_pristine_skeleton(nvcc, tmp_path_factory):
     folder = tmp_path_factory.mktemp("lab05-skeleton")
     for name, text in pristine_skeleton_sources(LAB).items():
         (folder / name).write_text(text)
-    p = make("cuda-variant", f"VARIANT={folder}")
+    p = make("cuda-variant", f"VARIANT_LAB={LAB}", f"VARIANT={folder}")
     assert p.returncode == 0, p.stdout + p.stderr
     return folder / "lab"
 
@@ -216,3 +216,14 @@ def test_skeleton_is_visibly_incomplete(gpu, lab05_pristine_skeleton):
 
 def test_students_build_runs(gpu, lab05):
     assert run_lab(lab05, width=8, height=8, spp=1).image.shape == (8, 8, 3)
+
+
+# The bar is not met: 42.49 ms measured on the H200 (reference/gpu/h200-2026-12-02-labs05-07,
+# best of 5; --use_fast_math 41.93 ms). Strict: once it passes, this marker must go.
+@pytest.mark.xfail(strict=True, reason="lab 05's reference takes ~42.5 ms on the H200, bar 40 ms")
+def test_h200_bar(lab05_ref):
+    """On an H200, the baseline's kernel takes at most 40 ms (best of 3)."""
+    from test_lab06 import best_seconds, on_h200
+    on_h200()
+    seconds = best_seconds(lab05_ref)
+    assert seconds <= 0.040, f"{seconds * 1e3:.1f} ms"
