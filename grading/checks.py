@@ -369,9 +369,10 @@ def render_floor(binary, scene: dict, width: int = 32, height: int = 32, spp: in
 def check_translation_invariance(binary) -> CheckResult:
     """A scene moved far from the origin, by up to 1e4 times its size, renders as before: the
     zero-variance sphere interior (closed form, 2 bounces) and a lit floor (closed form per
-    pixel). Light measured from the offset ray origin instead of the surface point fails it:
-    the offset grows with |position|, and the sphere interior moved by 1e4 radii rendered 39%
-    too bright."""
+    pixel). The shared driver renders scenes centred on their geometry, which makes this hold
+    for any renderer built on it; a renderer that loads scenes itself must do the same or
+    keep its offsets and light sampling independent of |position| (before either, the sphere
+    interior moved by 1e4 radii rendered 39% too bright)."""
     worst_interior, worst_floor = 0.0, 0.0
     radius = INTERIOR["radius"]
     want = scenes.sphere_interior_radiance(**INTERIOR, bounces=2)

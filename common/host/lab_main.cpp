@@ -7,6 +7,7 @@
 #include <cli.h>
 #include <errors.h>
 #include <lab.h>
+#include <scene_centring.h>
 #include <scene_loader.h>
 
 std::string cpu_model_name() {
@@ -33,7 +34,8 @@ static std::string json_escape(const std::string& s) {
 // `setup_reported` tells lab_main whether hooks.setup_done has been called already.
 static int run(int argc, char** argv, const LabHooks& hooks, bool& setup_reported) {
     const Options options = parse_options(argc, argv, argv[0]);
-    const Scene scene = load_scene(options.scene_path);
+    // Centred on its geometry: where a scene sits in the world does not change its image.
+    const Scene scene = centre_scene(load_scene(options.scene_path));
     const RenderSettings settings = settings_for(scene, options);
 
     // Open the outputs before rendering: a bad path fails in a millisecond, not after the

@@ -112,7 +112,7 @@ inline Float8 intersect_triangle(const RayPacket& ray, const RayShear8& shear,
     // its shadow-ray tests.
     if (none(candidates)) return t_max;
 
-    // TODO(lab02): the watertight test of intersect_triangle (common/triangle.h) in all 8
+    // TODO(lab02): the watertight test of intersect_triangle (common/core/triangle.h) in all 8
     // lanes at once: the vertices relative to the origin in each lane's own axis order
     // (permuted(tri.v0, shear.kx) - shear.origin_k.x, ...), the shear (shear.sx ...),
     // the three edge functions as a product minus a product (never fused), the

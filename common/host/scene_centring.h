@@ -1,0 +1,18 @@
+// Renders work in coordinates centred on the scene's geometry ("camera-relative rendering" in
+// game engines): the loaded scene is moved so the centre of its primitives' bounding box is the
+// origin, camera and light with it. The image does not change (every distance and direction
+// is the same), but float coordinates near the origin are fine-grained, so a scene far from
+// the world origin renders as it would there: rounding and ray offsets scale with the scene,
+// not with where it sits. Without this, the Cornell box moved 5000 of its sizes away lost its
+// corners (offsets of ~20 float ulps of 5000 reach 1% of the box).
+#pragma once
+
+#include <scene.h>
+
+// The translation that centre_scene applies: minus the centre of the primitives' bounding
+// box, computed in double; zero for a scene without primitives.
+Vec3 centring_offset(const Scene& scene);
+
+// The scene moved by centring_offset (triangles rebuilt, so normals and extents are the
+// moved triangles' own).
+Scene centre_scene(Scene scene);
