@@ -19,6 +19,7 @@
 #include <cfloat>
 
 #include <camera.h>
+#include <material_set.h>
 #include <rng.h>
 #include <sample_sum.h>
 #include <scene_view.h>
@@ -185,8 +186,10 @@ RT_HD inline bool sample_light(const SceneView& scene, Vec3 position, Vec3 origi
 // throughput: returns true when it made one), then the next ray (cosine-sampled, mirrored, or
 // reflected or refracted by Fresnel) with its weight, unless the budget of max_bounces
 // interactions is spent. Reads random numbers by the path's bounce number only
-// (bounce_dimension), so every renderer that calls it draws the same ones.
-template <class Rng>
+// (bounce_dimension), so every renderer that calls it draws the same ones. Materials
+// (material_set.h) is the set of material kinds compiled in: a renderer that knows its scene
+// has no mirror or glass asks for DiffuseOnly and carries no code for them.
+template <class Materials = AnyMaterial, class Rng>
 RT_HD RT_FORCE_INLINE bool bounce_step(const SceneView& scene, const Hit& hit, const Rng& rng,
                                        int max_bounces, PathState& path, ShadowRay& shadow) {
     // BEGIN SOLUTION
@@ -204,7 +207,7 @@ RT_HD RT_FORCE_INLINE bool bounce_step(const SceneView& scene, const Hit& hit, c
     const int bounce = path.bounce++;
     path.alive = path.bounce < max_bounces;
 
-    if (material.type == MaterialType::Diffuse) {
+    if (!Materials::kSpecular || material.type == MaterialType::Diffuse) {
         const bool lit = scene.has_light && sample_light(scene, surface.position, above, facing,
                                                          material.albedo, shadow);
         if (lit) shadow.radiance = path.throughput * shadow.radiance;
@@ -215,20 +218,22 @@ RT_HD RT_FORCE_INLINE bool bounce_step(const SceneView& scene, const Hit& hit, c
         }
         return lit;
     }
-    if (!path.alive) return false;
-    if (material.type == MaterialType::Mirror) {
-        path.throughput *= material.albedo;
-        path.ray = {above, reflect(incoming, facing)};
-    } else {  // glass: reflect or refract, chosen with the Fresnel reflectance
-        const float eta = entering ? 1.0f / material.ior : material.ior;
-        float cos_t;
-        const float reflectance = fresnel_dielectric(-dot(incoming, facing), eta, cos_t);
-        if (rng.at(bounce_dimension(bounce, 0)) < reflectance) {
+    if constexpr (Materials::kSpecular) {
+        if (!path.alive) return false;
+        if (!Materials::kGlass || (Materials::kMirror && material.type == MaterialType::Mirror)) {
+            path.throughput *= material.albedo;
             path.ray = {above, reflect(incoming, facing)};
-        } else {
-            const Vec3 below =
-                offset_ray_origin(surface.position, -facing, hit.t, surface.extent);
-            path.ray = {below, refract(incoming, facing, eta, cos_t)};
+        } else {  // glass: reflect or refract, chosen with the Fresnel reflectance
+            const float eta = entering ? 1.0f / material.ior : material.ior;
+            float cos_t;
+            const float reflectance = fresnel_dielectric(-dot(incoming, facing), eta, cos_t);
+            if (rng.at(bounce_dimension(bounce, 0)) < reflectance) {
+                path.ray = {above, reflect(incoming, facing)};
+            } else {
+                const Vec3 below =
+                    offset_ray_origin(surface.position, -facing, hit.t, surface.extent);
+                path.ray = {below, refract(incoming, facing, eta, cos_t)};
+            }
         }
     }
     return false;
@@ -251,14 +256,14 @@ RT_HD RT_FORCE_INLINE bool bounce_step(const SceneView& scene, const Hit& hit, c
 // Radiance arriving along a camera ray, estimated by one random path of at most
 // max_bounces surface interactions: closest hit, bounce step, and the shadow ray it asks for
 // traced at once (its radiance added if nothing blocks it), until the path ends.
-template <class Geometry, class Rng>
+template <class Materials = AnyMaterial, class Geometry, class Rng>
 RT_HD inline Vec3 trace_path(const SceneView& scene, const Geometry& geometry, Ray ray,
                              const Rng& rng, int max_bounces) {
     PathState path = start_path(ray, max_bounces);
     while (path.alive) {
         const Hit hit = closest_hit(geometry, path.ray);
         ShadowRay shadow;
-        if (bounce_step(scene, hit, rng, max_bounces, path, shadow) &&
+        if (bounce_step<Materials>(scene, hit, rng, max_bounces, path, shadow) &&
             !occluded(geometry, shadow.ray, shadow.t_max)) {
             path.radiance += shadow.radiance;
         }
@@ -305,9 +310,9 @@ RT_HD inline Vec3 direct_light(const SceneView& scene, Vec3 position, Vec3 origi
     return direct_light(scene, scene, position, origin, facing_normal, albedo);
 }
 
-template <class Rng>
+template <class Materials = AnyMaterial, class Rng>
 RT_HD inline Vec3 trace_path(const SceneView& scene, Ray ray, const Rng& rng, int max_bounces) {
-    return trace_path(scene, scene, ray, rng, max_bounces);
+    return trace_path<Materials>(scene, scene, ray, rng, max_bounces);
 }
 
 RT_HD inline Vec3 render_pixel(const SceneView& scene, const Camera& camera,

@@ -5,7 +5,9 @@
 
 #include <ray.h>
 
-struct Sphere {
+// 16-byte aligned, centre and radius in the first row: the intersection test reads them with
+// one vector load on a GPU (see Triangle).
+struct alignas(16) Sphere {
     Vec3 center;    // world-space centre
     float radius;   // > 0
     int material;   // index into the scene's material table

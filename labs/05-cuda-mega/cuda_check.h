@@ -1,6 +1,6 @@
-// Every CUDA call of lab 05 goes through check(): a failure becomes one line naming what was
-// being done and what CUDA said, and the shared main exits non-zero with it. Owning wrappers
-// free device memory and events on every path out, errors included.
+// Every CUDA call of the CUDA labs goes through check(): a failure becomes one line naming
+// what was being done and what CUDA said, and the shared main exits non-zero with it. Owning
+// wrappers free device memory and events on every path out, errors included.
 #pragma once
 
 #include <cuda_runtime.h>
@@ -101,7 +101,7 @@ inline cudaDeviceProp open_device() {
     int count = 0;
     const cudaError_t status = cudaGetDeviceCount(&count);
     if (status == cudaErrorNoDevice || (status == cudaSuccess && count == 0)) {
-        throw GpuError("GPU: no CUDA GPU found (lab 05 renders on an NVIDIA GPU)");
+        throw GpuError("GPU: no CUDA GPU found (the CUDA labs render on an NVIDIA GPU)");
     }
     if (status == cudaErrorInsufficientDriver) {  // also what a machine with no driver says
         throw GpuError("GPU: no usable CUDA GPU: no NVIDIA driver, or one older than this "

@@ -86,6 +86,9 @@ def occupancy(registers: int, block: int, smem: int, arch: int) -> float:
 def short(name: str) -> str:
     name = name.replace("(SceneMemory)0", "global").replace("(SceneMemory)1", "constant")
     name = name.replace("(SceneMemory)2", "shared").replace("SceneMemory::", "")
+    name = name.replace("MaterialSet<false, false>", "DiffuseOnly")
+    name = name.replace("MaterialSet<true, true>", "AnyMaterial")
+    name = re.sub(r"\s+>", ">", name)  # the demangler writes "Foo<Bar<int> >"
     return re.sub(r"^void |\(.*\)$", "", name)
 
 

@@ -72,6 +72,17 @@ inline std::vector<float4> pack(const SceneView& scene, const SceneLayout& l) {
     return pool;
 }
 
+// Where a renderer puts the scene: each block's shared memory when it is small (the Cornell
+// box's 10 triangles, sphere and 4 materials take 720 bytes; shared memory measured faster
+// than the constant bank and global memory there, handouts/05-cuda-mega.md), else global
+// memory, through the L1 cache: every block copies the whole scene first, which for a large
+// scene would cost more than it saves.
+constexpr size_t kSharedSceneBytes = 16 * 1024;
+
+inline SceneMemory choose_scene_memory(const SceneLayout& layout) {
+    return layout.bytes() <= kSharedSceneBytes ? SceneMemory::Shared : SceneMemory::Global;
+}
+
 // The constant bank's copy: 48 KiB of the 64 KiB a program may use (about 850 triangles),
 // leaving room for the constants the compiler places there itself.
 constexpr size_t kConstantPoolBytes = 48 * 1024;

@@ -12,8 +12,10 @@
 //
 // The configurations: "megakernel" (lab 05's render_kernel in its reference shape),
 // "<layout>" (the lab reference: warp-aggregated push, scene in shared memory when small,
-// 2^21 paths a wave), "<layout>-atomic-each" (one atomic per push), "<layout>-global-scene"
-// and "<layout>-wave-N" (N paths a wave).
+// 2^21 paths a wave, shading compiled for the scene's material kinds), "<layout>-atomic-each"
+// (one atomic per push), "<layout>-global-scene", "<layout>-all-materials" (shading compiled
+// for every material kind, on a scene without mirrors or glass) and "<layout>-wave-N" (N
+// paths a wave).
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -21,6 +23,7 @@
 #include <cstring>
 #include <functional>
 #include <string>
+#include <type_traits>
 #include <vector>
 
 #include <bench_pools.cuh>
@@ -74,19 +77,27 @@ static Config wavefront(const Setup& s, std::string name, std::string change, lo
             }};
 }
 
-// Lab 05's reference megakernel over the whole image in one launch.
-template <SceneMemory kMemory>
+// Lab 05's reference megakernel (its shape: labs/05-cuda-mega/solution/render.cu) over the
+// whole image in one launch.
+constexpr int kLab05ThreadsPerPixel = 32, kLab05BlockThreads = 64;
+template <SceneMemory kMemory, class Materials>
+constexpr auto lab05_kernel =
+    render_kernel<kLab05ThreadsPerPixel, kMemory, kLab05BlockThreads, true, 72, Materials>;
+
+template <SceneMemory kMemory, class Materials>
 static double megakernel(const Setup& s, Image& image) {
-    constexpr auto kernel = render_kernel<16, kMemory, 64, true, 64>;
+    constexpr auto kernel = lab05_kernel<kMemory, Materials>;
     const size_t shared = kMemory == SceneMemory::Shared ? s.layout.bytes() : 0;
     DeviceArray<Vec3> pixels(static_cast<size_t>(s.settings.width) * s.settings.height, "allocating the image");
     const KernelArgs args{s.layout, s.pool, s.camera, s.settings, 0, s.settings.height, pixels.data()};
-    const long long threads = static_cast<long long>(s.settings.width) * s.settings.height * 16;
+    const long long threads =
+        static_cast<long long>(s.settings.width) * s.settings.height * kLab05ThreadsPerPixel;
     cudaFuncAttributes attributes{};
     check(cudaFuncGetAttributes(&attributes, kernel), "loading the megakernel");
     GpuTimer timer;
     timer.start();
-    kernel<<<static_cast<unsigned>((threads + 63) / 64), 64, shared>>>(args);
+    kernel<<<static_cast<unsigned>((threads + kLab05BlockThreads - 1) / kLab05BlockThreads),
+             kLab05BlockThreads, shared>>>(args);
     timer.stop();
     check_launch("running the megakernel");
     check(cudaMemcpy(&image.at(0, 0), pixels.data(), pixels.bytes(), cudaMemcpyDeviceToHost),
@@ -94,18 +105,26 @@ static double megakernel(const Setup& s, Image& image) {
     return timer.seconds();
 }
 
-template <class Pool>
+template <class Pool, class Materials>
 static void add_pool_configs(const Setup& s, std::vector<Config>& configs) {
-    using Shared = WavefrontConfig<Pool, SceneMemory::Shared, true>;
-    using SharedEach = WavefrontConfig<Pool, SceneMemory::Shared, false>;
-    using Global = WavefrontConfig<Pool, SceneMemory::Global, true>;
+    using Shared = WavefrontConfig<Pool, SceneMemory::Shared, true, Materials>;
+    using SharedEach = WavefrontConfig<Pool, SceneMemory::Shared, false, Materials>;
+    using SharedAny = WavefrontConfig<Pool, SceneMemory::Shared, true, AnyMaterial>;
+    using Global = WavefrontConfig<Pool, SceneMemory::Global, true, Materials>;
+    using Occupancy75 = WavefrontConfig<Pool, SceneMemory::Shared, true, Materials, 12>;
+    using Occupancy100 = WavefrontConfig<Pool, SceneMemory::Shared, true, Materials, 16>;
     const std::string n = Pool::kName;
-    const bool small = s.layout.bytes() <= kSharedSceneBytes;
-    if (small) {
+    if (choose_scene_memory(s.layout) == SceneMemory::Shared) {
         configs.push_back(wavefront<Shared>(s, n, "the lab's reference", kDefaultWavePaths));
         configs.push_back(wavefront<SharedEach>(s, n + "-atomic-each", "one atomicAdd per push", kDefaultWavePaths));
         configs.push_back(wavefront<Global>(s, n + "-global-scene", "scene in global memory", kDefaultWavePaths));
-        for (long long w : {1LL << 18, 1LL << 20, 1LL << 22}) {
+        if (!std::is_same_v<Materials, AnyMaterial>) {
+            configs.push_back(wavefront<SharedAny>(s, n + "-all-materials",
+                                                   "shading compiled for every material kind", kDefaultWavePaths));
+        }
+        configs.push_back(wavefront<Occupancy75>(s, n + "-occupancy-75", "12 blocks a multiprocessor (at most 40 registers)", kDefaultWavePaths));
+        configs.push_back(wavefront<Occupancy100>(s, n + "-occupancy-100", "16 blocks a multiprocessor (at most 32 registers)", kDefaultWavePaths));
+        for (long long w : {1LL << 18, 1LL << 19, 1LL << 20, 1LL << 22}) {
             configs.push_back(wavefront<Shared>(s, n + "-wave-" + std::to_string(w),
                                                 std::to_string(w) + " paths a wave", w));
         }
@@ -116,7 +135,11 @@ static void add_pool_configs(const Setup& s, std::vector<Config>& configs) {
 
 template <class... Pools>
 static void add_all_pools(const Setup& s, std::vector<Config>& configs, PoolList<Pools...>) {
-    (add_pool_configs<Pools>(s, configs), ...);
+    if (has_specular_material(s.scene->view().materials, s.scene->view().num_materials)) {
+        (add_pool_configs<Pools, AnyMaterial>(s, configs), ...);
+    } else {
+        (add_pool_configs<Pools, DiffuseOnly>(s, configs), ...);
+    }
 }
 
 static double max_relative_difference(const Image& a, const Image& b) {
@@ -187,11 +210,22 @@ static int run(int argc, char** argv) {
 
     std::vector<Config> configs;
     add_all_pools(s, configs, BenchPools{});
-    const bool small = s.layout.bytes() <= kSharedSceneBytes;
+    const bool small = choose_scene_memory(s.layout) == SceneMemory::Shared;
+    const bool specular = has_specular_material(scene.view().materials, scene.view().num_materials);
+    // Lab 05's reference as lab05-ref runs it: the scene's memory and material kinds.
+    const void* const lab05 =
+        small ? (specular ? reinterpret_cast<const void*>(lab05_kernel<SceneMemory::Shared, AnyMaterial>)
+                          : reinterpret_cast<const void*>(lab05_kernel<SceneMemory::Shared, DiffuseOnly>))
+              : (specular ? reinterpret_cast<const void*>(lab05_kernel<SceneMemory::Global, AnyMaterial>)
+                          : reinterpret_cast<const void*>(lab05_kernel<SceneMemory::Global, DiffuseOnly>));
     configs.push_back({"megakernel", small ? "lab 05's reference kernel" : "lab 05's kernel, scene in global memory",
-                       [s, small](Image& image, WavefrontStats*) {
-                           return small ? megakernel<SceneMemory::Shared>(s, image)
-                                        : megakernel<SceneMemory::Global>(s, image);
+                       [s, small, specular](Image& image, WavefrontStats*) {
+                           if (small) {
+                               return specular ? megakernel<SceneMemory::Shared, AnyMaterial>(s, image)
+                                               : megakernel<SceneMemory::Shared, DiffuseOnly>(s, image);
+                           }
+                           return specular ? megakernel<SceneMemory::Global, AnyMaterial>(s, image)
+                                           : megakernel<SceneMemory::Global, DiffuseOnly>(s, image);
                        }});
     if (list) {
         for (const Config& c : configs) std::printf("%s\t%s\n", c.name.c_str(), c.change.c_str());
@@ -257,13 +291,13 @@ static int run(int argc, char** argv) {
         } else {
             cudaFuncAttributes a{};
             int blocks = 0;
-            const void* k = small ? reinterpret_cast<const void*>(render_kernel<16, SceneMemory::Shared, 64, true, 64>)
-                                  : reinterpret_cast<const void*>(render_kernel<16, SceneMemory::Global, 64, true, 64>);
-            check(cudaFuncGetAttributes(&a, k), "reading the megakernel's attributes");
-            check(cudaOccupancyMaxActiveBlocksPerMultiprocessor(&blocks, k, 64, small ? s.layout.bytes() : 0),
+            check(cudaFuncGetAttributes(&a, lab05), "reading the megakernel's attributes");
+            check(cudaOccupancyMaxActiveBlocksPerMultiprocessor(&blocks, lab05, kLab05BlockThreads,
+                                                                small ? s.layout.bytes() : 0),
                   "computing the megakernel's occupancy");
             std::printf(", \"registers\": %d, \"local_bytes\": %zu, \"blocks_per_sm\": %d, \"occupancy\": %.3f",
-                        a.numRegs, a.localSizeBytes, blocks, double(blocks) * 64 / s.prop.maxThreadsPerMultiProcessor);
+                        a.numRegs, a.localSizeBytes, blocks,
+                        double(blocks) * kLab05BlockThreads / s.prop.maxThreadsPerMultiProcessor);
         }
         std::printf("}");
         std::fflush(stdout);

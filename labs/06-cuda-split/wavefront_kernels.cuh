@@ -15,21 +15,28 @@
 // time: the path's logic is lab 01's, only the loop around it is cut into kernels.
 //
 // Each kernel is a template on a Config: the pool's layout (AoS here, SoA in lab 07), where
-// the scene is read from (scene_pool.cuh) and which push the queues use, so that each of
-// those choices is measured with everything else the same.
+// the scene is read from (scene_pool.cuh), which push the queues use and the material kinds
+// compiled into the shading kernel (material_set.h), so that each of those choices is
+// measured with everything else the same.
 #pragma once
 
 #include <path_tracer.h>
 
+#include "packed_hit.cuh"
 #include "path_queue.cuh"
 #include "scene_pool.cuh"
 #include "wave.cuh"
 
-template <class PoolT, SceneMemory kMemory, bool kAggregated = true>
+template <class PoolT, SceneMemory kMemory, bool kAggregated = true, class MaterialsT = AnyMaterial,
+          int kMinBlocks = 1>
 struct WavefrontConfig {
     using Pool = PoolT;
+    using Materials = MaterialsT;  // what shade_hits compiles in: the scene's kinds, or all
     static constexpr SceneMemory kSceneMemory = kMemory;
     static constexpr bool kAggregatedPush = kAggregated;  // push, else push_each_atomic
+    // Blocks of kStageThreads each kernel must fit on a multiprocessor (__launch_bounds__):
+    // more caps the registers lower, for more warps in flight to hide memory latency.
+    static constexpr int kMinBlocksPerSM = kMinBlocks;
 };
 
 // Threads per block of every stage (not tuned: every measurement in the handouts uses 128).
@@ -49,7 +56,7 @@ __device__ inline void enqueue(const PathQueue& queue, int id) {
 // GEN: the camera ray of every slot of the wave, as render_pixel makes it (the same jitter
 // numbers), and every path onto the first active queue.
 template <class C>
-__global__ void __launch_bounds__(kStageThreads)
+__global__ void __launch_bounds__(kStageThreads, C::kMinBlocksPerSM)
     generate_camera_paths(const WavefrontArgs args, const Wave wave, const typename C::Pool pool,
                           const PathQueue active) {
     const int threads = static_cast<int>(gridDim.x * blockDim.x);
@@ -61,41 +68,49 @@ __global__ void __launch_bounds__(kStageThreads)
         const int y = static_cast<int>(pixel / args.settings.width);
         const Ray ray = args.camera.ray_through(x + rng.at(kDimPixelX), y + rng.at(kDimPixelY));
         const PathState path = start_path(ray, args.settings.bounces);
-        pool.store_path(slot, path);
+        pool.start_path(slot, path);
         if (path.alive) enqueue<C>(active, slot);
     }
 }
 
 // CHIT: the nearest surface on each active path's ray.
 template <class C>
-__global__ void __launch_bounds__(kStageThreads)
+__global__ void __launch_bounds__(kStageThreads, C::kMinBlocksPerSM)
     find_closest_hits(const WavefrontArgs args, const typename C::Pool pool, const PathQueue active) {
     extern __shared__ float4 shared_scene[];  // used when the scene is in shared memory
     const SceneView scene = scene_in<C::kSceneMemory>(args.layout, args.scene_pool, shared_scene);
     for_each_queued(active, [&](int id) { pool.store_hit(id, closest_hit(scene, pool.load_ray(id))); });
 }
 
-// PROCESS: the core's bounce step at each active path's hit. A path that goes on is pushed
-// to the next bounce's active queue; one whose step asked for a shadow ray, to the shadow
-// queue, with the request in its slot. A path that ends simply is not pushed: its radiance
-// stays in its slot for accumulate_samples.
+// PROCESS: the core's bounce step at each active path's hit; every path on `active` is about
+// to make interaction number `bounce`. A path that goes on is stored and pushed to the next
+// bounce's active queue; one whose step asked for a shadow ray, to the shadow queue, with
+// the request in its slot. A path that ends simply is not pushed: its radiance stays in its
+// slot for accumulate_samples. The step starts from zero radiance and whatever it adds (the
+// background, for a path that escapes) joins the slot's radiance afterwards: the same single
+// addition the core's loop makes, and no radiance read or written for the other paths.
 template <class C>
-__global__ void __launch_bounds__(kStageThreads)
-    shade_hits(const WavefrontArgs args, const Wave wave, const typename C::Pool pool,
+__global__ void __launch_bounds__(kStageThreads, C::kMinBlocksPerSM)
+    shade_hits(const WavefrontArgs args, const Wave wave, const typename C::Pool pool, int bounce,
                const PathQueue active, const PathQueue next, const PathQueue shadows) {
     extern __shared__ float4 shared_scene[];
     const SceneView scene = scene_in<C::kSceneMemory>(args.layout, args.scene_pool, shared_scene);
     for_each_queued(active, [&](int id) {
-        PathState path = pool.load_path(id);
+        PathState path = pool.load_path(id, bounce);
         ShadowRay shadow;
-        const bool wants_shadow_ray = bounce_step(scene, pool.load_hit(id), stream_of(args, wave, id),
-                                                  args.settings.bounces, path, shadow);
-        pool.store_path(id, path);
+        const bool wants_shadow_ray = bounce_step<typename C::Materials>(
+            scene, pool.load_hit(id), stream_of(args, wave, id), args.settings.bounces, path, shadow);
+        if (path.radiance.x != 0.0f || path.radiance.y != 0.0f || path.radiance.z != 0.0f) {
+            pool.add_radiance(id, path.radiance);
+        }
         if (wants_shadow_ray) {
             pool.store_shadow(id, shadow);
             enqueue<C>(shadows, id);
         }
-        if (path.alive) enqueue<C>(next, id);
+        if (path.alive) {
+            pool.store_path(id, path);
+            enqueue<C>(next, id);
+        }
     });
 }
 
@@ -103,7 +118,7 @@ __global__ void __launch_bounds__(kStageThreads)
 // Only this kernel writes a queued path's radiance between two shade_hits launches, so the
 // addition needs no atomic.
 template <class C>
-__global__ void __launch_bounds__(kStageThreads)
+__global__ void __launch_bounds__(kStageThreads, C::kMinBlocksPerSM)
     trace_shadow_rays(const WavefrontArgs args, const typename C::Pool pool, const PathQueue shadows) {
     extern __shared__ float4 shared_scene[];
     const SceneView scene = scene_in<C::kSceneMemory>(args.layout, args.scene_pool, shared_scene);
@@ -118,7 +133,7 @@ __global__ void __launch_bounds__(kStageThreads)
 // render_pixel's, bit for bit in the double sums; `means`, when given (the band's last wave),
 // receives sum.mean(spp). One thread per pixel: no atomics, no order to depend on.
 template <class C>
-__global__ void __launch_bounds__(kStageThreads)
+__global__ void __launch_bounds__(kStageThreads, C::kMinBlocksPerSM)
     accumulate_samples(const Wave wave, const typename C::Pool pool, SampleSum* sums, Vec3* means,
                        int spp) {
     const int threads = static_cast<int>(gridDim.x * blockDim.x);

@@ -14,6 +14,7 @@
 #include <array>
 #include <cstdlib>
 #include <string>
+#include <type_traits>
 #include <vector>
 
 #include <image.h>
@@ -119,10 +120,12 @@ public:
             ::find_closest_hits<C><<<grid_[kClosestHit], kStageThreads, shared_bytes_>>>(args_, memory_.pool, active);
         });
     }
+    // The bounce of the paths on `active` is where its counter lies: active(b)'s is sizes[b].
     void shade_hits(const PathQueue& active, const PathQueue& next, const PathQueue& shadows) {
+        const int bounce = static_cast<int>(active.size - memory_.sizes);
         launch(kShade, [&] {
-            ::shade_hits<C><<<grid_[kShade], kStageThreads, shared_bytes_>>>(args_, wave_, memory_.pool,
-                                                                          active, next, shadows);
+            ::shade_hits<C><<<grid_[kShade], kStageThreads, shared_bytes_>>>(
+                args_, wave_, memory_.pool, bounce, active, next, shadows);
         });
     }
     void trace_shadow_rays(const PathQueue& shadows) {
@@ -281,11 +284,9 @@ double render_waves(const RenderJob& job, const cudaDeviceProp& prop, const Scen
     return seconds;
 }
 
-// The scene in each block's shared memory when it is small, else in global memory: lab 05's
-// rule and threshold (16 KiB; the Cornell box takes 720 bytes).
-constexpr size_t kSharedSceneBytes = 16 * 1024;
-
-// The whole render() of a wavefront lab, for path-pool layout Pool.
+// The whole render() of a wavefront lab, for path-pool layout Pool: the scene in each
+// block's shared memory when it is small, else in global memory (lab 05's rule,
+// choose_scene_memory), and a shading kernel for the scene's material kinds.
 template <class Pool>
 RenderStats render_wavefront(const RenderJob& job, Image& image, WavefrontStats* stats = nullptr) {
     const cudaDeviceProp prop = open_device();
@@ -294,9 +295,15 @@ RenderStats render_wavefront(const RenderJob& job, Image& image, WavefrontStats*
     DeviceArray<float4> scene_pool(host_pool.size(), "allocating the scene on the GPU");
     check(cudaMemcpy(scene_pool.data(), host_pool.data(), scene_pool.bytes(), cudaMemcpyHostToDevice),
           "copying the scene to the GPU");
-    const double seconds =
-        layout.bytes() <= kSharedSceneBytes
-            ? render_waves<WavefrontConfig<Pool, SceneMemory::Shared>>(job, prop, layout, scene_pool.data(), image, stats)
-            : render_waves<WavefrontConfig<Pool, SceneMemory::Global>>(job, prop, layout, scene_pool.data(), image, stats);
+    const bool shared = choose_scene_memory(layout) == SceneMemory::Shared;
+    const bool specular = has_specular_material(job.scene.materials, job.scene.num_materials);
+    using S = std::integral_constant<SceneMemory, SceneMemory::Shared>;
+    using G = std::integral_constant<SceneMemory, SceneMemory::Global>;
+    const auto render = [&](auto memory, auto materials) {
+        using C = WavefrontConfig<Pool, decltype(memory)::value, true, decltype(materials)>;
+        return render_waves<C>(job, prop, layout, scene_pool.data(), image, stats);
+    };
+    const double seconds = shared ? (specular ? render(S{}, AnyMaterial{}) : render(S{}, DiffuseOnly{}))
+                                  : (specular ? render(G{}, AnyMaterial{}) : render(G{}, DiffuseOnly{}));
     return {seconds, describe(prop)};
 }

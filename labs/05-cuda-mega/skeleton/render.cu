@@ -21,32 +21,25 @@
 const char* const kLabName = "05-cuda-mega";
 
 // The launch shape, each choice measured on an H200 with lab05-bench (the handout's tables,
-// baseline kernel times): 16 threads share a pixel's samples (a grid of millions of threads,
-// so the last wave is a small part of the work, while a pixel's threads still fit in one
-// warp for the shuffles: 49.8 ms with one thread per pixel, 44.0 with 16); blocks of 64
-// threads (42.5 ms; 44.0 with 128, 45.1 with 512); by bounces with path regeneration
-// (44.0 ms; 44.4 by whole paths with trace_path); at most 64 registers a thread: uncapped,
-// the 64-thread shape takes 78 and 38% occupancy, capped 50% (make kernel-report). With
-// 128-thread blocks the cap cost 1% (44.0 against 43.4 ms uncapped at 72 registers); the
-// uncapped 64-thread shape is lab05-bench's regs-any.
-constexpr int kThreadsPerPixel = 16;
+// baseline kernel times, best of 5): 32 threads share a pixel's samples (a grid of millions
+// of threads, so the last wave of blocks is a small part of the work, while a pixel's
+// threads still fit in one warp for the shuffles: 47.4 ms with one thread per pixel, 40.36
+// with 32, 40.51 with 16); blocks of 64 threads (block-128 42.0 ms); by bounces with path
+// regeneration; at most 72 registers a thread (39.91 ms: 8 bytes of spills at 44%
+// occupancy; capped at 64, 40 bytes of spills at 50%, 40.36 ms; uncapped, 78 registers at
+// 38%, 41.32 ms); only the material kinds the scene uses (40.51 ms against 41.08 for a
+// kernel compiled for every material, same shape: no glass code, fewer spills).
+constexpr int kThreadsPerPixel = 32;
 constexpr int kBlockThreads = 64;
 constexpr bool kRegenerate = true;
-constexpr int kMaxRegisters = 64;
+constexpr int kMaxRegisters = 72;
 
-template <SceneMemory kMemory>
-constexpr auto kernel_for =
-    render_kernel<kThreadsPerPixel, kMemory, kBlockThreads, kRegenerate, kMaxRegisters>;
-
-// Where the scene goes: each block's shared memory when it is small (the Cornell box's 10
-// triangles, sphere and 4 materials take 720 bytes; shared memory measured faster than the
-// constant bank and global memory there), else global memory, through the L1 cache: every
-// block copies the whole scene first, which for a large scene would cost more than it saves.
-constexpr size_t kSharedSceneBytes = 16 * 1024;
-
-static SceneMemory choose_scene_memory(const SceneLayout& layout) {
-    return layout.bytes() <= kSharedSceneBytes ? SceneMemory::Shared : SceneMemory::Global;
-}
+// One kernel per place for the scene (choose_scene_memory, scene_pool.cuh) and per set of
+// material kinds (material_set.h): a scene without mirrors or glass gets a kernel without
+// their code.
+template <SceneMemory kMemory, class Materials>
+constexpr auto kernel_for = render_kernel<kThreadsPerPixel, kMemory, kBlockThreads, kRegenerate,
+                                          kMaxRegisters, Materials>;
 
 // The most bytes of device memory the image's pixels may take at once; more rows than that
 // are rendered in several bands. RT_LAB05_BAND_BYTES lowers it (the tests force bands so).
@@ -63,12 +56,13 @@ static size_t band_budget_bytes() {
 // Makes the kernel ready before anything is timed: loads its module (CUDA loads modules
 // lazily, at the first launch, which would otherwise land inside the timed region) and
 // allows the dynamic shared memory it needs.
-template <SceneMemory kMemory>
+template <SceneMemory kMemory, class Materials>
 static void prepare_kernel(size_t shared_bytes) {
     cudaFuncAttributes attributes{};
-    check(cudaFuncGetAttributes(&attributes, kernel_for<kMemory>), "loading the render kernel");
+    check(cudaFuncGetAttributes(&attributes, kernel_for<kMemory, Materials>),
+          "loading the render kernel");
     if (shared_bytes > 0) {
-        check(cudaFuncSetAttribute(kernel_for<kMemory>,
+        check(cudaFuncSetAttribute(kernel_for<kMemory, Materials>,
                                    cudaFuncAttributeMaxDynamicSharedMemorySize,
                                    static_cast<int>(shared_bytes)),
               "giving the kernel the shared memory for the scene");
@@ -76,7 +70,7 @@ static void prepare_kernel(size_t shared_bytes) {
 }
 
 // One band: launch the kernel over its pixels and return its GPU time in seconds.
-template <SceneMemory kMemory>
+template <SceneMemory kMemory, class Materials>
 static double render_band(const KernelArgs& args, size_t shared_bytes) {
     GpuTimer timer;
     // TODO(lab05): launch enough blocks of kBlockThreads threads for your kernel's
@@ -84,16 +78,16 @@ static double render_band(const KernelArgs& args, size_t shared_bytes) {
     // Until then: one thread per row, as the placeholder kernel expects.
     const unsigned blocks = static_cast<unsigned>((args.rows + kBlockThreads - 1) / kBlockThreads);
     timer.start();
-    kernel_for<kMemory><<<blocks, kBlockThreads, shared_bytes>>>(args);
+    kernel_for<kMemory, Materials><<<blocks, kBlockThreads, shared_bytes>>>(args);
     timer.stop();
     check_launch("running the render kernel");
     return timer.seconds();
 }
 
-template <SceneMemory kMemory>
+template <SceneMemory kMemory, class Materials>
 static double render_bands(KernelArgs args, size_t shared_bytes, Image& image,
                            Progress& progress) {
-    prepare_kernel<kMemory>(shared_bytes);
+    prepare_kernel<kMemory, Materials>(shared_bytes);
     const int width = args.settings.width, height = args.settings.height;
     const size_t row_bytes = static_cast<size_t>(width) * sizeof(Vec3);
     const size_t budget = band_budget_bytes();
@@ -109,7 +103,7 @@ static double render_bands(KernelArgs args, size_t shared_bytes, Image& image,
     for (int first = 0; first < height; first += band_rows) {
         args.first_row = first;
         args.rows = std::min(band_rows, height - first);
-        seconds += render_band<kMemory>(args, shared_bytes);
+        seconds += render_band<kMemory, Materials>(args, shared_bytes);
         check(cudaMemcpy(&image.at(0, first), band.data(), args.rows * row_bytes,
                          cudaMemcpyDeviceToHost),
               "copying the pixels back from the GPU");
@@ -135,11 +129,15 @@ RenderStats render(const RenderJob& job, Image& image) {
           "copying the scene to the GPU");
 
     const KernelArgs args{layout, pool.data(), job.camera, job.settings, 0, 0, nullptr};
+    const bool specular = has_specular_material(job.scene.materials, job.scene.num_materials);
     double seconds = 0;
     if (memory == SceneMemory::Shared) {
-        seconds = render_bands<SceneMemory::Shared>(args, layout.bytes(), image, job.progress);
+        const size_t bytes = layout.bytes();
+        seconds = specular ? render_bands<SceneMemory::Shared, AnyMaterial>(args, bytes, image, job.progress)
+                           : render_bands<SceneMemory::Shared, DiffuseOnly>(args, bytes, image, job.progress);
     } else {
-        seconds = render_bands<SceneMemory::Global>(args, 0, image, job.progress);
+        seconds = specular ? render_bands<SceneMemory::Global, AnyMaterial>(args, 0, image, job.progress)
+                           : render_bands<SceneMemory::Global, DiffuseOnly>(args, 0, image, job.progress);
     }
     return {seconds, describe(prop),
             "kernel only (CUDA events); excludes context creation, module load and copies"};

@@ -12,6 +12,8 @@
 
 #include <path_tracer.h>
 
+#include "packed_hit.cuh"
+
 // Lays arrays out one after another in one allocation, each on a 256-byte boundary (so every
 // warp's access to it starts on a cache line). With a null base it only measures.
 class ArrayCarver {
@@ -33,9 +35,10 @@ private:
 };
 
 // TODO(lab07): the pool as a structure of arrays. Give SoaPathPool one array per scalar
-// field of lab 06's AosPathPool::Record (PathState, Hit, ShadowRay; a Vec3 is three float
-// arrays), carved out of the one allocation with ArrayCarver (bytes_for measures the same
-// layout with a null base), and the same member functions reading and writing them.
+// field of lab 06's AosPathPool::Record (Ray, PackedHit, throughput, radiance, the shadow
+// ray's fields; a Vec3 is three float arrays), carved out of the one allocation with
+// ArrayCarver (bytes_for measures the same layout with a null base), and the same member
+// functions reading and writing them (path_pool_aos.cuh says what each one does).
 // Until then: nothing is stored and every load returns a default, a hit included (no hit),
 // so no path keeps any radiance: the image is black.
 struct SoaPathPool {
@@ -43,7 +46,8 @@ struct SoaPathPool {
     static SoaPathPool carve(void*, int) { return {}; }
     static size_t bytes_for(int slots) { return static_cast<size_t>(slots); }
 
-    __device__ PathState load_path(int) const { return start_path(Ray{}, 1); }
+    __device__ void start_path(int, const PathState&) const {}
+    __device__ PathState load_path(int, int bounce) const { return {Ray{}, Vec3(0.0f), Vec3(0.0f), bounce, true}; }
     __device__ void store_path(int, const PathState&) const {}
     __device__ Ray load_ray(int) const { return {}; }
     __device__ Hit load_hit(int) const { return {}; }

@@ -14,6 +14,8 @@
 
 #include <path_tracer.h>
 
+#include "packed_hit.cuh"
+
 // Lays arrays out one after another in one allocation, each on a 256-byte boundary (so every
 // warp's access to it starts on a cache line). With a null base it only measures.
 class ArrayCarver {
@@ -66,16 +68,14 @@ struct RayArray {
     }
 };
 
-// The fields of AosPathPool::Record, each in its own array: 27 words of 4 bytes and one byte
-// per path (the AoS record's 108 bytes hold the same, `alive` in its padding).
+// The fields of AosPathPool::Record, each in its own array: 23 words of 4 bytes per path
+// (the AoS record's 112 bytes hold the same 92 and 20 bytes of padding that keep its rows
+// aligned).
 struct SoaPathPool {
-    RayArray ray;                // PathState
+    RayArray ray;                // PathState, less what the queues say (bounce, alive)
     Vec3Array throughput, radiance;
-    int* bounce;
-    uint8_t* alive;
-    float* hit_t;                // Hit
-    int* hit_sphere;
-    int* hit_triangle;
+    float* hit_t;                // PackedHit
+    int* hit_primitive;
     RayArray shadow_ray;         // ShadowRay
     float* shadow_t_max;
     Vec3Array shadow_radiance;
@@ -87,11 +87,8 @@ struct SoaPathPool {
         p.ray.carve(c);
         p.throughput.carve(c);
         p.radiance.carve(c);
-        p.bounce = c.take<int>();
-        p.alive = c.take<uint8_t>();
         p.hit_t = c.take<float>();
-        p.hit_sphere = c.take<int>();
-        p.hit_triangle = c.take<int>();
+        p.hit_primitive = c.take<int>();
         p.shadow_ray.carve(c);
         p.shadow_t_max = c.take<float>();
         p.shadow_radiance.carve(c);
@@ -107,22 +104,24 @@ struct SoaPathPool {
         return c.bytes();
     }
 
-    __device__ PathState load_path(int i) const {
-        return {ray.load(i), throughput.load(i), radiance.load(i), bounce[i], alive[i] != 0};
+    __device__ void start_path(int i, const PathState& p) const {
+        ray.store(i, p.ray);
+        throughput.store(i, p.throughput);
+        radiance.store(i, p.radiance);
+    }
+    __device__ PathState load_path(int i, int bounce) const {
+        return {ray.load(i), throughput.load(i), Vec3(0.0f), bounce, true};
     }
     __device__ void store_path(int i, const PathState& p) const {
         ray.store(i, p.ray);
         throughput.store(i, p.throughput);
-        radiance.store(i, p.radiance);
-        bounce[i] = p.bounce;
-        alive[i] = p.alive;
     }
     __device__ Ray load_ray(int i) const { return ray.load(i); }
-    __device__ Hit load_hit(int i) const { return {hit_t[i], hit_sphere[i], hit_triangle[i]}; }
+    __device__ Hit load_hit(int i) const { return unpack_hit({hit_t[i], hit_primitive[i]}); }
     __device__ void store_hit(int i, const Hit& h) const {
-        hit_t[i] = h.t;
-        hit_sphere[i] = h.sphere;
-        hit_triangle[i] = h.triangle;
+        const PackedHit packed = pack_hit(h);
+        hit_t[i] = packed.t;
+        hit_primitive[i] = packed.primitive;
     }
     __device__ ShadowRay load_shadow(int i) const {
         return {shadow_ray.load(i), shadow_t_max[i], shadow_radiance.load(i)};
@@ -137,9 +136,10 @@ struct SoaPathPool {
 };
 // SKELETON
 //> // TODO(lab07): the pool as a structure of arrays. Give SoaPathPool one array per scalar
-//> // field of lab 06's AosPathPool::Record (PathState, Hit, ShadowRay; a Vec3 is three float
-//> // arrays), carved out of the one allocation with ArrayCarver (bytes_for measures the same
-//> // layout with a null base), and the same member functions reading and writing them.
+//> // field of lab 06's AosPathPool::Record (Ray, PackedHit, throughput, radiance, the shadow
+//> // ray's fields; a Vec3 is three float arrays), carved out of the one allocation with
+//> // ArrayCarver (bytes_for measures the same layout with a null base), and the same member
+//> // functions reading and writing them (path_pool_aos.cuh says what each one does).
 //> // Until then: nothing is stored and every load returns a default, a hit included (no hit),
 //> // so no path keeps any radiance: the image is black.
 //> struct SoaPathPool {
@@ -147,7 +147,8 @@ struct SoaPathPool {
 //>     static SoaPathPool carve(void*, int) { return {}; }
 //>     static size_t bytes_for(int slots) { return static_cast<size_t>(slots); }
 //>
-//>     __device__ PathState load_path(int) const { return start_path(Ray{}, 1); }
+//>     __device__ void start_path(int, const PathState&) const {}
+//>     __device__ PathState load_path(int, int bounce) const { return {Ray{}, Vec3(0.0f), Vec3(0.0f), bounce, true}; }
 //>     __device__ void store_path(int, const PathState&) const {}
 //>     __device__ Ray load_ray(int) const { return {}; }
 //>     __device__ Hit load_hit(int) const { return {}; }
