@@ -13,6 +13,7 @@ that), as the sandbox cannot write build/.
 from __future__ import annotations
 
 import pathlib
+import shutil
 
 from grading.harness import ROOT
 from grading.sandbox import Limits, Runner
@@ -29,15 +30,21 @@ def visible_tree() -> list[pathlib.Path]:
     return [p for p in paths if p.exists()]
 
 
-def build_in_sandbox(variant_lab: str, src: pathlib.Path) -> tuple[pathlib.Path | None, str]:
-    """Build the sources in `src` as `variant_lab` (e.g. 01-serial) into src/lab:
-    (binary, "") or (None, the compiler's output)."""
+def build_in_sandbox(variant_lab: str, src: pathlib.Path,
+                     target: str = "variant") -> tuple[pathlib.Path | None, str]:
+    """Build the sources in `src` as `variant_lab` (e.g. 01-serial) into src/lab with
+    `make target` (cuda-variant for a CUDA lab): (binary, "") or (None, the compiler's
+    output)."""
+    # nvcc is found by its absolute path: the sandbox's PATH holds only the system's folders,
+    # and the toolkit (under /usr/local) is visible but not on it.
+    nvcc = shutil.which("nvcc")
+    extra = [f"NVCC={nvcc}"] if target == "cuda-variant" and nvcc else []
     with Runner(trusted=False) as r:
         for path in visible_tree():
             r.bind(path)
         r.bind(src, writable=True)
-        out = r.run(["make", "-s", "-C", str(ROOT), "variant", f"VARIANT_LAB={variant_lab}",
-                     f"VARIANT={src.resolve()}"], COMPILE_LIMITS)
+        out = r.run(["make", "-s", "-C", str(ROOT), target, f"VARIANT_LAB={variant_lab}",
+                     f"VARIANT={src.resolve()}", *extra], COMPILE_LIMITS)
     binary = src / "lab"
     if out.failure is None and binary.is_file():
         return binary, ""

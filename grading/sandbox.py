@@ -167,8 +167,9 @@ class Runner:
             data = r.output("image.pfm")          # bytes or None, read after the run
     """
 
-    def __init__(self, trusted: bool):
+    def __init__(self, trusted: bool, gpu: bool = False):
         self.trusted = trusted
+        self.gpu = gpu  # a GPU lab's runs: the sandbox shows the GPU (grading/gpu.py)
         self.root = pathlib.Path(tempfile.mkdtemp(prefix="grading-"))
         os.chmod(self.root, 0o755)  # the unprivileged sandbox user must reach staged inputs
         self.inputs: dict[str, pathlib.Path] = {}
@@ -258,6 +259,9 @@ class Runner:
             cmd += ["--ro-bind", str(outside), inside]
         for path, writable in self.binds:
             cmd += ["--bind" if writable else "--ro-bind", path, path]
+        if self.gpu:  # after --dev /dev and --clearenv, which it adds to
+            from grading.gpu import sandbox_args
+            cmd += sandbox_args()
         cmd += ["--remount-ro", "/"]  # bubblewrap's root is a tmpfs: no files may go there
         for key, value in {"PATH": "/usr/local/bin:/usr/bin:/bin", "HOME": SCRATCH,
                            "TMPDIR": "/tmp", "LANG": "C.UTF-8", **env}.items():
