@@ -24,6 +24,10 @@ DEV = "/dev"
 # NVIDIA container runtime mounts, the RPM distributions' folder. The grader's own
 # LD_LIBRARY_PATH is searched too (lib_dirs()).
 DRIVER_LIB_DIRS = ("/usr/lib/x86_64-linux-gnu", "/usr/local/nvidia/lib64", "/usr/lib64")
+# What the driver's library may read to place the GPU (its PCI device, NUMA node, the
+# module's parameters), as flatpak shows it to sandboxed GPU programs: read-only hardware
+# facts, no one's data. The sandbox otherwise shows only /sys/devices/system/{cpu,node}.
+SYSFS = ("/sys/bus/pci", "/sys/devices", "/sys/module/nvidia")
 
 
 def is_gpu_lab(lab: str) -> bool:
@@ -64,15 +68,21 @@ def lib_dirs(candidates=DRIVER_LIB_DIRS, environment: str | None = None) -> list
     return found
 
 
-def sandbox_args(dev: str = DEV, libs: list[str] | None = None) -> list[str]:
+def sandbox_args(dev: str = DEV, libs: list[str] | None = None, sysfs=SYSFS) -> list[str]:
     """bubblewrap arguments that give a sandboxed CUDA program the GPU: each NVIDIA device
-    node, bound as a device (`--dev-bind`; it must come after `--dev /dev`), and each folder
-    holding libcuda.so, read-only, with LD_LIBRARY_PATH naming them (it must come after
-    `--clearenv`). Built from what exists: on a machine without a GPU it is empty."""
+    node, bound as a device (`--dev-bind`; it must come after `--dev /dev`), the `sysfs`
+    folders read-only where they exist, and each folder holding libcuda.so, read-only, with
+    LD_LIBRARY_PATH naming them (it must come after `--clearenv`). Built from what exists:
+    on a machine without a GPU (no device node) it is empty."""
     libs = lib_dirs() if libs is None else libs
+    nodes = device_nodes(dev)
+    if not nodes:
+        return []
     args: list[str] = []
-    for name in device_nodes(dev):
+    for name in nodes:
         args += ["--dev-bind", os.path.join(dev, name), f"/dev/{name}"]
+    for folder in sysfs:
+        args += ["--ro-bind-try", folder, folder]
     for folder in libs:
         args += ["--ro-bind", folder, folder]
     if libs:

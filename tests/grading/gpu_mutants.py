@@ -86,7 +86,3 @@ def build_cuda_folder(lab: str, folder: pathlib.Path, files: dict[str, str]) -> 
     if p.returncode != 0:
         raise RuntimeError(f"building {folder} as {lab} failed:\n{(p.stdout + p.stderr)[-3000:]}")
     return folder / "lab"
-
-
-def build_mutant(name: str, folder: pathlib.Path) -> pathlib.Path:
-    return build_cuda_folder(LAB, folder, mutant_sources(name))

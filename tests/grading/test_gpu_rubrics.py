@@ -25,7 +25,7 @@ from grading import checks, gpu, sandbox
 from grading.grade import (GOLDENS, GPU_TIMED_SCALE, RUBRICS, describe, grade, grading_order,
                            passed_by_check)
 from grading.harness import ROOT, build
-from tests.grading.gpu_mutants import MUTANTS, build_cuda_folder, build_mutant
+from tests.grading.gpu_mutants import LAB, MUTANTS, build_cuda_folder, mutant_sources
 from tests.labs.cuda_env import missing_gpu, missing_nvcc
 
 GPU_LABS = {"05": "05-cuda-mega", "06": "06-cuda-split", "07": "07-soa"}
@@ -77,6 +77,53 @@ def test_speed_is_measured_against_the_labs_own_reference(lab, monkeypatch):
     # At least 2e8 paths: ~0.37 s of kernel time for the slowest reference (lab 06) on the
     # H200, more for the faster ones, whose spp is higher (grading/grade.py).
     assert seen["spp"] * (64 * seen["scale"]) ** 2 >= 2e8
+
+
+# ---- host side: the mutants still are what they say -------------------------------------------
+
+@pytest.mark.parametrize("name", sorted(MUTANTS))
+def test_each_mutant_applies_to_the_solution_and_builds(name, tmp_path):
+    """Each edit finds its text in today's solution (mutant_sources raises otherwise) and the
+    result compiles: a mutant the solution has drifted away from would test nothing."""
+    from grading.variants import lab_sources
+    files = mutant_sources(name)
+    file = MUTANTS[name].file
+    assert files[file] != lab_sources(LAB)[file]
+    if reason := missing_nvcc():
+        pytest.skip(reason)
+    assert build_cuda_folder(LAB, tmp_path / name, files).is_file()
+
+
+# ---- host side: submitted GPU sources are built in the sandbox --------------------------------
+
+@pytest.fixture
+def nvcc_and_sandbox():
+    if reason := missing_nvcc() or sandbox.probe():
+        pytest.skip(reason)
+    build("lab01-ref")  # the driver objects the sandboxed build links (it cannot write build/)
+
+
+def test_lab07_sources_build_in_the_sandbox(nvcc_and_sandbox, tmp_path):
+    """Lab 07's build reads lab 06's reference queue and stage loop (grading/compile.py,
+    SHARED_SOLUTIONS); without them in view its skeleton does not compile in the sandbox."""
+    from grading.grade import build_lab
+    from grading.variants import pristine_skeleton_sources
+    for name, text in pristine_skeleton_sources(GPU_LABS["07"]).items():
+        (tmp_path / name).write_text(text)
+    binary, errors = build_lab("07", tmp_path, trusted=False)
+    assert binary is not None and binary.is_file(), errors
+
+
+def test_a_gpu_submission_including_the_solution_does_not_compile(nvcc_and_sandbox, tmp_path):
+    """As for the CPU labs: the solution is out of the sandboxed compiler's view (a lab 05
+    render.cu that #includes it), and in view when trusted, so the test can fail."""
+    from grading.grade import build_lab
+    solution = ROOT / "labs" / GPU_LABS["05"] / "solution"
+    (tmp_path / "render.cu").write_text(f'#include "{solution}/render.cu"\n')
+    binary, errors = build_lab("05", tmp_path, trusted=False)
+    assert binary is None and "No such file or directory" in errors, errors
+    binary, errors = build_lab("05", tmp_path, trusted=True)
+    assert binary is not None, errors
 
 
 # ---- host side: a machine without a GPU ------------------------------------------------------
@@ -135,19 +182,20 @@ def test_gpu_binds_are_built_from_what_exists(tmp_path):
     libs = gpu.lib_dirs([str(with_driver), str(without_driver), str(tmp_path / "absent")],
                         environment=f"{from_env}:{with_driver}")
     assert libs == [str(from_env), str(with_driver)]
-    args = gpu.sandbox_args(dev=str(dev), libs=libs)
+    args = gpu.sandbox_args(dev=str(dev), libs=libs, sysfs=("/sys/bus/pci",))
     assert args == [
         "--dev-bind", f"{dev}/nvidia-caps", "/dev/nvidia-caps",
         "--dev-bind", f"{dev}/nvidia-uvm", "/dev/nvidia-uvm",
         "--dev-bind", f"{dev}/nvidia0", "/dev/nvidia0",
         "--dev-bind", f"{dev}/nvidia1", "/dev/nvidia1",
         "--dev-bind", f"{dev}/nvidiactl", "/dev/nvidiactl",
+        "--ro-bind-try", "/sys/bus/pci", "/sys/bus/pci",
         "--ro-bind", str(from_env), str(from_env),
         "--ro-bind", str(with_driver), str(with_driver),
         "--setenv", "LD_LIBRARY_PATH", f"{from_env}:{with_driver}"]
-    empty = tmp_path / "empty"
+    empty = tmp_path / "empty"  # no device node: no GPU, nothing to show
     empty.mkdir()
-    assert gpu.sandbox_args(dev=str(empty), libs=[]) == []
+    assert gpu.sandbox_args(dev=str(empty), libs=libs) == []
 
 
 def test_only_gpu_runs_see_the_gpu(monkeypatch):
@@ -164,6 +212,39 @@ def test_only_gpu_runs_see_the_gpu(monkeypatch):
     at = gpu_cmd.index("--dev-bind")
     assert gpu_cmd[at:at + 3] == marker
     assert gpu_cmd.index("--dev") < at and gpu_cmd.index("--clearenv") < at
+
+
+@pytest.fixture
+def open_folder():
+    """A folder the sandbox's unprivileged user can read (pytest's tmp_path may be closed
+    to it), as it can /dev and /usr."""
+    import tempfile
+    with tempfile.TemporaryDirectory(prefix="gpu-binds-") as folder:
+        os.chmod(folder, 0o755)
+        yield pathlib.Path(folder)
+
+
+def test_a_sandboxed_run_sees_the_gpu_binds(open_folder, monkeypatch):
+    """bubblewrap takes the binds as built, in that order: a stand-in device node appears
+    under /dev, LD_LIBRARY_PATH survives --clearenv, the driver's folder is readable."""
+    if reason := sandbox.probe():
+        pytest.skip(f"the grader's sandbox is not available here: {reason} (make deps)")
+    dev, lib = open_folder / "dev", open_folder / "lib"
+    for folder in (dev, lib):
+        folder.mkdir(mode=0o755)
+    for path in (dev / "nvidia0", lib / "libcuda.so.1"):
+        path.write_text("stand-in")
+        path.chmod(0o644)
+    real = gpu.sandbox_args
+    monkeypatch.setattr(gpu, "sandbox_args", lambda: real(dev=str(dev), libs=[str(lib)]))
+    script = 'cat /dev/nvidia0; echo " $LD_LIBRARY_PATH"; cat "$LD_LIBRARY_PATH/libcuda.so.1"'
+    with sandbox.Runner(trusted=False, gpu=True) as r:
+        out = r.run(["/bin/sh", "-c", script], sandbox.Limits(wall_seconds=20))
+    assert out.returncode == 0, out.stderr
+    assert out.stdout.split() == ["stand-in", str(lib), "stand-in"], out
+    with sandbox.Runner(trusted=False) as r:  # a CPU lab's run: none of it
+        out = r.run(["/bin/sh", "-c", "ls /dev/nvidia0"], sandbox.Limits(wall_seconds=20))
+    assert out.returncode != 0, out
 
 
 # ---- host side: the symptoms are named --------------------------------------------------------
@@ -257,12 +338,12 @@ def gpu_builds(on_gpu, tmp_path_factory):
     name -> binary."""
     from grading.variants import pristine_skeleton_sources
     root = tmp_path_factory.mktemp("gpu-builds")
-    jobs = {f"skeleton-{lab}": (lambda lab=lab: build_cuda_folder(
-                GPU_LABS[lab], root / f"skeleton-{lab}", pristine_skeleton_sources(GPU_LABS[lab])))
-            for lab in GPU_LABS}
-    jobs.update({name: (lambda name=name: build_mutant(name, root / name)) for name in MUTANTS})
-    with concurrent.futures.ThreadPoolExecutor(len(jobs)) as pool:
-        futures = {name: pool.submit(job) for name, job in jobs.items()}
+    folders = {f"skeleton-{lab}": (GPU_LABS[lab], pristine_skeleton_sources(GPU_LABS[lab]))
+               for lab in GPU_LABS}
+    folders.update({name: (LAB, mutant_sources(name)) for name in MUTANTS})
+    with concurrent.futures.ThreadPoolExecutor(len(folders)) as pool:
+        futures = {name: pool.submit(build_cuda_folder, lab, root / name, files)
+                   for name, (lab, files) in folders.items()}
         return {name: f.result() for name, f in futures.items()}
 
 
@@ -286,7 +367,7 @@ def test_skeleton_scores_at_most_ten_percent(gpu_builds, lab, tmp_path):
 def test_missing_synchronisation_loses_every_point(gpu_builds, tmp_path):
     """Pixels read back before the kernel wrote them: black images, named as such."""
     results = grade("05", gpu_builds["missing-sync"], tmp_path, trusted=True)
-    assert results["score"] == 0, describe(results)
+    assert results["score"] == 0, f"{MUTANTS['missing-sync'].what}:\n{describe(results)}"
     interior = next(t for t in results["tests"] if t["extra_data"]["check"] == "sphere-interior")
     assert "exactly black" in interior["output"], describe(results)
     assert "before the kernel had written them" in interior["output"], describe(results)
@@ -297,9 +378,9 @@ def test_swapped_index_loses_what_shows_position(gpu_builds, tmp_path):
     tell, the lit plane names it, and the hidden scene fails, so neither golden image, nor
     anything gated on them, counts."""
     results = grade("05", gpu_builds["swapped-index"], tmp_path, trusted=True)
+    assert results["score"] == 15, f"{MUTANTS['swapped-index'].what}:\n{describe(results)}"
     passed = passed_by_check(results)
     assert passed["sphere-interior"] and passed["glass-pane"], describe(results)
     assert not passed["lit-plane"] and not passed["hidden"], describe(results)
     plane = next(t for t in results["tests"] if t["extra_data"]["check"] == "lit-plane")
     assert "x and y swapped" in plane["output"], describe(results)
-    assert results["score"] == 15, describe(results)
