@@ -1,15 +1,19 @@
 """The rubrics of the GPU labs (05-07).
 
 Host side, wherever the tests run (CI has no GPU): each rubric sums to 100 and grades speed
-only after both golden images, against the lab's own reference; a machine without a GPU gets
-one line and a complete results.json marked for regrade; the sandbox's GPU binds are made
-from the device nodes and driver folders that exist; the symptoms the GPU mutants show are
-named (checked here on a CPU renderer made to show them).
+only after both golden images, against the lab's own reference; the mutants still apply to
+the solution and build (where nvcc is); submitted GPU sources build in the sandbox, without
+the solution in view; a machine without a GPU gets one line and a complete results.json
+marked for regrade; the sandbox's GPU binds are made from the device nodes and driver folders
+that exist and reach a sandboxed process; the symptoms the GPU mutants show are named
+(checked on lab 01's reference made to show them); and the whole rubric runs on a CPU
+stand-in.
 
 On a GPU (tools/gpu_check.sh runs these; elsewhere they skip and say why): each lab's
 reference scores 100 in the sandbox, each pristine skeleton at most 10%, and each classic GPU
 bug (tests/grading/gpu_mutants.py) loses the points it should, with a message naming the
-symptom. All renders are small: the whole file takes about two minutes on an H200.
+symptom. Renders are small but for the timed ones (~0.4 s of kernel time each on an H200),
+so that this part stays within a few minutes there.
 """
 import concurrent.futures
 import json
