@@ -12,7 +12,7 @@ stand-in.
 On a GPU (tools/gpu_check.sh runs these; elsewhere they skip and say why): each lab's
 reference scores 100 in the sandbox, each pristine skeleton at most 10%, and each classic GPU
 bug (tests/grading/gpu_mutants.py) loses the points it should, with a message naming the
-symptom. Renders are small but for the timed ones (~0.4 s of kernel time each on an H200),
+symptom, and lab 06's reference handed in for lab 07 loses the speed points. Renders are small but for the timed ones (~0.4 s of kernel time each on an H200),
 so that this part stays within a few minutes there.
 """
 import concurrent.futures
@@ -388,3 +388,14 @@ def test_swapped_index_loses_what_shows_position(gpu_builds, tmp_path):
     assert not passed["lit-plane"] and not passed["hidden"], describe(results)
     plane = next(t for t in results["tests"] if t["extra_data"]["check"] == "lit-plane")
     assert "x and y swapped" in plane["output"], describe(results)
+
+
+def test_lab06_handed_in_for_lab07_loses_only_the_speed(on_gpu, tmp_path):
+    """Lab 07's lesson is the pool's layout: lab 06's reference (the AoS pool, the same
+    image) is correct, but on the H200 it takes 2.4x the SoA pool's time (322 against 133 ms
+    on the baseline), far below the bar. This is the speed check failing on a GPU."""
+    results = grade("07", ROOT / "lab06-ref", tmp_path, trusted=True)
+    passed = passed_by_check(results)
+    assert not passed.pop("speed"), describe(results)
+    assert all(passed.values()), describe(results)
+    assert results["score"] == 70, describe(results)
