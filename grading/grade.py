@@ -259,20 +259,26 @@ def no_gpu_line(lab: str, reason: str) -> str:
 
 def gpu_problem(lab: str, run_policy: RunPolicy) -> str | None:
     """Why lab `lab` cannot be graded on this machine's GPU, in one line, or None: no GPU, or
-    the lab's trusted reference cannot render a pixel where the submission would run (the
-    sandbox without the device nodes or the driver's library). Either is the machine's
-    fault, never the submission's."""
+    the lab's trusted reference cannot render a pixel, outside the sandbox or where the
+    submission will run (a sandbox without the device nodes or the driver's library). Each
+    is the machine's fault, never the submission's. The run outside comes first also because
+    the driver creates /dev/nvidia-uvm (nvidia-modprobe) at a machine's first CUDA program,
+    which a sandboxed one cannot do; the sandbox shows the nodes that exist when it starts."""
     reason = gpu.missing_gpu()
     if reason:
         return no_gpu_line(lab, reason)
     from grading.harness import run_lab
-    with policy(run_policy):
-        run = run_lab(gpu_reference(lab), width=1, height=1, spp=1, check=False)
-    if run.returncode != 0 or run.image is None:
-        said = run.stderr.strip().splitlines()[-1:] or [sandbox.describe_exit(run.returncode)]
-        where = "trusted" if run_policy.trusted else "in the sandbox"
-        return (f"lab {lab}'s reference cannot render on this machine's GPU ({where}): "
-                f"{said[0][:300]}; not graded, marked for regrade")
+    policies = [dataclasses.replace(run_policy, trusted=True)]
+    if not run_policy.trusted:
+        policies.append(run_policy)
+    for p in policies:
+        with policy(p):
+            run = run_lab(gpu_reference(lab), width=1, height=1, spp=1, check=False)
+        if run.returncode != 0 or run.image is None:
+            said = run.stderr.strip().splitlines()[-1:] or [sandbox.describe_exit(run.returncode)]
+            where = "trusted" if p.trusted else "in the sandbox"
+            return (f"lab {lab}'s reference cannot render on this machine's GPU ({where}): "
+                    f"{said[0][:300]}; not graded, marked for regrade")
     return None
 
 

@@ -141,6 +141,23 @@ def test_no_gpu_refuses_in_process_and_marks_for_regrade(tmp_path, monkeypatch):
     assert "\n" not in results["output"] and "marked for regrade" in results["output"]
 
 
+def test_a_reference_that_cannot_reach_the_gpu_refuses_the_grade(tmp_path, monkeypatch):
+    """nvidia-smi sees a GPU but CUDA programs cannot use it (here: a stand-in reference that
+    fails as lab 05's does without a GPU): the machine's fault, said in one line, regrade."""
+    from grading import grade as grading
+    failing = tmp_path / "lab05-ref"
+    failing.write_text("#!/bin/sh\necho 'error: GPU: no CUDA GPU found (stand-in)' >&2\nexit 3\n")
+    failing.chmod(0o755)
+    monkeypatch.setattr(gpu, "missing_gpu", lambda: None)
+    monkeypatch.setattr(grading, "gpu_reference", lambda lab: failing)
+    results = grade("05", failing, tmp_path, trusted=True)
+    assert results["score"] == 0 and "\n" not in results["output"], results["output"]
+    assert results["output"] == ("lab 05's reference cannot render on this machine's GPU "
+                                 "(trusted): error: GPU: no CUDA GPU found (stand-in); "
+                                 "not graded, marked for regrade"), results["output"]
+    assert all(t["extra_data"]["regrade"] for t in results["tests"])
+
+
 def path_without_nvidia_smi(tmp_path) -> str:
     """A PATH with what the grader may call, nvidia-smi left out."""
     bin_dir = tmp_path / "bin"
