@@ -6,8 +6,8 @@ A CUDA program talks to the driver through device nodes (/dev/nvidiactl, /dev/nv
 linked into every lab binary loads at start-up. bubblewrap's `--dev /dev` gives a sandbox a
 minimal /dev without them, and `--clearenv` drops the LD_LIBRARY_PATH that finds libcuda.so
 where it lies outside the loader's cache (/usr/local/nvidia/lib64 on container GPU machines).
-So a GPU lab's runs get exactly those nodes and folders, read-only for the folders, and
-nothing else: CPU labs get none of it.
+So a GPU lab's runs get exactly those nodes and folders, read-only for the folders, and the
+sysfs folders the driver may read (SYSFS); CPU labs get none of it.
 """
 from __future__ import annotations
 

@@ -7,7 +7,8 @@ lie about its own speed. Every process the grader starts from a submission goes 
 
 - (untrusted, the default) runs it under bubblewrap: as an unprivileged user, in its own user,
   PID, network, IPC and mount namespaces, seeing read-only exactly the files it was given, the
-  system's libraries and MPI's files, and writing only to a scratch folder of its own;
+  system's libraries and MPI's files (and, for a GPU lab, the GPU: grading/gpu.py), and
+  writing only to a scratch folder of its own;
 - applies resource limits inside (CPU seconds, memory, file size, processes, open files);
 - kills the whole process tree when the wall-clock limit passes, when an output stream exceeds
   its cap, or when the grader itself dies (`--die-with-parent`; the PID namespace dies with its
