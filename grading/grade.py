@@ -19,7 +19,7 @@ import sys
 import time
 from typing import Callable
 
-from grading import checks, hidden, sandbox
+from grading import checks, gpu, hidden, sandbox
 from grading.harness import ROOT, RunPolicy, available_cores, build, policy
 from grading.results import Results, Test
 
@@ -92,6 +92,52 @@ def checked_golden(scene: str, points: int, **options) -> Item:
 
 
 
+# ---- the GPU labs (05-07) ------------------------------------------------------------------
+# Their correctness checks are lab 01's, run on the student's GPU binary. Their speed is
+# compared with the lab's own reference (labNN-ref, built from labs/NN-*/solution) on the same
+# GPU in the same run, interleaved, best of 3, in wall-clock time the grader measures around
+# each process (checks.check_speedup). A GPU process spends ~0.3 s creating its CUDA context
+# and loading its kernels before any pixel is rendered (0.34-0.37 s of process time against
+# 0.042 s of kernel time for lab 05 at 600x600, 512 spp, on the H200), which would squash
+# every ratio towards 1. So the timed render is the golden Cornell view at 10x its size
+# (640x640, the baseline's shape, a grid that fills the GPU) with spp chosen for ~0.3-0.4 s
+# of the reference's kernel time on an H200, and the start-up, measured by rendering one pixel
+# with the trusted reference, is subtracted from both sides: the ratio compares rendering,
+# copies included, not context creation. Each timed image is box-filtered to the golden size
+# and must pass the golden comparison.
+GPU_SPEED_BAR = 0.75  # at least 3/4 of the reference's speed: at most 1.33x its time
+GPU_TIMED_SCALE = 10
+# H200 throughput of the references (reference/gpu/): lab 05 4.3, lab 06 0.57, lab 07 1.4
+# Gpaths/s, so 640x640 at these spp takes 0.39, 0.37 and 0.30 s of kernel time.
+GPU_TIMED_SPP = {"05": 4096, "06": 512, "07": 1024}
+
+
+def gpu_reference(lab: str) -> pathlib.Path:
+    return ROOT / f"lab{lab}-ref"
+
+
+def gpu_speed(lab: str, points: int) -> Item:
+    """Speed against the lab's reference; counts only once both golden images pass."""
+    reference = gpu_reference(lab)
+    return Item("speed", f"speed >= {GPU_SPEED_BAR:g}x the lab {lab} reference", points,
+                lambda b: checks.check_speedup(b, reference, GPU_SPEED_BAR,
+                                               spp=GPU_TIMED_SPP[lab], scale=GPU_TIMED_SCALE,
+                                               overhead_reference=reference),
+                requires=GOLDENS)
+
+
+def gpu_rubric(lab: str) -> list[Item]:
+    """Labs 05-07 alike. The sphere interior is worth little: lab 05's skeleton (spheres only,
+    one path per pixel) passes it, the zero-variance scene needing no second path. A
+    reproducible skeleton proves nothing either, so reproducibility, like scale, counts only
+    for a renderer that renders the golden image."""
+    return [
+        worth(SPHERE_INTERIOR, 5), worth(LIT_PLANE, 10), worth(GLASS_PANE, 10), hidden_scene(),
+        checked_golden("cornell", 20), checked_golden("showcase", 15), worth(SCALE, 5),
+        needs(worth(REPRODUCIBLE, 5), "golden-cornell"), gpu_speed(lab, 30),
+    ]
+
+
 # Points per check, per lab (grading/README.md gives the formulas). The checks are described
 # in grading/checks.py. In labs 03 and 04 the point is parallelism: a correct serial renderer
 # (lab 03's skeleton is one) earns nothing there until its parallel speedup is shown, and the
@@ -128,6 +174,7 @@ RUBRICS = {
         parallel_speedup(40, threads=1, launcher=checks.mpirun(available_cores()),
                          overhead_reference=LAB04_REFERENCE),
     ],
+    **{lab: gpu_rubric(lab) for lab in sorted(gpu.GPU_LABS)},
 }
 
 # One run may take this long (seconds); every test render of a reference takes under 2 s on
@@ -169,8 +216,17 @@ def grade(lab: str, binary: pathlib.Path, heatmap_dir: pathlib.Path, *, trusted:
             results.refuse(f"refusing to grade untrusted code without a sandbox: {reason} "
                            f"(pass --trusted to grade your own code without one)")
             return results.as_dict()
+    on_gpu = gpu.is_gpu_lab(lab)
+    # CUDA reserves virtual address space for all of the GPU's memory and the host's (unified
+    # addressing), so an address-space limit (RLIMIT_AS) stops every CUDA program at start-up.
     limits = sandbox.Limits(wall_seconds=run_seconds,
-                            memory_bytes=None if trusted else sandbox.Limits.memory_bytes)
+                            memory_bytes=None if trusted or on_gpu else sandbox.Limits.memory_bytes)
+    run_policy = RunPolicy(trusted=trusted, limits=limits, gpu=on_gpu)
+    if on_gpu:
+        reason = gpu_problem(lab, run_policy)
+        if reason:
+            results.refuse(reason, regrade=True)
+            return results.as_dict()
     start = time.perf_counter()
     for item in grading_order(rubric):
         test = results.test(item.id)
@@ -183,7 +239,7 @@ def grade(lab: str, binary: pathlib.Path, heatmap_dir: pathlib.Path, *, trusted:
                            f"{'passes' if len(labels) == 1 else 'pass'}")
         else:
             t0 = time.perf_counter()
-            with policy(RunPolicy(trusted=trusted, limits=limits)):
+            with policy(dataclasses.replace(run_policy, limits=limits)):
                 result = run_check(item, binary, heatmap_dir, secret)
             test.finish(item.points if result.passed else 0, result.detail,
                         seconds=time.perf_counter() - t0, regrade=result.regrade,
@@ -194,6 +250,36 @@ def grade(lab: str, binary: pathlib.Path, heatmap_dir: pathlib.Path, *, trusted:
         results.changed()
     results.complete(time.perf_counter() - start)
     return results.as_dict()
+
+
+def no_gpu_line(lab: str, reason: str) -> str:
+    return (f"lab {lab} renders on an NVIDIA GPU and {reason}: not graded, marked for regrade "
+            f"on a machine with one")
+
+
+def gpu_problem(lab: str, run_policy: RunPolicy) -> str | None:
+    """Why lab `lab` cannot be graded on this machine's GPU, in one line, or None: no GPU, or
+    the lab's trusted reference cannot render a pixel, outside the sandbox or where the
+    submission will run (a sandbox without the device nodes or the driver's library). Each
+    is the machine's fault, never the submission's. The run outside comes first also because
+    the driver creates /dev/nvidia-uvm (nvidia-modprobe) at a machine's first CUDA program,
+    which a sandboxed one cannot do; the sandbox shows the nodes that exist when it starts."""
+    reason = gpu.missing_gpu()
+    if reason:
+        return no_gpu_line(lab, reason)
+    from grading.harness import run_lab
+    policies = [dataclasses.replace(run_policy, trusted=True)]
+    if not run_policy.trusted:
+        policies.append(run_policy)
+    for p in policies:
+        with policy(p):
+            run = run_lab(gpu_reference(lab), width=1, height=1, spp=1, check=False)
+        if run.returncode != 0 or run.image is None:
+            said = run.stderr.strip().splitlines()[-1:] or [sandbox.describe_exit(run.returncode)]
+            where = "trusted" if p.trusted else "in the sandbox"
+            return (f"lab {lab}'s reference cannot render on this machine's GPU ({where}): "
+                    f"{said[0][:300]}; not graded, marked for regrade")
+    return None
 
 
 def run_check(item: Item, binary, heatmap_dir, secret: str = "") -> checks.CheckResult:
@@ -240,7 +326,9 @@ def print_table(lab: str, binary: pathlib.Path, results: dict) -> None:
         print(results["output"])
 
 
-LAB_FOLDERS = {"01": "01-serial", "02": "02-simd", "03": "03-openmp", "04": "04-mpi"}
+LAB_FOLDERS = {"01": "01-serial", "02": "02-simd", "03": "03-openmp", "04": "04-mpi",
+               "05": "05-cuda-mega", "06": "06-cuda-split", "07": "07-soa"}
+SOURCE_SUFFIXES = (".cpp", ".h", ".hpp", ".cu", ".cuh")
 
 
 def first_errors(text: str, lines: int = 20) -> str:
@@ -260,7 +348,8 @@ def build_lab(lab: str, sources: pathlib.Path | None = None,
     if sources is not None:
         from grading.variants import build_sources
         files = {f.name: f.read_text(errors="replace") for f in sorted(sources.iterdir())
-                 if f.is_file() and f.suffix in (".cpp", ".h", ".hpp")}
+                 if f.is_file() and f.suffix in SOURCE_SUFFIXES}
+        target = "cuda-variant" if gpu.is_gpu_lab(lab) else "variant"
         workdir = pathlib.Path(tempfile.mkdtemp(prefix=f"lab{lab}-build-"))
         if not trusted:
             from grading.compile import build_in_sandbox
@@ -269,10 +358,10 @@ def build_lab(lab: str, sources: pathlib.Path | None = None,
             src.mkdir()
             for name, text in files.items():
                 (src / name).write_text(text)
-            binary, errors = build_in_sandbox(LAB_FOLDERS[lab], src)
+            binary, errors = build_in_sandbox(LAB_FOLDERS[lab], src, target)
             return binary, first_errors(errors) if errors else ""
         try:
-            return build_sources(LAB_FOLDERS[lab], workdir, files), ""
+            return build_sources(LAB_FOLDERS[lab], workdir, files, target=target), ""
         except RuntimeError as e:
             return None, first_errors(str(e))
     p = subprocess.run(["make", "-s", "-C", str(ROOT), f"lab{lab}"], capture_output=True,
@@ -316,9 +405,16 @@ def main(argv=None) -> int:
             print(f"error: {line}", file=sys.stderr)
             results.refuse(line)
             return 2
-        build("lab01-ref")  # the baseline of every speedup
+        if gpu.is_gpu_lab(a.lab) and (reason := gpu.missing_gpu()):
+            line = no_gpu_line(a.lab, reason)  # one line, and a results.json that says it
+            print(f"error: {line}", file=sys.stderr)
+            results.refuse(line, regrade=True)
+            return 2
+        build("lab01-ref")  # the baseline of every speedup, the hidden scene's golden data
         if a.lab == "04":
             build("lab04-ref")  # measures mpirun's start-up
+        if gpu.is_gpu_lab(a.lab):
+            build(f"lab{a.lab}-ref")  # the baseline of the lab's speed
         if a.binary:
             binary = pathlib.Path(a.binary)
             if not binary.is_file():

@@ -57,6 +57,7 @@ class RunPolicy:
     the sandbox (grading others' code), and under which limits (grading/sandbox.py)."""
     trusted: bool = True
     limits: Limits = Limits(wall_seconds=600, memory_bytes=None)
+    gpu: bool = False  # the binaries run on the GPU: the sandbox must show it (grading/gpu.py)
 
 
 _policy = RunPolicy()
@@ -132,7 +133,7 @@ def run_lab(binary: pathlib.Path | str, scene: pathlib.Path | str | None = None,
         limits = dataclasses.replace(limits, wall_seconds=timeout)
     if scene is None and not pol.trusted:
         scene = DEFAULT_SCENE  # the built-in default path is outside the sandbox's view
-    with Runner(trusted=pol.trusted) as r:
+    with Runner(trusted=pol.trusted, gpu=pol.gpu) as r:
         cmd = [*launcher, r.input(binary), "--quiet", "--json", "--pfm", r.scratch("image.pfm")]
         for flag, value in (("--scene", scene), ("--width", width), ("--height", height),
                             ("--spp", spp), ("--bounces", bounces), ("--seed", seed),

@@ -72,14 +72,17 @@ class Results:
     def test(self, id: str) -> Test:
         return next(t for t in self.tests if t.id == id)
 
-    def refuse(self, reason: str, detail: str = "") -> None:
+    def refuse(self, reason: str, detail: str = "", regrade: bool = False) -> None:
         """Nothing was graded (no sandbox, no binary, a compile error): every test scores 0
-        and says why; `detail` (the compiler's errors) goes to the top-level output."""
+        and says why; `detail` (the compiler's errors) goes to the top-level output.
+        `regrade`: the machine, not the submission, is at fault (a GPU lab where there is no
+        GPU); every test is marked for regrade, with no points meanwhile: provisional full
+        points would give them to an empty hand-in."""
         self.refused = True
         self.notes.append(clip(f"{reason}:\n{detail}" if detail else reason))
         for t in self.tests:
             if not t.finished:
-                t.finish(0, f"not graded: {reason}")
+                t.finish(0, f"not graded: {reason}", regrade=regrade)
         self.changed()
 
     def interrupt(self, reason: str) -> None:

@@ -7,7 +7,8 @@ lie about its own speed. Every process the grader starts from a submission goes 
 
 - (untrusted, the default) runs it under bubblewrap: as an unprivileged user, in its own user,
   PID, network, IPC and mount namespaces, seeing read-only exactly the files it was given, the
-  system's libraries and MPI's files, and writing only to a scratch folder of its own;
+  system's libraries and MPI's files (and, for a GPU lab, the GPU: grading/gpu.py), and
+  writing only to a scratch folder of its own;
 - applies resource limits inside (CPU seconds, memory, file size, processes, open files);
 - kills the whole process tree when the wall-clock limit passes, when an output stream exceeds
   its cap, or when the grader itself dies (`--die-with-parent`; the PID namespace dies with its
@@ -167,8 +168,9 @@ class Runner:
             data = r.output("image.pfm")          # bytes or None, read after the run
     """
 
-    def __init__(self, trusted: bool):
+    def __init__(self, trusted: bool, gpu: bool = False):
         self.trusted = trusted
+        self.gpu = gpu  # a GPU lab's runs: the sandbox shows the GPU (grading/gpu.py)
         self.root = pathlib.Path(tempfile.mkdtemp(prefix="grading-"))
         os.chmod(self.root, 0o755)  # the unprivileged sandbox user must reach staged inputs
         self.inputs: dict[str, pathlib.Path] = {}
@@ -258,6 +260,9 @@ class Runner:
             cmd += ["--ro-bind", str(outside), inside]
         for path, writable in self.binds:
             cmd += ["--bind" if writable else "--ro-bind", path, path]
+        if self.gpu:  # after --dev /dev and --clearenv, which it adds to
+            from grading.gpu import sandbox_args
+            cmd += sandbox_args()
         cmd += ["--remount-ro", "/"]  # bubblewrap's root is a tmpfs: no files may go there
         for key, value in {"PATH": "/usr/local/bin:/usr/bin:/bin", "HOME": SCRATCH,
                            "TMPDIR": "/tmp", "LANG": "C.UTF-8", **env}.items():

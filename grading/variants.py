@@ -21,15 +21,16 @@ def lab_sources(lab: str, source_dir: str = "solution") -> dict[str, str]:
 
 
 def build_sources(variant_lab: str, workdir: pathlib.Path, sources: dict[str, str],
-                  make_args=()) -> pathlib.Path:
+                  make_args=(), target: str = "variant") -> pathlib.Path:
     """Write `sources` (bare file names: render.cpp, path_tracer.h, ray.h...) into a folder and
     build them as the Makefile builds `variant_lab` (a lab folder name, or 02-simd-a for lab 02
-    Part A); `make_args` override Makefile variables (e.g. OPT, BUILD). Returns the binary."""
+    Part A); `make_args` override Makefile variables (e.g. OPT, BUILD); `target` is
+    cuda-variant for a CUDA lab. Returns the binary."""
     src = workdir / "src"
     src.mkdir(parents=True, exist_ok=True)
     for name, text in sources.items():
         (src / name).write_text(text)
-    p = subprocess.run(["make", "-s", "-C", str(ROOT), "variant", f"VARIANT_LAB={variant_lab}",
+    p = subprocess.run(["make", "-s", "-C", str(ROOT), target, f"VARIANT_LAB={variant_lab}",
                         f"VARIANT={src}", *make_args], capture_output=True, text=True)
     if p.returncode != 0:
         raise RuntimeError(f"building a {variant_lab} variant failed:\n{(p.stdout + p.stderr)[-2000:]}")

@@ -86,7 +86,7 @@ if command -v cuobjdump >/dev/null && [ -x lab05-bench ]; then
 fi
 
 # ---- 4. the GPU tests -------------------------------------------------------------------
-gpu_tests="tests/labs/test_lab05.py tests/labs/test_lab06.py tests/labs/test_lab07.py tests/labs/test_device_code.py"
+gpu_tests="tests/labs/test_lab05.py tests/labs/test_lab06.py tests/labs/test_lab07.py tests/labs/test_device_code.py tests/grading/test_gpu_rubrics.py"
 say "tests: pytest $gpu_tests"
 python3 -m pytest -q -rs -p no:cacheprovider $gpu_tests \
     --junitxml=/tmp/gpu-check-junit.xml > "$out/pytest.txt" 2>&1

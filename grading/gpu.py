@@ -1,0 +1,90 @@
+"""What grading a GPU lab (05-07) needs of the machine: an NVIDIA GPU, and a sandbox that lets
+a CUDA program reach it.
+
+A CUDA program talks to the driver through device nodes (/dev/nvidiactl, /dev/nvidia-uvm,
+/dev/nvidia0, ...) and the driver's user-space library (libcuda.so), which the CUDA runtime
+linked into every lab binary loads at start-up. bubblewrap's `--dev /dev` gives a sandbox a
+minimal /dev without them, and `--clearenv` drops the LD_LIBRARY_PATH that finds libcuda.so
+where it lies outside the loader's cache (/usr/local/nvidia/lib64 on container GPU machines).
+So a GPU lab's runs get exactly those nodes and folders, read-only for the folders, and the
+sysfs folders the driver may read (SYSFS); CPU labs get none of it.
+"""
+from __future__ import annotations
+
+import functools
+import glob
+import os
+import shutil
+import subprocess
+
+GPU_LABS = frozenset({"05", "06", "07"})
+
+DEV = "/dev"
+# Where the driver's libcuda.so may live: Debian/Ubuntu's multiarch folder, the folder the
+# NVIDIA container runtime mounts, the RPM distributions' folder. The grader's own
+# LD_LIBRARY_PATH is searched too (lib_dirs()).
+DRIVER_LIB_DIRS = ("/usr/lib/x86_64-linux-gnu", "/usr/local/nvidia/lib64", "/usr/lib64")
+# What the driver's library may read to place the GPU (its PCI device, NUMA node, the
+# module's parameters), as flatpak shows it to sandboxed GPU programs: read-only hardware
+# facts, no one's data. The sandbox otherwise shows only /sys/devices/system/{cpu,node}.
+SYSFS = ("/sys/bus/pci", "/sys/devices", "/sys/module/nvidia")
+
+
+def is_gpu_lab(lab: str) -> bool:
+    return lab in GPU_LABS
+
+
+@functools.lru_cache(maxsize=None)
+def missing_gpu() -> str | None:
+    """Why nothing can run on an NVIDIA GPU here, or None. Asks nvidia-smi, which comes with
+    the driver (as tests/labs/cuda_env.py does for the lab tests)."""
+    if shutil.which("nvidia-smi") is None:
+        return "this machine has no NVIDIA GPU (no driver: nvidia-smi not found)"
+    try:
+        p = subprocess.run(["nvidia-smi", "--query-gpu=name", "--format=csv,noheader"],
+                           capture_output=True, text=True, timeout=60)
+    except (OSError, subprocess.TimeoutExpired) as e:
+        return f"this machine's NVIDIA driver does not answer (nvidia-smi: {e})"
+    if p.returncode != 0 or not p.stdout.strip():
+        return "this machine has no NVIDIA GPU (nvidia-smi lists none)"
+    return None
+
+
+def device_nodes(dev: str = DEV) -> list[str]:
+    """The NVIDIA device nodes present (names below `dev`): nvidiactl, nvidia-uvm,
+    nvidia-uvm-tools, nvidia0, nvidia1, ..., and the nvidia-caps folder (MIG)."""
+    return sorted(os.path.basename(p) for p in glob.glob(os.path.join(dev, "nvidia*")))
+
+
+def lib_dirs(candidates=DRIVER_LIB_DIRS, environment: str | None = None) -> list[str]:
+    """The folders, of `candidates` and of the LD_LIBRARY_PATH `environment` (default: the
+    grader's), that hold the driver's library libcuda.so*, in that order, each once."""
+    if environment is None:
+        environment = os.environ.get("LD_LIBRARY_PATH", "")
+    found = []
+    for folder in [*environment.split(":"), *candidates]:
+        if folder and folder not in found and glob.glob(os.path.join(folder, "libcuda.so*")):
+            found.append(folder)
+    return found
+
+
+def sandbox_args(dev: str = DEV, libs: list[str] | None = None, sysfs=SYSFS) -> list[str]:
+    """bubblewrap arguments that give a sandboxed CUDA program the GPU: each NVIDIA device
+    node, bound as a device (`--dev-bind`; it must come after `--dev /dev`), the `sysfs`
+    folders read-only where they exist, and each folder holding libcuda.so, read-only, with
+    LD_LIBRARY_PATH naming them (it must come after `--clearenv`). Built from what exists:
+    on a machine without a GPU (no device node) it is empty."""
+    libs = lib_dirs() if libs is None else libs
+    nodes = device_nodes(dev)
+    if not nodes:
+        return []
+    args: list[str] = []
+    for name in nodes:
+        args += ["--dev-bind", os.path.join(dev, name), f"/dev/{name}"]
+    for folder in sysfs:
+        args += ["--ro-bind-try", folder, folder]
+    for folder in libs:
+        args += ["--ro-bind", folder, folder]
+    if libs:
+        args += ["--setenv", "LD_LIBRARY_PATH", ":".join(libs)]
+    return args
