@@ -29,8 +29,16 @@ LIB_OBJ    := $(LIB_SRC:%.cpp=$(BUILD)/%.o)
 DRIVER_OBJ := $(BUILD)/common/host/lab_main.o $(BUILD)/common/host/main.o
 COMMON_OBJ := $(LIB_OBJ) $(DRIVER_OBJ)
 
+# The double build (common/core/real.h): the same sources with -DRT_DOUBLE, every object in
+# build/double/ (a float object and a double one must never be linked together: Vec3 differs).
+# Offered for lab 01 and the GPU megakernel (lab05-ref-double, cuda.mk); labs 02-04 use lab
+# 02's 8-wide float AVX2 code and have no double build.
+DOUBLE_BUILD      := $(BUILD)/double
+DOUBLE_LIB_OBJ    := $(LIB_OBJ:$(BUILD)/%=$(DOUBLE_BUILD)/%)
+DOUBLE_COMMON_OBJ := $(COMMON_OBJ:$(BUILD)/%=$(DOUBLE_BUILD)/%)
+
 PHONY_EXTRA := variant
-PHONY_EXTRA += render grade check-nvcc bench-micro bench-cpu count-work
+PHONY_EXTRA += render grade check-nvcc bench-micro bench-cpu count-work bench-precision
 .PHONY: all help deps labs $(PHONY_EXTRA) test test-unit test-labs skeletons check-skeletons golden bench tradeoff \
         clean
 .DEFAULT_GOAL := help
@@ -53,6 +61,8 @@ help:
 	@echo "make bench-micro  Google Benchmark of the inner loops (closest hit, shadow ray, path)"
 	@echo "make count-work   instructions per camera path, split by query (needs valgrind)"
 	@echo "make tradeoff     error against time: RMSE vs spp for the lab-01 reference"
+	@echo "make lab01-ref-double  lab 01's reference computing in double (lab05-ref-double: GPU)"
+	@echo "make bench-precision  float against double: time and error of lab 01's reference"
 	@echo "make golden       regenerate the golden images in reference/ (minutes)"
 	@echo "make skeletons    regenerate the skeletons from the solutions"
 	@echo "make clean        remove build products"
@@ -64,6 +74,9 @@ deps:
 $(BUILD)/%.o: %.cpp
 	@mkdir -p $(dir $@)
 	$(CXX) $(CXXFLAGS) $(LAB_INCLUDES) $(INCLUDES) -c $< -o $@
+$(DOUBLE_BUILD)/%.o: %.cpp
+	@mkdir -p $(dir $@)
+	$(CXX) $(CXXFLAGS) -DRT_DOUBLE $(LAB_INCLUDES) $(INCLUDES) -c $< -o $@
 
 # ---- labs -------------------------------------------------------------------------------
 # lab01 builds labs/01-serial/skeleton, lab01-ref builds labs/01-serial/solution. Each
@@ -86,6 +99,15 @@ LAB_BINARIES :=
 include cuda.mk
 include $(sort $(wildcard labs/*/lab.mk))
 include grading/grading.mk
+
+# Lab 01's reference in double, with the same scene files and command line (--json says
+# "precision": "double").
+$(DOUBLE_BUILD)/labs/01-serial/solution/%.o: LAB_INCLUDES = -Ilabs/01-serial/solution
+lab01-ref-double: $(DOUBLE_BUILD)/labs/01-serial/solution/render.o $(DOUBLE_COMMON_OBJ)
+	$(CXX) $(CXXFLAGS) $^ -o $@
+.PHONY: lab01-ref-double
+LAB_BINARIES += lab01-ref-double
+
 labs: $(LAB_BINARIES)
 
 # ---- tests ------------------------------------------------------------------------------
@@ -93,6 +115,10 @@ UNIT_SRC := $(wildcard tests/unit/*.cpp)
 UNIT_OBJ := $(UNIT_SRC:%.cpp=$(BUILD)/%.o)
 
 $(BUILD)/unit_tests: $(UNIT_OBJ) $(LIB_OBJ)
+	$(CXX) $(CXXFLAGS) $^ -o $@ -lgtest -lgtest_main -pthread
+
+# The unit tests that show the double build computes in double (tests/precision/).
+$(BUILD)/precision_tests_double: $(DOUBLE_BUILD)/tests/precision/test_double.o $(DOUBLE_LIB_OBJ)
 	$(CXX) $(CXXFLAGS) $^ -o $@ -lgtest -lgtest_main -pthread
 
 test-unit: $(BUILD)/unit_tests
@@ -162,6 +188,10 @@ bench-micro: $(BUILD)/intersect_bench
 
 tradeoff: lab01-ref
 	$(PYTHON) tools/bench_serial.py tradeoff
+
+# Float against double: time and error of lab01-ref and lab01-ref-double (tools/bench_precision.py).
+bench-precision: lab01-ref lab01-ref-double
+	$(PYTHON) tools/bench_precision.py
 
 # ---- variants -----------------------------------------------------------------------------
 # A lab built from a folder of edited sources outside the tree: the pristine skeleton as

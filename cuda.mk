@@ -5,6 +5,7 @@
 #   make lab05-bench-fast-math   the same built with --use_fast_math
 #   make lab05-ref-fast-math     the reference built with --use_fast_math (accuracy table)
 #   make lab05-ref-no-fma        the reference built with --fmad=false (no fused multiply-add)
+#   make lab05-ref-double        the reference in double precision (common/core/real.h)
 #   make kernel-report           registers, spills, stack and shared memory of every kernel
 #   make gpu-check OUT=DIR       on a GPU machine: build, test, benchmark, report (tools/gpu_check.sh)
 #
@@ -58,7 +59,7 @@ endef
 LAB05 := labs/05-cuda-mega
 LAB05_BUILD := $(BUILD)/$(LAB05)
 LAB05_TARGETS := lab05 lab05-ref lab05-bench lab05-bench-fast-math lab05-ref-fast-math \
-                 lab05-ref-no-fma
+                 lab05-ref-no-fma lab05-ref-double
 .PHONY: $(LAB05_TARGETS) kernel-report gpu-check print-cuda-build-command cuda-variant
 
 ifeq ($(HAVE_NVCC),)
@@ -78,6 +79,13 @@ $(LAB05_BUILD)/fast-math/render.o $(LAB05_BUILD)/no-fma/render.o: $(LAB05)/solut
 lab05-ref-fast-math: $(LAB05_BUILD)/fast-math/render.o $(COMMON_OBJ)
 	$(NVCC) $(CUDA_ARCH) $^ -o $@
 lab05-ref-no-fma: $(LAB05_BUILD)/no-fma/render.o $(COMMON_OBJ)
+	$(NVCC) $(CUDA_ARCH) $^ -o $@
+# The reference in double: -DRT_DOUBLE, linked with the double build's host objects (Makefile).
+$(LAB05_BUILD)/double/render.o: $(LAB05)/solution/render.cu
+	@mkdir -p $(dir $@)
+	$(NVCC) $(NVCCFLAGS) $(CUDA_ARCH) -DRT_DOUBLE -I$(LAB05)/solution -I$(LAB05) \
+	    $(INCLUDES) -MMD -MP -MF $(@:.o=.d) -c $< -o $@
+lab05-ref-double: $(LAB05_BUILD)/double/render.o $(DOUBLE_COMMON_OBJ)
 	$(NVCC) $(CUDA_ARCH) $^ -o $@
 
 # A CUDA lab built from a folder of edited sources (the pristine skeleton, a mutant), as

@@ -3,6 +3,7 @@
 
 #include <cmath>
 
+#include <real.h>
 #include <vec3.h>
 
 enum class MaterialType : int { Diffuse = 0, Mirror = 1, Glass = 2 };
@@ -10,41 +11,43 @@ enum class MaterialType : int { Diffuse = 0, Mirror = 1, Glass = 2 };
 struct Material {
     MaterialType type;  // which BSDF
     Vec3 albedo;        // diffuse reflectance or mirror tint (unused by glass)
-    float ior;          // index of refraction inside glass (unused otherwise)
+    real ior;           // index of refraction inside glass (unused otherwise)
 };
 
-constexpr float kPi = 3.14159265358979323846f;
+constexpr real kPi = real(3.14159265358979323846);
 
 // sin(2 pi u) and cos(2 pi u) for u in [0, 1), without a libm call on the hot path. The
 // quadrant comes exactly from 4u, the rest from Cephes' single-precision polynomials on
 // [-pi/4, pi/4] (about 1 ulp). Lab 02's sincos_2pi8 (simd8.h) is this, lane by lane, with the
-// same operations in the same order, so both give the same bits.
-RT_HD inline void sincos_2pi(float u, float& s, float& c) {
-    const float t = u * 4.0f;  // exact
-    const float q = rintf(t);
-    const float x = (t - q) * 1.57079632679489661923f;  // in [-pi/4, pi/4]
-    const float z = x * x;
-    const float sin_x = x + x * z * ((-1.9515295891e-4f * z + 8.3321608736e-3f) * z - 1.6666654611e-1f);
-    const float cos_x = 1.0f - z * 0.5f +
+// same operations in the same order, so both give the same bits. The double build computes
+// in double but keeps these single-precision polynomials (about 1e-7): the random directions
+// then differ from the float build's by rounding only.
+RT_HD inline void sincos_2pi(real u, real& s, real& c) {
+    const real t = u * real(4);  // exact
+    const real q = rint_real(t);
+    const real x = (t - q) * real(1.57079632679489661923);  // in [-pi/4, pi/4]
+    const real z = x * x;
+    const real sin_x = x + x * z * ((-1.9515295891e-4f * z + 8.3321608736e-3f) * z - 1.6666654611e-1f);
+    const real cos_x = 1.0f - z * 0.5f +
                         z * z * ((2.443315711809948e-5f * z - 1.388731625493765e-3f) * z +
                                  4.166664568298827e-2f);
     // Quadrant k: sin = (sin x, cos x, -sin x, -cos x)[k], cos = (cos x, -sin x, -cos x, sin x)[k].
     const int k = static_cast<int>(q) & 3;
-    const float s_abs = (k & 1) ? cos_x : sin_x;
-    const float c_abs = (k & 1) ? sin_x : cos_x;
+    const real s_abs = (k & 1) ? cos_x : sin_x;
+    const real c_abs = (k & 1) ? sin_x : cos_x;
     s = (k & 2) ? -s_abs : s_abs;
     c = ((k ^ (k >> 1)) & 1) ? -c_abs : c_abs;
 }
 
 // Cosine-weighted direction about unit normal n from two uniform numbers (Malley's method).
 // Its pdf cos/pi cancels the Lambertian BRDF's cos/pi, so throughput simply gains the albedo.
-RT_HD inline Vec3 sample_cosine_hemisphere(Vec3 n, float u1, float u2) {
-    const float r = sqrtf(u1);
-    float sin_phi, cos_phi;
+RT_HD inline Vec3 sample_cosine_hemisphere(Vec3 n, real u1, real u2) {
+    const real r = sqrt_real(u1);
+    real sin_phi, cos_phi;
     sincos_2pi(u2, sin_phi, cos_phi);
-    const float x = r * cos_phi;
-    const float y = r * sin_phi;
-    const float z = sqrtf(max_float(0.0f, 1.0f - u1));
+    const real x = r * cos_phi;
+    const real y = r * sin_phi;
+    const real z = sqrt_real(max_float(0.0f, 1.0f - u1));
     Vec3 t, b;
     orthonormal_basis(n, t, b);
     return t * x + b * y + n * z;
@@ -53,21 +56,21 @@ RT_HD inline Vec3 sample_cosine_hemisphere(Vec3 n, float u1, float u2) {
 // Unpolarised Fresnel reflectance of a smooth dielectric (exact, not Schlick's fit).
 // cos_i: cosine of the incident angle (> 0); eta = n_incident / n_transmitted.
 // Returns 1 for total internal reflection and stores the transmitted cosine in cos_t.
-RT_HD inline float fresnel_dielectric(float cos_i, float eta, float& cos_t) {
-    const float sin2_t = eta * eta * max_float(0.0f, 1.0f - cos_i * cos_i);
+RT_HD inline real fresnel_dielectric(real cos_i, real eta, real& cos_t) {
+    const real sin2_t = eta * eta * max_float(0.0f, 1.0f - cos_i * cos_i);
     if (sin2_t >= 1.0f) {
         cos_t = 0.0f;
         return 1.0f;
     }
-    cos_t = sqrtf(1.0f - sin2_t);
-    const float r_parallel = (cos_i - eta * cos_t) / (cos_i + eta * cos_t);
-    const float r_perpendicular = (eta * cos_i - cos_t) / (eta * cos_i + cos_t);
+    cos_t = sqrt_real(1.0f - sin2_t);
+    const real r_parallel = (cos_i - eta * cos_t) / (cos_i + eta * cos_t);
+    const real r_perpendicular = (eta * cos_i - cos_t) / (eta * cos_i + cos_t);
     return 0.5f * (r_parallel * r_parallel + r_perpendicular * r_perpendicular);
 }
 
 // Refracted direction of unit d through a surface with unit normal n facing d's side,
 // given eta and the transmitted cosine from fresnel_dielectric.
-RT_HD inline Vec3 refract(Vec3 d, Vec3 n, float eta, float cos_t) {
-    const float cos_i = -dot(d, n);
+RT_HD inline Vec3 refract(Vec3 d, Vec3 n, real eta, real cos_t) {
+    const real cos_i = -dot(d, n);
     return normalize(d * eta + n * (eta * cos_i - cos_t));
 }

@@ -26,7 +26,7 @@
 
 // The nearest surface a ray meets: which primitive and how far.
 struct Hit {
-    float t = FLT_MAX;  // distance along the ray; FLT_MAX when nothing was hit
+    real t = kRealMax;  // distance along the ray; kRealMax (real.h) when nothing was hit
     int sphere = -1;    // index of the sphere hit, or -1
     int triangle = -1;  // index of the triangle hit, or -1
 
@@ -37,7 +37,7 @@ struct Hit {
 struct SurfacePoint {
     Vec3 position;  // world-space hit point
     Vec3 normal;    // unit geometric normal: outward for spheres, the front side for triangles
-    float extent;   // the primitive's largest |coordinate|, for offset_ray_origin (ray.h)
+    real extent;    // the primitive's largest |coordinate|, for offset_ray_origin (ray.h)
     int material;   // index into the material table
 };
 
@@ -60,7 +60,7 @@ RT_HD inline Hit closest_hit(const SceneView& scene, const Ray& ray) {
     Hit hit;
     // BEGIN SOLUTION
     for (int i = 0; i < scene.num_spheres; ++i) {
-        const float t = intersect_sphere(ray, scene.spheres[i], hit.t);
+        const real t = intersect_sphere(ray, scene.spheres[i], hit.t);
         if (t < hit.t) {
             hit.t = t;
             hit.sphere = i;
@@ -68,7 +68,7 @@ RT_HD inline Hit closest_hit(const SceneView& scene, const Ray& ray) {
     }
     const RayShear shear(ray.direction);
     for (int i = 0; i < scene.num_triangles; ++i) {
-        const float t = intersect_triangle(ray, shear, scene.triangles[i], hit.t);
+        const real t = intersect_triangle(ray, shear, scene.triangles[i], hit.t);
         if (t < hit.t) {
             hit.t = t;
             hit.sphere = -1;
@@ -79,7 +79,7 @@ RT_HD inline Hit closest_hit(const SceneView& scene, const Ray& ray) {
     //> // TODO(lab01): this finds spheres only. Loop over the triangles too (build one
     //> // RayShear per ray, then intersect_triangle), keeping the nearest hit.
     //> for (int i = 0; i < scene.num_spheres; ++i) {
-    //>     const float t = intersect_sphere(ray, scene.spheres[i], hit.t);
+    //>     const real t = intersect_sphere(ray, scene.spheres[i], hit.t);
     //>     if (t < hit.t) {
     //>         hit.t = t;
     //>         hit.sphere = i;
@@ -91,7 +91,7 @@ RT_HD inline Hit closest_hit(const SceneView& scene, const Ray& ray) {
 
 // Whether anything blocks the ray before distance t_max. Stops at the first blocker:
 // a shadow ray needs any hit, not the closest. Glass blocks too (no caustics).
-RT_HD inline bool occluded(const SceneView& scene, const Ray& ray, float t_max) {
+RT_HD inline bool occluded(const SceneView& scene, const Ray& ray, real t_max) {
     // BEGIN SOLUTION
     for (int i = 0; i < scene.num_spheres; ++i) {
         if (intersect_sphere(ray, scene.spheres[i], t_max) < t_max) return true;
@@ -140,7 +140,7 @@ RT_HD inline PathState start_path(const Ray& camera_ray, int max_bounces) {
 // decides it: in the path loop below right away, in a wavefront renderer in a kernel of its own.
 struct ShadowRay {
     Ray ray;
-    float t_max;
+    real t_max;
     Vec3 radiance;
 };
 
@@ -157,10 +157,10 @@ RT_HD inline bool sample_light(const SceneView& scene, Vec3 position, Vec3 origi
                                Vec3 facing_normal, Vec3 albedo, ShadowRay& shadow) {
     // BEGIN SOLUTION
     const Vec3 to_light = scene.light.position - position;
-    const float distance2 = length_squared(to_light);
-    const float distance = sqrtf(distance2);
-    const Vec3 wi = to_light * (1.0f / distance);
-    const float cos_theta = dot(facing_normal, wi);
+    const real distance2 = length_squared(to_light);
+    const real distance = sqrt_real(distance2);
+    const Vec3 wi = to_light * (real(1) / distance);
+    const real cos_theta = dot(facing_normal, wi);
     if (cos_theta <= 0.0f) return false;  // light behind the surface
     shadow.ray = {origin, wi};
     shadow.t_max = distance - dot(origin - position, wi);
@@ -224,9 +224,9 @@ RT_HD RT_FORCE_INLINE bool bounce_step(const SceneView& scene, const Hit& hit, c
             path.throughput *= material.albedo;
             path.ray = {above, reflect(incoming, facing)};
         } else {  // glass: reflect or refract, chosen with the Fresnel reflectance
-            const float eta = entering ? 1.0f / material.ior : material.ior;
-            float cos_t;
-            const float reflectance = fresnel_dielectric(-dot(incoming, facing), eta, cos_t);
+            const real eta = entering ? real(1) / material.ior : material.ior;
+            real cos_t;
+            const real reflectance = fresnel_dielectric(-dot(incoming, facing), eta, cos_t);
             if (rng.at(bounce_dimension(bounce, 0)) < reflectance) {
                 path.ray = {above, reflect(incoming, facing)};
             } else {
@@ -290,7 +290,9 @@ RT_HD inline Vec3 render_pixel(const SceneView& scene, const Geometry& geometry,
     // BEGIN SOLUTION
     for (int s = 0; s < settings.spp; ++s) {
         const SampleStream rng(settings.seed, pixel, s);
-        const Ray ray = camera.ray_through(x + rng.at(kDimPixelX), y + rng.at(kDimPixelY));
+        // real(...): the double build places the jitter in double (the random number is float).
+        const Ray ray =
+            camera.ray_through(x + real(rng.at(kDimPixelX)), y + real(rng.at(kDimPixelY)));
         sum.add(trace_path(scene, geometry, ray, rng, settings.bounces));
     }
     return sum.mean(settings.spp);

@@ -1,13 +1,14 @@
 // A ray: origin plus unit direction; points along it are origin + t * direction.
 #pragma once
 
+#include <real.h>  // also here: lab 02 Part A's vec3.h stands in for ours
 #include <vec3.h>
 
 struct Ray {
     Vec3 origin;     // where the ray starts
     Vec3 direction;  // unit length, so t is a distance
 
-    RT_HD Vec3 at(float t) const { return origin + direction * t; }
+    RT_HD Vec3 at(real t) const { return origin + direction * t; }
 };
 
 // Start point for a ray leaving surface point p on the side of unit normal n. The offset must
@@ -23,8 +24,8 @@ struct Ray {
 // 2^-20 of their sum is 8 to 16 ulps. Measured over random rays leaving triangles and spheres
 // of sizes 1e-3..1e5 placed up to 1e4 from the origin, grazing ones included: no self-hit
 // down to 2^-22, some at 2^-23; 2^-20 keeps a margin of 4 (tests/unit/test_offset.cpp).
-RT_HD inline Vec3 offset_ray_origin(Vec3 p, Vec3 n, float distance_travelled, float extent) {
-    constexpr float kRelativeOffset = 1.0f / (1 << 20);
-    const float scale = max_component(abs(p)) + distance_travelled + extent;
+RT_HD inline Vec3 offset_ray_origin(Vec3 p, Vec3 n, real distance_travelled, real extent) {
+    constexpr real kRelativeOffset = real(1) / (1 << 20);
+    const real scale = max_component(abs(p)) + distance_travelled + extent;
     return p + n * (scale * kRelativeOffset);
 }

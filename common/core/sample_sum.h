@@ -7,6 +7,7 @@
 // measured). One double add per sample and channel costs nothing next to tracing the path.
 #pragma once
 
+#include <real.h>
 #include <vec3.h>
 
 struct SampleSum {
@@ -18,9 +19,9 @@ struct SampleSum {
         b += sample.z;
     }
 
-    // The mean of `count` samples, rounded once to float.
+    // The mean of `count` samples, rounded once to `real`.
     RT_HD Vec3 mean(int count) const {
-        return Vec3(static_cast<float>(r / count), static_cast<float>(g / count),
-                    static_cast<float>(b / count));
+        return Vec3(static_cast<real>(r / count), static_cast<real>(g / count),
+                    static_cast<real>(b / count));
     }
 };

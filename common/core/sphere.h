@@ -9,13 +9,13 @@
 // one vector load on a GPU (see Triangle).
 struct alignas(16) Sphere {
     Vec3 center;    // world-space centre
-    float radius;   // > 0
+    real radius;    // > 0
     int material;   // index into the scene's material table
 };
 
 // The largest coordinate magnitude on the sphere: what its intersection's rounding error
 // grows with (offset_ray_origin in ray.h).
-RT_HD inline float sphere_extent(const Sphere& s) { return max_component(abs(s.center)) + s.radius; }
+RT_HD inline real sphere_extent(const Sphere& s) { return max_component(abs(s.center)) + s.radius; }
 
 // Distance along `ray` to the nearest intersection with `s` in (0, t_max), or t_max when
 // there is none. Avoids both cancellations of the textbook b^2 - 4ac form:
@@ -23,19 +23,19 @@ RT_HD inline float sphere_extent(const Sphere& s) { return max_component(abs(s.c
 //    ray), not b^2 - c, which loses every digit when the sphere is far away or small;
 //  - the near root is c / q with q = b + sign(b) sqrt(disc), not b - sqrt(disc)
 //    (Haines et al., "Precision Improvements for Ray/Sphere Intersection", Ray Tracing Gems).
-RT_HD inline float intersect_sphere(const Ray& ray, const Sphere& s, float t_max) {
+RT_HD inline real intersect_sphere(const Ray& ray, const Sphere& s, real t_max) {
     const Vec3 f = ray.origin - s.center;
-    const float b = -dot(f, ray.direction);           // the ray passes closest to the centre at t = b
+    const real b = -dot(f, ray.direction);           // the ray passes closest to the centre at t = b
     const Vec3 perpendicular = f + ray.direction * b;   // centre-to-ray offset at that point
-    const float r2 = s.radius * s.radius;
-    const float disc = r2 - length_squared(perpendicular);
+    const real r2 = s.radius * s.radius;
+    const real disc = r2 - length_squared(perpendicular);
     if (!(disc >= 0.0f)) return t_max;
-    const float q = b + copysignf(sqrtf(disc), b);
-    const float c = length_squared(f) - r2;
-    const float t_a = c / q;
-    const float t_b = q;
-    const float t_near = min_float(t_a, t_b);
-    const float t_far = max_float(t_a, t_b);
+    const real q = b + copysign_real(sqrt_real(disc), b);
+    const real c = length_squared(f) - r2;
+    const real t_a = c / q;
+    const real t_b = q;
+    const real t_near = min_float(t_a, t_b);
+    const real t_far = max_float(t_a, t_b);
     if (t_near > 0.0f && t_near < t_max) return t_near;
     if (t_far > 0.0f && t_far < t_max) return t_far;
     return t_max;

@@ -5,41 +5,42 @@
 
 #include <ray.h>
 
-// Four 16-byte rows, 16-byte aligned: what the cheap cull reads (normal and plane offset) is
+// Four 16-byte rows (32-byte ones in the double build), 16-byte aligned: what the cheap cull reads (normal and plane offset) is
 // the first row, each vertex starts a row. A GPU then loads a row with one vector load (one
 // LDS.128 from shared memory instead of four scalar loads: the megakernel is bound by
 // instruction issue), and a CPU finds the whole triangle in one 64-byte cache line.
 struct alignas(16) Triangle {
     Vec3 normal;         // unit geometric normal, or zero for a degenerate triangle
-    float plane_offset;  // dot(normal, v0): the plane is dot(normal, p) == plane_offset
+    real plane_offset;   // dot(normal, v0): the plane is dot(normal, p) == plane_offset
     Vec3 v0;             // vertices; the front side is where (v1-v0) x (v2-v0) points
-    float extent;        // largest |coordinate| of the vertices: bounds the hit's rounding error
+    real extent;         // largest |coordinate| of the vertices: bounds the hit's rounding error
     Vec3 v1;
     int material;        // index into the scene's material table
     Vec3 v2;
-    float unused = 0.0f;  // fills the last row (lab 02 reads 16 bytes at each vertex)
+    real unused = 0;      // fills the last row (lab 02 reads 16 bytes at each vertex)
 };
 
 // Builds a triangle with its normal; a zero-area triangle gets a zero normal and is never hit.
 // The normal is computed in double: in float, |(v1-v0) x (v2-v0)|^2 grows as the edge length
 // to the fourth power, so it overflows for edges past ~1e9 and underflows below ~1e-11, and
 // the triangle silently vanished. Double holds that square for any float vertices. Host only:
-// scenes are built before rendering.
+// scenes are built before rendering. (In the double build the vertices are doubles too, and
+// the square still overflows only past edges of ~1e77, far beyond scene_limits.h's bounds.)
 inline Triangle make_triangle(Vec3 v0, Vec3 v1, Vec3 v2, int material) {
     const double e1[3] = {double(v1.x) - v0.x, double(v1.y) - v0.y, double(v1.z) - v0.z};
     const double e2[3] = {double(v2.x) - v0.x, double(v2.y) - v0.y, double(v2.z) - v0.z};
     const double n[3] = {e1[1] * e2[2] - e1[2] * e2[1], e1[2] * e2[0] - e1[0] * e2[2],
                          e1[0] * e2[1] - e1[1] * e2[0]};
     const double len = std::sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
-    const Vec3 normal = len > 0.0 ? Vec3(static_cast<float>(n[0] / len),
-                                         static_cast<float>(n[1] / len),
-                                         static_cast<float>(n[2] / len))
+    const Vec3 normal = len > 0.0 ? Vec3(static_cast<real>(n[0] / len),
+                                         static_cast<real>(n[1] / len),
+                                         static_cast<real>(n[2] / len))
                                   : Vec3(0.0f);
-    // The plane of the stored (float) normal through v0, rounded once.
-    const float plane_offset = static_cast<float>(double(normal.x) * v0.x +
+    // The plane of the stored (real) normal through v0, rounded once.
+    const real plane_offset = static_cast<real>(double(normal.x) * v0.x +
                                                   double(normal.y) * v0.y +
                                                   double(normal.z) * v0.z);
-    const float extent =
+    const real extent =
         max_float(max_component(abs(v0)), max_float(max_component(abs(v1)), max_component(abs(v2))));
     Triangle tri;
     tri.normal = normal;
@@ -56,7 +57,7 @@ inline Triangle make_triangle(Vec3 v0, Vec3 v1, Vec3 v2, int material) {
 // dominant axis z, and the shear that maps the ray onto +z.
 struct RayShear {
     int kx, ky, kz;  // permuted axes
-    float sx, sy, sz;  // shear constants
+    real sx, sy, sz;  // shear constants
 
     RT_HD explicit RayShear(Vec3 d) {
         const Vec3 a = abs(d);
@@ -68,7 +69,7 @@ struct RayShear {
             kx = ky;
             ky = tmp;
         }
-        sz = 1.0f / d[kz];
+        sz = real(1) / d[kz];
         sx = d[kx] * sz;
         sy = d[ky] * sz;
     }
@@ -86,6 +87,13 @@ RT_HD inline float edge_function(float px, float py, float qx, float qy) {
     return px * qy - py * qx;
 #endif
 }
+RT_HD inline double edge_function(double px, double py, double qx, double qy) {
+#if defined(__CUDA_ARCH__)
+    return __dsub_rn(__dmul_rn(px, qy), __dmul_rn(py, qx));
+#else
+    return px * qy - py * qx;
+#endif
+}
 
 // The same in double, where float products are exact: the sign is exact even when the
 // float result rounds to zero.
@@ -93,50 +101,67 @@ RT_HD inline double edge_function_exact(float px, float py, float qx, float qy) 
     return static_cast<double>(px) * qy - static_cast<double>(py) * qx;
 }
 
+// The double build's fallback. There is no wider type to make double products exact on the
+// GPU (long double is host only, and its 64-bit significand is not enough for them either),
+// so each product is split exactly into its rounded value and its rounding error with an FMA
+// (p = a*b, e = fma(a, b, -p)), and the edge function is (p1 - p2) + (e1 - e2). Its sign is
+// the exact sign or the value is zero (an edge hit), and swapping p and q negates every step
+// exactly, so the neighbour across the edge gets exactly the negated value: still watertight.
+// The products use the _rn intrinsics on the GPU so that nvcc cannot fuse p1 into p1 - p2.
+RT_HD inline double edge_function_exact(double px, double py, double qx, double qy) {
+#if defined(__CUDA_ARCH__)
+    const double p1 = __dmul_rn(px, qy), p2 = __dmul_rn(py, qx);
+#else
+    const double p1 = px * qy, p2 = py * qx;
+#endif
+    const double e1 = fma(px, qy, -p1), e2 = fma(py, qx, -p2);
+    return (p1 - p2) + (e1 - e2);
+}
+
 // Watertight ray/triangle intersection (Woop, Benthin, Wald, JCGT 2013). Returns the
 // distance in (0, t_max), or t_max for a miss. Rays parallel to the triangle's plane and
 // degenerate triangles give det == 0 and miss; no division happens before that check.
-RT_HD inline float intersect_triangle(const Ray& ray, const RayShear& shear, const Triangle& tri,
-                                      float t_max) {
+RT_HD inline real intersect_triangle(const Ray& ray, const RayShear& shear, const Triangle& tri,
+                                     real t_max) {
     // Cheap cull first: skip the triangle when its plane lies behind the ray or clearly beyond
     // t_max (ten times fewer flops than the full test; most triangles of a closed room end
     // here). It only rejects, never accepts, so the watertight test below still decides every
     // hit; the 1e-5 margin keeps rounding from culling a hit right at t_max. Parallel rays and
     // degenerate triangles (zero normal) have denom == 0 and are culled too.
-    const float denom = dot(tri.normal, ray.direction);
-    const float num = tri.plane_offset - dot(tri.normal, ray.origin);  // t_plane = num / denom
+    const real denom = dot(tri.normal, ray.direction);
+    const real num = tri.plane_offset - dot(tri.normal, ray.origin);  // t_plane = num / denom
     // Bitwise | rather than ||: one well-predicted branch instead of several random ones.
     const bool behind = num * denom <= 0.0f;
-    const bool beyond = fabsf(num) >= t_max * 1.00001f * fabsf(denom);
+    const bool beyond = fabs_real(num) >= t_max * real(1.00001f) * fabs_real(denom);
     if (behind | beyond) return t_max;
 
     const Vec3 a = tri.v0 - ray.origin;
     const Vec3 b = tri.v1 - ray.origin;
     const Vec3 c = tri.v2 - ray.origin;
-    const float az = a[shear.kz], bz = b[shear.kz], cz = c[shear.kz];
-    const float ax = a[shear.kx] - shear.sx * az, ay = a[shear.ky] - shear.sy * az;
-    const float bx = b[shear.kx] - shear.sx * bz, by = b[shear.ky] - shear.sy * bz;
-    const float cx = c[shear.kx] - shear.sx * cz, cy = c[shear.ky] - shear.sy * cz;
+    const real az = a[shear.kz], bz = b[shear.kz], cz = c[shear.kz];
+    const real ax = a[shear.kx] - shear.sx * az, ay = a[shear.ky] - shear.sy * az;
+    const real bx = b[shear.kx] - shear.sx * bz, by = b[shear.ky] - shear.sy * bz;
+    const real cx = c[shear.kx] - shear.sx * cz, cy = c[shear.ky] - shear.sy * cz;
 
-    float u = edge_function(cx, cy, bx, by);
-    float v = edge_function(ax, ay, cx, cy);
-    float w = edge_function(bx, by, ax, ay);
+    real u = edge_function(cx, cy, bx, by);
+    real v = edge_function(ax, ay, cx, cy);
+    real w = edge_function(bx, by, ax, ay);
     if (u == 0.0f || v == 0.0f || w == 0.0f) {  // rare: on an edge, or rounded to zero
-        u = static_cast<float>(edge_function_exact(cx, cy, bx, by));
-        v = static_cast<float>(edge_function_exact(ax, ay, cx, cy));
-        w = static_cast<float>(edge_function_exact(bx, by, ax, ay));
+        u = static_cast<real>(edge_function_exact(cx, cy, bx, by));
+        v = static_cast<real>(edge_function_exact(ax, ay, cx, cy));
+        w = static_cast<real>(edge_function_exact(bx, by, ax, ay));
     }
     const bool any_negative = (u < 0.0f) | (v < 0.0f) | (w < 0.0f);
     const bool any_positive = (u > 0.0f) | (v > 0.0f) | (w > 0.0f);
     if (any_negative & any_positive) return t_max;  // the ray passes outside an edge
 
-    const float det = u + v + w;
+    const real det = u + v + w;
     if (det == 0.0f) return t_max;  // parallel ray or degenerate triangle
-    const float t_scaled = u * (shear.sz * az) + v * (shear.sz * bz) + w * (shear.sz * cz);
+    const real t_scaled = u * (shear.sz * az) + v * (shear.sz * bz) + w * (shear.sz * cz);
     // t = t_scaled / det must lie in (0, t_max); compare without dividing first.
-    const float sign = copysignf(1.0f, det);
-    const float t_signed = t_scaled * sign;
-    const float det_abs = det * sign;
+    const real sign = copysign_real(real(1), det);
+    const real t_signed = t_scaled * sign;
+    const real det_abs = det * sign;
     if (!(t_signed > 0.0f) || !(t_signed < t_max * det_abs)) return t_max;
     return t_scaled / det;
 }

@@ -49,7 +49,9 @@ std::string pfm_bytes(const Image& image) {
     for (int y = image.height - 1; y >= 0; --y) {
         for (int x = 0; x < image.width; ++x) {
             const Vec3& p = image.at(x, y);
-            const float rgb[3] = {p.x, p.y, p.z};
+            // Written as float in either build (real.h): the double build's pixels round here.
+            const float rgb[3] = {static_cast<float>(p.x), static_cast<float>(p.y),
+                                  static_cast<float>(p.z)};
             std::memcpy(dst, rgb, sizeof rgb);  // x86 and CUDA hosts are little endian
             dst += sizeof rgb;
         }

@@ -23,8 +23,8 @@ struct BoundsD {
 };
 
 Vec3 moved(Vec3 p, const double offset[3]) {
-    return {static_cast<float>(p.x + offset[0]), static_cast<float>(p.y + offset[1]),
-            static_cast<float>(p.z + offset[2])};
+    return {static_cast<real>(p.x + offset[0]), static_cast<real>(p.y + offset[1]),
+            static_cast<real>(p.z + offset[2])};
 }
 
 }  // namespace
@@ -38,9 +38,9 @@ Vec3 centring_offset(const Scene& scene) {
         box.add(t.v2);
     }
     if (box.empty) return Vec3(0.0f);
-    return {static_cast<float>(-0.5 * (box.lo[0] + box.hi[0])),
-            static_cast<float>(-0.5 * (box.lo[1] + box.hi[1])),
-            static_cast<float>(-0.5 * (box.lo[2] + box.hi[2]))};
+    return {static_cast<real>(-0.5 * (box.lo[0] + box.hi[0])),
+            static_cast<real>(-0.5 * (box.lo[1] + box.hi[1])),
+            static_cast<real>(-0.5 * (box.lo[2] + box.hi[2]))};
 }
 
 Scene centre_scene(Scene scene) {

@@ -1,5 +1,10 @@
-// What the renderer's float arithmetic (common/core) can show, as the scene loader enforces
-// it: every scene it accepts renders, and nothing in it vanishes silently.
+// What the renderer's arithmetic (common/core, in `real`: float, or double in the double
+// build) can show, as the scene loader enforces it: every scene it accepts renders, and
+// nothing in it vanishes silently. The bounds below are float's; the double build's follow
+// the same reasoning with double's range: coordinates up to 1e30 (a product of three stays
+// below 1e90, the triangle normal's squared length, edge^4, below 1e120, both far from
+// DBL_MAX 1.8e308) and sizes from 1e-30 (their cubes and edge^4 far above DBL_MIN 2.2e-308).
+// The relative bound stays: ray offsets are 2^-20 of the extent in both builds.
 //  - Coordinates and radii up to 1e9 in magnitude: the triangle test multiplies three
 //    coordinate differences (t_scaled in triangle.h), which stays far below FLT_MAX (3.4e38)
 //    there; past ~1e12 it overflows and triangles vanish.
@@ -20,8 +25,19 @@
 
 #include <triangle.h>
 
+#if defined(RT_DOUBLE)
+constexpr double kMaxCoordinate = 1e30;
+constexpr real kMinSize = 1e-30;
+constexpr const char* kMaxCoordinateText = "1e30";  // as messages write the bounds
+constexpr const char* kMinSizeText = "1e-30";
+constexpr double kMaxNumber = DBL_MAX;  // any finite number a scene file gives
+#else
 constexpr double kMaxCoordinate = 1e9;
 constexpr float kMinSize = 1e-9f;  // a float: a size written as 1e-9 rounds to it, not below
+constexpr const char* kMaxCoordinateText = "1e9";
+constexpr const char* kMinSizeText = "1e-9";
+constexpr double kMaxNumber = 3.0e38;  // within float range
+#endif
 constexpr double kMinRelativeSize = 1.0 / (1 << 18);
 
 inline std::string format_number(double x) {
@@ -32,26 +48,29 @@ inline std::string format_number(double x) {
 
 inline std::string coordinate_problem(double x) {
     if (std::fabs(x) <= kMaxCoordinate) return "";
-    return "expected a coordinate within +-1e9 (beyond it the renderer's float arithmetic "
-           "overflows): scale the scene down or move it nearer the origin";
+    return std::string("expected a coordinate within +-") + kMaxCoordinateText +
+           " (beyond it the renderer's " + kPrecisionName +
+           " arithmetic overflows): scale the scene down or move it nearer the origin";
 }
 
 // `what` names the size ("a radius", ...) at the start of the message.
 inline std::string size_problem(const char* what, double size, double extent) {
     if (size < kMinSize)
         return std::string(what) + " of " + format_number(size) +
-               " is below 1e-9, too small for the renderer's float arithmetic: scale the scene up";
+               " is below " + kMinSizeText + ", too small for the renderer's " +
+               kPrecisionName + " arithmetic: scale the scene up";
     if (size < kMinRelativeSize * extent)
         return std::string(what) + " of " + format_number(size) +
-               " is too small for float precision that far from the origin (coordinates up to " +
-               format_number(extent) + "): move the scene nearer the origin or make it larger";
+               " is too small for " + kPrecisionName +
+               " precision that far from the origin (coordinates up to " + format_number(extent) + "): move the scene nearer the origin or make it larger";
     return "";
 }
 
 inline std::string sphere_problem(const Sphere& s) {
     if (s.radius > kMaxCoordinate)
         return "a radius of " + format_number(s.radius) +
-               " is above 1e9, too large for the renderer's float arithmetic: scale the scene down";
+               " is above " + kMaxCoordinateText + ", too large for the renderer's " +
+               kPrecisionName + " arithmetic: scale the scene down";
     return size_problem("a radius", s.radius, sphere_extent(s));
 }
 
@@ -71,7 +90,7 @@ inline std::string triangle_problem(const double (&written)[3][3], const Triangl
     const std::string size = size_problem("a triangle with a longest edge", longest, tri.extent);
     if (!size.empty()) return size;
     if (is_black(tri.normal))
-        return "the triangle collapses to a line when its vertices are rounded to float: make it "
-               "larger or move it nearer the origin";
+        return std::string("the triangle collapses to a line when its vertices are rounded to ") +
+               kPrecisionName + ": make it larger or move it nearer the origin";
     return "";
 }

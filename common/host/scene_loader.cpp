@@ -59,12 +59,13 @@ public:
         return obj.at(key);
     }
 
-    float number(const json& v, const std::string& pointer) const {
+    real number(const json& v, const std::string& pointer) const {
         if (!v.is_number()) fail(pointer, "expected a number, found " + type_of(v));
         const double d = v.get<double>();
-        if (!std::isfinite(d) || std::fabs(d) > 3.0e38)
-            fail(pointer, "expected a finite number within float range");
-        return static_cast<float>(d);
+        if (!std::isfinite(d) || std::fabs(d) > kMaxNumber)
+            fail(pointer, std::string("expected a finite number within ") + kPrecisionName +
+                              " range");
+        return static_cast<real>(d);
     }
 
     Vec3 vec3(const json& v, const std::string& pointer) const {
@@ -115,7 +116,7 @@ private:
     const std::map<std::string, size_t>& offsets_;
 };
 
-// A point of the scene, within what the renderer's float arithmetic handles (scene_limits.h).
+// A point of the scene, within what the renderer's arithmetic handles (scene_limits.h).
 Vec3 read_position(const SceneReader& r, const json& v, const std::string& pointer) {
     const Vec3 p = r.vec3(v, pointer);
     for (int axis = 0; axis < 3; ++axis) {

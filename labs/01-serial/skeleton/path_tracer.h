@@ -24,7 +24,7 @@
 
 // The nearest surface a ray meets: which primitive and how far.
 struct Hit {
-    float t = FLT_MAX;  // distance along the ray; FLT_MAX when nothing was hit
+    real t = kRealMax;  // distance along the ray; kRealMax (real.h) when nothing was hit
     int sphere = -1;    // index of the sphere hit, or -1
     int triangle = -1;  // index of the triangle hit, or -1
 
@@ -35,7 +35,7 @@ struct Hit {
 struct SurfacePoint {
     Vec3 position;  // world-space hit point
     Vec3 normal;    // unit geometric normal: outward for spheres, the front side for triangles
-    float extent;   // the primitive's largest |coordinate|, for offset_ray_origin (ray.h)
+    real extent;    // the primitive's largest |coordinate|, for offset_ray_origin (ray.h)
     int material;   // index into the material table
 };
 
@@ -59,7 +59,7 @@ RT_HD inline Hit closest_hit(const SceneView& scene, const Ray& ray) {
     // TODO(lab01): this finds spheres only. Loop over the triangles too (build one
     // RayShear per ray, then intersect_triangle), keeping the nearest hit.
     for (int i = 0; i < scene.num_spheres; ++i) {
-        const float t = intersect_sphere(ray, scene.spheres[i], hit.t);
+        const real t = intersect_sphere(ray, scene.spheres[i], hit.t);
         if (t < hit.t) {
             hit.t = t;
             hit.sphere = i;
@@ -70,7 +70,7 @@ RT_HD inline Hit closest_hit(const SceneView& scene, const Ray& ray) {
 
 // Whether anything blocks the ray before distance t_max. Stops at the first blocker:
 // a shadow ray needs any hit, not the closest. Glass blocks too (no caustics).
-RT_HD inline bool occluded(const SceneView& scene, const Ray& ray, float t_max) {
+RT_HD inline bool occluded(const SceneView& scene, const Ray& ray, real t_max) {
     // TODO(lab01): return true when any sphere or triangle lies on the ray before t_max.
     (void)scene;
     (void)ray;
@@ -108,7 +108,7 @@ RT_HD inline PathState start_path(const Ray& camera_ray, int max_bounces) {
 // decides it: in the path loop below right away, in a wavefront renderer in a kernel of its own.
 struct ShadowRay {
     Ray ray;
-    float t_max;
+    real t_max;
     Vec3 radiance;
 };
 

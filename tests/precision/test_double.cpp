@@ -1,0 +1,54 @@
+// Built with -DRT_DOUBLE only (make build/precision_tests_double): the double build really
+// computes in double. Each test asks for something float cannot give, so a switch that
+// silently left the core in float fails here.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstring>
+
+#include <sphere.h>
+#include <triangle.h>
+
+TEST(DoubleBuild, RealIsDouble) {
+    EXPECT_EQ(sizeof(real), sizeof(double));
+    EXPECT_EQ(sizeof(Vec3), 3 * sizeof(double));
+    EXPECT_STREQ(kPrecisionName, "double");
+}
+
+// A unit sphere 1e8 from the origin, seen from 10 units away: floats there are 8 apart, so a
+// float intersection cannot even place the ray's origin. Double gives t to ~1e-8.
+TEST(DoubleBuild, ResolvesASphereFarFromTheOrigin) {
+    const double far = 1e8;
+    const Sphere s{Vec3(far, 0, 0), 1.0, 0};
+    const Ray ray{Vec3(far - 10, 0.5, 0), Vec3(1, 0, 0)};
+    const double expected = 10 - std::sqrt(1 - 0.25);
+    EXPECT_NEAR(intersect_sphere(ray, s, kRealMax), expected, 1e-7);
+}
+
+// The watertight test's fallback in double: two products that round to the same double
+// (the fast edge function says 0) but differ exactly by 2^-60. The fallback finds the sign,
+// and the edge seen from the other side gets exactly the negated value.
+TEST(DoubleBuild, EdgeFunctionFallbackFindsTheSignOfADifferenceBelowRounding) {
+    const double px = 1 + std::ldexp(1.0, -30), qy = 1 + std::ldexp(1.0, -30);  // 1 + 2^-29 + 2^-60
+    const double py = 1 + std::ldexp(1.0, -29), qx = 1;                         // 1 + 2^-29
+    EXPECT_EQ(edge_function(px, py, qx, qy), 0.0);
+    const double exact = edge_function_exact(px, py, qx, qy);
+    EXPECT_EQ(exact, std::ldexp(1.0, -60));
+    EXPECT_EQ(edge_function_exact(qx, qy, px, py), -exact);
+}
+
+// A ray through the edge two triangles share hits at least one of them, with coordinates
+// whose float roundings would move the edge.
+TEST(DoubleBuild, SharedEdgeStaysWatertight) {
+    const Vec3 a(0, 0, 0), b(1, 0, 0), c(0, 1, 0), d(1, 1, 0);
+    const Triangle t1 = make_triangle(a, b, d, 0);
+    const Triangle t2 = make_triangle(a, d, c, 0);
+    for (int i = 1; i < 1000; ++i) {
+        const double x = i / 1000.0 + 1e-12;  // on the diagonal a-d, off float's grid
+        const Ray ray{Vec3(x, x, 1), Vec3(0, 0, -1)};
+        const RayShear shear(ray.direction);
+        const bool hit = intersect_triangle(ray, shear, t1, kRealMax) < kRealMax ||
+                         intersect_triangle(ray, shear, t2, kRealMax) < kRealMax;
+        EXPECT_TRUE(hit) << "x = " << x;
+    }
+}
