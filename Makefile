@@ -144,8 +144,8 @@ check-skeletons:
 	$(PYTHON) tools/skeletons.py --check
 
 # common/core/ is exactly what runs on the GPU too: every header of it must compile under nvcc
-# on its own, with nothing but core/ on the include path, and a kernel must call the path
-# tracer.
+# on its own, with nothing but core/ on the include path, in the float and the double build
+# (real.h), and a kernel must call the path tracer.
 NVCC ?= nvcc
 CORE_HEADERS := $(notdir $(wildcard common/core/*.h))
 check-nvcc:
@@ -153,12 +153,14 @@ check-nvcc:
 	@mkdir -p $(BUILD)/cuda
 	@for h in $(CORE_HEADERS); do \
 	    printf '#include <%s>\n' $$h > $(BUILD)/cuda/header_$${h%.h}.cu; \
-	    $(NVCC) -std=c++17 -Icommon/core -arch=sm_90 -Xcompiler -Wall,-Werror -Werror all-warnings \
-	        -c $(BUILD)/cuda/header_$${h%.h}.cu -o $(BUILD)/cuda/header_$${h%.h}.o || exit 1; \
+	    for precision in "" -DRT_DOUBLE; do \
+	        $(NVCC) -std=c++17 -Icommon/core -arch=sm_90 -Xcompiler -Wall,-Werror -Werror all-warnings \
+	            $$precision -c $(BUILD)/cuda/header_$${h%.h}.cu -o $(BUILD)/cuda/header_$${h%.h}.o || exit 1; \
+	    done; \
 	done
 	$(NVCC) -std=c++17 -O3 -Icommon/core -arch=sm_90 -Xcompiler -Wall,-Werror -Werror all-warnings \
 	    -c tests/cuda/device_compile_check.cu -o $(BUILD)/cuda/device_compile_check.o
-	@echo "check-nvcc: $(words $(CORE_HEADERS)) headers of common/core and the kernel check compile for sm_90"
+	@echo "check-nvcc: $(words $(CORE_HEADERS)) headers of common/core (float and double builds) and the kernel check compile for sm_90"
 
 LAB ?= 01
 grade:
