@@ -20,7 +20,7 @@ struct CameraSpec {
     Vec3 position{0.5f, 0.5f, 1.0f};
     Vec3 look_at{0.5f, 0.5f, 0.0f};
     Vec3 up{0.0f, 1.0f, 0.0f};
-    float vfov_degrees = 55.0f;
+    real vfov_degrees = 55.0f;
 
     Camera for_image(int width, int height) const {
         return Camera::look_at(position, look_at, up, vfov_degrees, width, height);
