@@ -159,6 +159,20 @@ def test_agrees_with_lab01(gpu, lab05_ref):
         (float(np.median(rel)), float((rel > 1e-2).mean()))
 
 
+@pytest.mark.parametrize("check", [
+    checks.check_sphere_interior,
+    lambda b: checks.check_golden(b, "cornell"),
+    lambda b: checks.check_golden(b, "showcase"),
+], ids=["sphere-interior", "golden-cornell", "golden-showcase"])
+def test_double_build_passes(gpu, check):
+    """The megakernel in double (common/core/real.h, make lab05-ref-double) renders the
+    same estimator: tests/labs/test_precision.py checks lab 01's double build on the CPU."""
+    binary = build("lab05-ref-double")[0]
+    assert run_lab(binary, width=4, height=4, spp=1).json["precision"] == "double"
+    result = check(binary)
+    assert result.passed, str(result)
+
+
 def test_baseline_is_finite_and_summarised(gpu, lab05_ref):
     """The report's baseline (600x600, 512 spp, 4 bounces): no NaN or Inf anywhere, and the
     summary names the GPU and times the kernel only (well under the process's wall time)."""

@@ -5,14 +5,12 @@ command line. The double build passes every correctness check lab 01's reference
 float build says "float". The double build accepts the wider scenes double can hold
 (common/host/scene_limits.h) which the float build refuses in one line."""
 import os
-import pathlib
 import subprocess
 
 import pytest
 
-from cuda_env import missing_gpu, missing_nvcc
 from grading import checks, scenes
-from grading.harness import ROOT, build, run_lab
+from grading.harness import build, run_lab
 
 
 @pytest.fixture(scope="module")
@@ -89,13 +87,8 @@ def test_double_build_accepts_wider_scales(lab01_ref, lab01_ref_double, tmp_path
 
 
 def test_lab05_double_builds(nvcc):
-    """nvcc compiles the megakernel with real = double (CI has nvcc, not a GPU)."""
+    """nvcc compiles the megakernel with real = double (CI has nvcc, not a GPU). Where a
+    GPU is, test_lab05.py's test_double_build_passes renders with it (tools/gpu_check.sh
+    runs that file)."""
     binary = build("lab05-ref-double")[0]
     assert os.access(binary, os.X_OK)
-
-
-def test_lab05_double_golden(gpu):
-    binary = build("lab05-ref-double")[0]
-    assert run_lab(binary, width=4, height=4, spp=1).json["precision"] == "double"
-    result = checks.check_golden(binary, "cornell")
-    assert result.passed, str(result)
