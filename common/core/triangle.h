@@ -5,8 +5,8 @@
 
 #include <ray.h>
 
-// Four 16-byte rows (32-byte ones in the double build), 16-byte aligned: what the cheap cull reads (normal and plane offset) is
-// the first row, each vertex starts a row. A GPU then loads a row with one vector load (one
+// Four 16-byte rows (32-byte rows in the double build), 16-byte aligned: what the cheap cull
+// reads (normal and plane offset) is the first row, each vertex starts a row. A GPU then loads a row with one vector load (one
 // LDS.128 from shared memory instead of four scalar loads: the megakernel is bound by
 // instruction issue), and a CPU finds the whole triangle in one 64-byte cache line.
 struct alignas(16) Triangle {

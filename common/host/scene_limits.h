@@ -62,7 +62,8 @@ inline std::string size_problem(const char* what, double size, double extent) {
     if (size < kMinRelativeSize * extent)
         return std::string(what) + " of " + format_number(size) +
                " is too small for " + kPrecisionName +
-               " precision that far from the origin (coordinates up to " + format_number(extent) + "): move the scene nearer the origin or make it larger";
+               " precision that far from the origin (coordinates up to " + format_number(extent) +
+               "): move the scene nearer the origin or make it larger";
     return "";
 }
 

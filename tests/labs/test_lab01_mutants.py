@@ -46,7 +46,8 @@ MUTANTS = {
         "if (intersect_triangle(ray, shear, scene.triangles[i], t_max) < t_max) return true;",
         "continue;", ["showcase"]),
     "no pixel jitter": ("path_tracer.h",
-                        "camera.ray_through(x + rng.at(kDimPixelX), y + rng.at(kDimPixelY))",
+                        "camera.ray_through(x + real(rng.at(kDimPixelX)), "
+                        "y + real(rng.at(kDimPixelY)))",
                         "camera.ray_through(x + 0.5f, y + 0.5f)", ["cornell"]),
     "every sample reuses sample 0": ("path_tracer.h", "SampleStream rng(settings.seed, pixel, s)",
                                      "SampleStream rng(settings.seed, pixel, 0)", ["cornell"]),
@@ -66,7 +67,7 @@ MUTANTS = {
                                   # 1e5, whose offsets are large, does.
                                   ["large"]),
     "uniform sampling weighted as cosine": (
-        "material.h", "const float r = sqrtf(u1);", "const float r = sqrtf(1.0f - u1 * u1);",
+        "material.h", "const real r = sqrt_real(u1);", "const real r = sqrt_real(1.0f - u1 * u1);",
         ["cornell"]),
     "glass never reflects": ("path_tracer.h", "if (rng.at(bounce_dimension(bounce, 0)) < reflectance)",
                              "if (reflectance < 0.0f)", ["glass"]),
@@ -79,8 +80,8 @@ MUTANTS = {
     "no offset at all": ("ray.h", "return p + n * (scale * kRelativeOffset);",
                          "return p + n * (0.0f * scale);", ["cornell"]),
     "offset ignores the primitive's extent": (
-        "ray.h", "const float scale = max_component(abs(p)) + distance_travelled + extent;",
-        "const float scale = max_component(abs(p)) + distance_travelled + 0.0f * extent;",
+        "ray.h", "const real scale = max_component(abs(p)) + distance_travelled + extent;",
+        "const real scale = max_component(abs(p)) + distance_travelled + 0.0f * extent;",
         ["large"]),
 }
 
