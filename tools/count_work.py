@@ -32,7 +32,7 @@ from grading.variants import build_sources  # noqa: E402
 # The two queries, kept out of line so that callgrind can count them.
 QUERIES = {
     "closest_hit": "RT_HD inline Hit closest_hit(const SceneView& scene, const Ray& ray) {",
-    "occluded": "RT_HD inline bool occluded(const SceneView& scene, const Ray& ray, float t_max) {",
+    "occluded": "RT_HD inline bool occluded(const SceneView& scene, const Ray& ray, real t_max) {",
 }
 
 
