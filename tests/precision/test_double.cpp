@@ -1,11 +1,15 @@
-// Built with -DRT_DOUBLE only (make build/precision_tests_double): the double build really
-// computes in double. Each test asks for something float cannot give, so a switch that
-// silently left the core in float fails here.
+// Built with -DRT_DOUBLE only (make build/precision_tests_double, run by
+// tests/labs/test_precision.py): the double build really computes in double. The first two
+// tests ask for what float cannot give, so a switch that silently left the core in float
+// fails them; the others check what only the double build uses (the triangle test's double
+// fallback, the scene limits of double).
 #include <gtest/gtest.h>
 
 #include <cmath>
-#include <cstring>
+#include <string>
 
+#include <errors.h>
+#include <scene_loader.h>
 #include <sphere.h>
 #include <triangle.h>
 
@@ -50,5 +54,28 @@ TEST(DoubleBuild, SharedEdgeStaysWatertight) {
         const bool hit = intersect_triangle(ray, shear, t1, kRealMax) < kRealMax ||
                          intersect_triangle(ray, shear, t2, kRealMax) < kRealMax;
         EXPECT_TRUE(hit) << "x = " << x;
+    }
+}
+
+// The scene loader's limits are double's (scene_limits.h): a sphere of radius 1e12, past
+// float's 1e9, loads; one past 1e30 is refused in one line that names double's bound.
+TEST(DoubleBuild, SceneLimitsAreDoubles) {
+    const auto scene = [](const char* radius) {
+        return std::string(
+                   "{ \"camera\": { \"position\": [0, 0, 0], \"look_at\": [0, 0, -1] },\n"
+                   "  \"materials\": { \"m\": { \"type\": \"diffuse\",\n"
+                   "                          \"albedo\": [0.5, 0.5, 0.5] } },\n"
+                   "  \"spheres\": [ { \"center\": [0, 0, 0], \"radius\": ") +
+               radius + ", \"material\": \"m\" } ] }\n";
+    };
+    EXPECT_NO_THROW(parse_scene(scene("1e12"), "wide.json"));
+    try {
+        parse_scene(scene("1e31"), "too-wide.json");
+        FAIL() << "a radius of 1e31 was accepted";
+    } catch (const InputError& e) {
+        const std::string message = e.what();
+        EXPECT_EQ(message.find('\n'), std::string::npos) << message;
+        EXPECT_NE(message.find("above 1e30"), std::string::npos) << message;
+        EXPECT_NE(message.find("double"), std::string::npos) << message;
     }
 }
