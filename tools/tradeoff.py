@@ -146,7 +146,7 @@ def run(plan: Plan, out: pathlib.Path, note: str, binary: pathlib.Path | None) -
     if plan.own_reference:
         scenes["extreme"] = tradeoff_scenes.write(scene_dir, "extreme", tradeoff_scenes.extreme())
     spps = tradeoff_sweep.spp_list(plan.max_spp)
-    sweeps, references = [], {}
+    sweeps, references, run_failures = [], {}, []
     for name, path in scenes.items():
         if plan.own_reference:
             ref = tradeoff_reference.render(ref_bin, path, width=SIZE, height=SIZE,
@@ -158,8 +158,14 @@ def run(plan: Plan, out: pathlib.Path, note: str, binary: pathlib.Path | None) -
         on_scene = runnable if name == "cornell" else [
             s for s in runnable if s.name == "lab01-ref" or not s.checked]
         for s in on_scene:
-            sweeps.append(tradeoff_sweep.sweep(s, name, path, ref, width=SIZE, height=SIZE,
-                                               bounces=BOUNCES, spps=spps, log=log))
+            try:
+                sweeps.append(tradeoff_sweep.sweep(s, name, path, ref, width=SIZE, height=SIZE,
+                                                   bounces=BOUNCES, spps=spps, log=log))
+            except RuntimeError as e:  # one renderer failing must not hide the others' rows
+                log(f"  {e}")
+                unavailable.append(Series(f"{s.name} on {name}", "", unavailable=str(e)))
+                if s.checked:
+                    run_failures.append(str(e))
 
     # ---- bias against bounces ----
     interior = tradeoff_scenes.INTERIOR
@@ -184,7 +190,8 @@ def run(plan: Plan, out: pathlib.Path, note: str, binary: pathlib.Path | None) -
         f"counts) + {tradeoff_bias.ROUNDING:g} of the converged radiance for float rounding.")
 
     # ---- verdict and report ----
-    failures = [s.failed for s in sweeps if s.failed] + tradeoff_bias.failures(bias_points)
+    failures = (run_failures + [s.failed for s in sweeps if s.failed]
+                + tradeoff_bias.failures(bias_points))
     machine.load_after = tradeoff_report.load()
     plots = {}
     for name in scenes:

@@ -38,6 +38,7 @@ from grading.compare import critical_z  # noqa: E402
 from grading.harness import run_lab  # noqa: E402
 
 import tradeoff_reference  # noqa: E402
+from tradeoff_series import first_words  # noqa: E402
 
 ALPHA = 1e-4
 # Float rounding of a path's value: the zero-variance interior of grading/checks.py differs
@@ -96,7 +97,7 @@ def sweep(series: str, binary, reference_binary, scene_path: pathlib.Path, inter
                       seed=SWEEP_SEED + b, launcher=launcher, threads=threads, check=False)
         if run.image is None or run.returncode != 0:
             raise RuntimeError(f"{series} at {b} bounces did not render: "
-                               f"{run.stderr.strip().splitlines()[-1:] or ['no message']}")
+                               f"{first_words(run.stderr)}")
         image = run.image.astype(np.float64)
         finite = np.isfinite(image).all(axis=2)
         d = image.mean(axis=2)[finite] - ref_grey[finite]

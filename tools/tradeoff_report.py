@@ -162,8 +162,9 @@ def markdown(*, machine: Machine, mode: str, note: str, sweeps, references: dict
         L += [f"## Error against samples per pixel: scene `{scene}`", "",
               f"Reference: {ref}.", "",
               "| renderer | slope +- SE | plateau | verdict | spp range | seconds at most spp "
-              "| RMSE at most spp | efficiency at most spp |",
-              "|---|---|---|---|---|---|---|---|"]
+              "| RMSE at most spp | efficiency at most spp | x lab01-ref |",
+              "|---|---|---|---|---|---|---|---|---|"]
+        base = next((s.points[-1].efficiency for s in rows if s.series == "lab01-ref"), math.nan)
         for s in rows:
             last = s.points[-1]
             slope = f"{s.fit.slope:+.3f} +- {s.fit.slope_se:.3f}" if s.fit else "-"
@@ -171,9 +172,11 @@ def markdown(*, machine: Machine, mode: str, note: str, sweeps, references: dict
             # The longest render times best (start-up and timer noise are smallest there);
             # for an unbiased renderer efficiency does not depend on spp.
             eff = f"{last.efficiency:.4g}" if math.isfinite(last.efficiency) else "-"
+            ratio = last.efficiency / base
+            ratio = f"{ratio:.2f}" if math.isfinite(ratio) else "-"
             L.append(f"| {s.series} | {slope} | {plateau} | {_verdict(s)} | "
                      f"{s.points[0].spp}..{last.spp} | {last.seconds:.3f} | {last.rmse:.5f} | "
-                     f"{eff} |")
+                     f"{eff} | {ratio} |")
         if f"error-time-{scene}" in plots:
             L += ["", f"![error against time, {scene}]({plots[f'error-time-{scene}']})"]
         L += ["", "<details><summary>every render</summary>", "",

@@ -25,6 +25,7 @@ from grading.harness import run_lab  # noqa: E402
 
 import tradeoff_fit  # noqa: E402
 from tradeoff_reference import Reference  # noqa: E402
+from tradeoff_series import first_words  # noqa: E402
 
 SWEEP_SEED = 100  # + log2(spp): each point its own seed, none of the reference's
 
@@ -87,8 +88,8 @@ def sweep(series, scene_name: str, scene_path: pathlib.Path, ref: Reference, *, 
                       bounces=bounces, seed=SWEEP_SEED + n.bit_length(),
                       launcher=series.launcher, check=False)
         if run.returncode != 0 or run.image is None or run.json is None:
-            tail = run.stderr.strip().splitlines()[-1:] or ["no message"]
-            raise RuntimeError(f"{series.name} on {scene_name} at {n} spp failed: {tail[0]}")
+            raise RuntimeError(f"{series.name} on {scene_name} at {n} spp failed: "
+                               f"{first_words(run.stderr)}")
         r = compare(run.image, n, ref.mean, ref.variance, ref.spp)
         mse = r.rmse ** 2 - ref.noise_mse()
         seconds = float(run.json["seconds"])
