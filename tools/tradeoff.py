@@ -147,25 +147,27 @@ def run(plan: Plan, out: pathlib.Path, note: str, binary: pathlib.Path | None) -
         scenes["extreme"] = tradeoff_scenes.write(scene_dir, "extreme", tradeoff_scenes.extreme())
     spps = tradeoff_sweep.spp_list(plan.max_spp)
     sweeps, references, run_failures = [], {}, []
-    for name, path in scenes.items():
-        if plan.own_reference:
-            ref = tradeoff_reference.render(ref_bin, path, width=SIZE, height=SIZE,
-                                            bounces=BOUNCES, spp=16 * plan.max_spp, log=log)
+    refs = {}
+    for name, path in scenes.items():  # every reference first: then the timed renders run
+        if plan.own_reference:        # back to back
+            refs[name] = tradeoff_reference.render(ref_bin, path, width=SIZE, height=SIZE,
+                                                   bounces=BOUNCES, spp=16 * plan.max_spp,
+                                                   log=log)
         else:
-            ref = tradeoff_reference.from_golden(name)
-        references[name] = (f"{ref.made_by}; {SIZE}x{SIZE} pixels, {BOUNCES} bounces, "
-                            f"{ref.spp} spp")
+            refs[name] = tradeoff_reference.from_golden(name)
+        references[name] = (f"{refs[name].made_by}; {SIZE}x{SIZE} pixels, {BOUNCES} bounces, "
+                            f"{refs[name].spp} spp")
+    for name, path in scenes.items():
         on_scene = runnable if name == "cornell" else [
             s for s in runnable if s.name == "lab01-ref" or not s.checked]
+        done, failed = tradeoff_sweep.sweep_all(on_scene, name, path, refs[name], width=SIZE,
+                                                height=SIZE, bounces=BOUNCES, spps=spps, log=log)
+        sweeps += done
         for s in on_scene:
-            try:
-                sweeps.append(tradeoff_sweep.sweep(s, name, path, ref, width=SIZE, height=SIZE,
-                                                   bounces=BOUNCES, spps=spps, log=log))
-            except RuntimeError as e:  # one renderer failing must not hide the others' rows
-                log(f"  {e}")
-                unavailable.append(Series(f"{s.name} on {name}", "", unavailable=str(e)))
+            if s.name in failed:
+                unavailable.append(Series(f"{s.name} on {name}", "", unavailable=failed[s.name]))
                 if s.checked:
-                    run_failures.append(str(e))
+                    run_failures.append(failed[s.name])
 
     # ---- bias against bounces ----
     interior = tradeoff_scenes.INTERIOR

@@ -77,40 +77,61 @@ def spp_list(largest: int) -> list[int]:
     return [1 << k for k in range(largest.bit_length()) if 1 << k <= largest]
 
 
-def sweep(series, scene_name: str, scene_path: pathlib.Path, ref: Reference, *, width: int,
-          height: int, bounces: int, spps, log=print) -> Sweep:
-    """Renders `series` (tradeoff_series.Series) at every spp of `spps` and fits the slope."""
-    points = []
-    for n in spps:
-        if ref.spp < 16 * n:
-            raise ValueError(f"the reference has {ref.spp} spp, fewer than 16 x {n}")
-        run = run_lab(series.binary, scene_path, width=width, height=height, spp=n,
-                      bounces=bounces, seed=SWEEP_SEED + n.bit_length(),
-                      launcher=series.launcher, check=False)
-        if run.returncode != 0 or run.image is None or run.json is None:
-            raise RuntimeError(f"{series.name} on {scene_name} at {n} spp failed: "
-                               f"{first_words(run.stderr)}")
-        r = compare(run.image, n, ref.mean, ref.variance, ref.spp)
-        mse = r.rmse ** 2 - ref.noise_mse()
-        seconds = float(run.json["seconds"])
-        eff = 1.0 / (mse * seconds) if mse > 0 and seconds > 0 else math.nan
-        points.append(Point(series.name, scene_name, n, seconds, run.wall_seconds, r.rmse,
-                            r.relmse, r.bias, r.bias_se, r.nan_count, r.inf_count, r.passed,
-                            mse, eff))
-        log(f"  {series.name:<20} {scene_name:<8} {n:>5} spp {seconds:>8.4f} s  RMSE {r.rmse:.5f}"
-            f"  bias {r.bias:+.5f} +- {r.bias_se:.5f}{'' if r.passed else '  z-test FAIL'}")
+def render_point(series, scene_name: str, scene_path: pathlib.Path, ref: Reference, n: int, *,
+                 width: int, height: int, bounces: int, log=print) -> Point:
+    """One render of `series` (tradeoff_series.Series) at n spp, compared with `ref`."""
+    if ref.spp < 16 * n:
+        raise ValueError(f"the reference has {ref.spp} spp, fewer than 16 x {n}")
+    run = run_lab(series.binary, scene_path, width=width, height=height, spp=n,
+                  bounces=bounces, seed=SWEEP_SEED + n.bit_length(),
+                  launcher=series.launcher, check=False)
+    if run.returncode != 0 or run.image is None or run.json is None:
+        raise RuntimeError(f"{series.name} on {scene_name} at {n} spp failed: "
+                           f"{first_words(run.stderr)}")
+    r = compare(run.image, n, ref.mean, ref.variance, ref.spp)
+    mse = r.rmse ** 2 - ref.noise_mse()
+    seconds = float(run.json["seconds"])
+    eff = 1.0 / (mse * seconds) if mse > 0 and seconds > 0 else math.nan
+    log(f"  {series.name:<20} {scene_name:<8} {n:>5} spp {seconds:>8.4f} s  RMSE {r.rmse:.5f}"
+        f"  bias {r.bias:+.5f} +- {r.bias_se:.5f}{'' if r.passed else '  z-test FAIL'}")
+    return Point(series.name, scene_name, n, seconds, run.wall_seconds, r.rmse, r.relmse,
+                 r.bias, r.bias_se, r.nan_count, r.inf_count, r.passed, mse, eff)
+
+
+def fitted(series, scene_name: str, points: list) -> Sweep:
+    """The sweep of one renderer with its slope fit and plateau."""
     result = Sweep(series.name, scene_name, series.checked, points)
     usable = [p for p in points if p.mse > 0 and math.isfinite(p.mse)]
-    if len(usable) < len(points):
-        result.problem = (f"{len(points) - len(usable)} of {len(points)} points have no "
-                          "usable error (NaN, or below the reference's own noise)")
-    if len(usable) >= 2:
-        x = [p.spp for p in usable]
-        y = [math.sqrt(p.mse) for p in usable]
-        result.fit = tradeoff_fit.fit_loglog(x, y)
-        result.plateau = tradeoff_fit.find_plateau(x, y)
-        if result.problem and len(usable) >= 0.75 * len(points):
-            result.problem = None  # a few low points do not spoil the fit
-    elif not result.problem:
-        result.problem = "fewer than 2 points"
+    if len(usable) < 2:
+        result.problem = f"only {len(usable)} of {len(points)} points have a usable error"
+        return result
+    if len(usable) < 0.75 * len(points):  # a point or two below the reference's noise is fine
+        result.problem = (f"{len(points) - len(usable)} of {len(points)} points have no usable "
+                          "error (NaN, or below the reference's own noise)")
+    x = [p.spp for p in usable]
+    y = [math.sqrt(p.mse) for p in usable]
+    result.fit = tradeoff_fit.fit_loglog(x, y)
+    result.plateau = tradeoff_fit.find_plateau(x, y)
     return result
+
+
+def sweep_all(series_list, scene_name: str, scene_path: pathlib.Path, ref: Reference, *,
+              width: int, height: int, bounces: int, spps, log=print):
+    """Every renderer at every spp, interleaved (each spp: every renderer in turn), so that a
+    shared machine's load, which drifts over minutes, slows all of them alike rather than
+    whichever ran during a busy spell. Returns (sweeps, {renderer name: why it failed})."""
+    points = {s.name: [] for s in series_list}
+    failed = {}
+    for n in spps:
+        for s in series_list:
+            if s.name in failed:
+                continue
+            try:
+                points[s.name].append(render_point(s, scene_name, scene_path, ref, n,
+                                                   width=width, height=height,
+                                                   bounces=bounces, log=log))
+            except RuntimeError as e:  # one renderer failing must not hide the others' rows
+                log(f"  {e}")
+                failed[s.name] = str(e)
+    sweeps = [fitted(s, scene_name, points[s.name]) for s in series_list if s.name not in failed]
+    return sweeps, failed
