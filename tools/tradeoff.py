@@ -2,9 +2,10 @@
 """Speed against accuracy, measured, plotted and checked (`make tradeoff`).
 
     make tradeoff            every renderer this host runs, on the Cornell baseline and an
-                             extreme scene, spp 1..4096, bounces 1..16 (10-20 min on 2 cores)
-    make tradeoff QUICK=1    the CI size: lab01-ref only, small images, fewer points (< 1 min
-                             on an idle 2-core machine)
+                             extreme scene, spp 1..4096, bounces 1..16 (8 min measured on a
+                             busy 2-core VM)
+    make tradeoff QUICK=1    the CI size: lab01-ref only, small images, fewer points (10-15 s
+                             measured on the same VM)
     tools/tradeoff.py --quick --binary PATH   the quick checks on any lab-01-compatible build
 
 Two checks, each failing the run (exit 1, one line `tradeoff: FAIL: ...`):
@@ -22,7 +23,9 @@ from __future__ import annotations
 import argparse
 import dataclasses
 import pathlib
+import shutil
 import sys
+import tempfile
 
 ROOT = pathlib.Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(ROOT))
@@ -124,8 +127,9 @@ def run(plan: Plan, out: pathlib.Path, note: str, binary: pathlib.Path | None) -
         raise BadInput("matplotlib is not installed for this python: run `make deps`") from None
     machine = tradeoff_report.Machine.here()
     log(f"tradeoff ({plan.name}) on {machine.cpu}, {machine.cores} cores, {machine.date}")
-    if tradeoff_series.make("lab01-ref"):
-        raise RuntimeError("lab01-ref does not build: " + tradeoff_series.make("lab01-ref"))
+    why = tradeoff_series.make("lab01-ref")
+    if why:
+        raise RuntimeError(f"lab01-ref {why}")
     ref_bin = reference_binary(plan)
     series = measured_series(plan, binary, log)
     runnable = [s for s in series if s.unavailable is None]
@@ -139,8 +143,19 @@ def run(plan: Plan, out: pathlib.Path, note: str, binary: pathlib.Path | None) -
     for s in unavailable:
         log(f"  not measured: {s.name}: {s.unavailable}")
 
+    # Scenes made here go to a folder of this run's own, so two runs at once (a test and a
+    # full run) never read each other's half-written file.
+    scene_dir = pathlib.Path(tempfile.mkdtemp(prefix="tradeoff-scenes-"))
+    try:
+        return measure(plan, out, note, machine, ref_bin, runnable, unavailable, scene_dir,
+                       log)
+    finally:
+        shutil.rmtree(scene_dir, ignore_errors=True)
+
+
+def measure(plan, out, note, machine, ref_bin, runnable, unavailable, scene_dir, log) -> int:
+    """The sweeps, the checks and the report; returns the exit status."""
     # ---- spp sweeps ----
-    scene_dir = ROOT / "build" / "tradeoff" / "scenes"
     g = golden("cornell")
     scenes = {"cornell": g.scene}
     if plan.own_reference:
