@@ -79,9 +79,11 @@ def reference_binary(plan: Plan) -> pathlib.Path:
     return ROOT / "lab01-ref"
 
 
-def measured_series(plan: Plan, binary: pathlib.Path | None, log) -> list[Series]:
+def measured_series(plan: Plan, binary: pathlib.Path | None, given: str | None,
+                    log) -> list[Series]:
     if binary is not None:
-        return [Series(binary.name, f"the build given with --binary ({binary})", binary)]
+        # Named as given, so the report's FAIL line says which build failed.
+        return [Series(given, f"the build given with --binary ({given})", binary)]
     series = tradeoff_series.cpu_references(plan.labs)
     if plan.gpu:
         series += tradeoff_series.gpu_references()
@@ -110,7 +112,7 @@ def main(argv=None) -> int:
             (out / ".write-test").unlink()
         except OSError as e:
             raise BadInput(f"--out {a.out}: cannot write there ({e.strerror or e})") from None
-        return run(QUICK if a.quick or binary else FULL, out, a.note, binary)
+        return run(QUICK if a.quick or binary else FULL, out, a.note, binary, a.binary)
     except BadInput as e:
         print(f"error: {e}", file=sys.stderr)
         return 2
@@ -119,7 +121,8 @@ def main(argv=None) -> int:
         return 2
 
 
-def run(plan: Plan, out: pathlib.Path, note: str, binary: pathlib.Path | None) -> int:
+def run(plan: Plan, out: pathlib.Path, note: str, binary: pathlib.Path | None,
+        given: str | None = None) -> int:
     log = lambda *args: print(*args, flush=True)  # noqa: E731
     try:
         import matplotlib  # noqa: F401  (the plots; checked before minutes of rendering)
@@ -131,7 +134,7 @@ def run(plan: Plan, out: pathlib.Path, note: str, binary: pathlib.Path | None) -
     if why:
         raise RuntimeError(f"lab01-ref {why}")
     ref_bin = reference_binary(plan)
-    series = measured_series(plan, binary, log)
+    series = measured_series(plan, binary, given, log)
     runnable = [s for s in series if s.unavailable is None]
     unavailable = [s for s in series if s.unavailable is not None]
     if not plan.gpu:

@@ -20,6 +20,7 @@ from grading.harness import ROOT, build
 sys.path.insert(0, str(ROOT / "tools"))
 import tradeoff_bias  # noqa: E402
 import tradeoff_fit  # noqa: E402
+import tradeoff_series  # noqa: E402
 from tradeoff_sweep import Sweep  # noqa: E402
 
 SPP = [1 << k for k in range(11)]
@@ -74,6 +75,19 @@ def test_bias_closed_form_agrees_with_the_centred_interior():
         want = (scenes.sphere_interior_radiance(**params, bounces=b)
                 - scenes.sphere_interior_radiance(**params, bounces=ref))
         assert tradeoff_bias.closed_form(b, ref, **params) == pytest.approx(want, rel=1e-12)
+
+
+def test_fixed_epsilon_variant_changes_only_the_offset():
+    """The variant's ray.h is today's common/core/ray.h with one line changed: the offset."""
+    original = (ROOT / "common" / "core" / "ray.h").read_text().splitlines()
+    variant = tradeoff_series.fixed_epsilon_ray_h().splitlines()
+    changed = [(a, b) for a, b in zip(original, variant) if a != b]
+    assert len(original) == len(variant) and len(changed) == 1, changed
+    assert "kRelativeOffset" in changed[0][0] and "0.0001f" in changed[0][1]
+    names = [v.name for v in tradeoff_series.VARIANTS]
+    assert "lab01 double" in names  # listed, with why it has no build yet
+    assert tradeoff_series.VARIANTS[names.index("lab01 double")].not_built.startswith(
+        "not built yet")
 
 
 def run_tool(*args):
