@@ -8,7 +8,8 @@ GNU make before Makefile) serves `make labNN-ref` from there. Earlier labs' refe
 built from their shipped solutions, as in the course repository.
 
 The binaries are built in a copy of the repository under build/release/ (kept between
-releases, so a second release only relinks) with two changes that make them run on the
+releases, so a second release only relinks; its objects are keyed by the build's flags and
+make files) with two changes that make them run on the
 students' machines rather than this one:
 - `-march=native` becomes `-march=x86-64-v2` (any x86-64 CPU of the last fifteen years; the
   AVX2 code of lab 02 is compiled with -mavx2 anyway and checks the CPU at run time). The
@@ -23,6 +24,8 @@ from __future__ import annotations
 
 import fcntl
 import filecmp
+import hashlib
+import os
 import pathlib
 import shutil
 import subprocess
@@ -59,10 +62,21 @@ def portable_opt() -> str:
     return " ".join(PORTABLE_ARCH if flag == "-march=native" else flag for flag in opt.split())
 
 
-def sync_mirror(files: list[str]) -> None:
-    """Make MIRROR hold exactly `files` of the repository. A file whose content changed is
-    rewritten (so it is newer than its objects and make rebuilds them); an unchanged one keeps
-    its time, so make does not."""
+def build_key(opt: str) -> str:
+    """Names the mirror's object folder. make does not rebuild an object when only its flags
+    change, so objects built under other flags or other make rules must never be reused:
+    anything that changes them changes the key, and the build starts afresh."""
+    h = hashlib.sha256(opt.encode())
+    for f in ["Makefile", "cuda.mk", *sorted(str(p.relative_to(ROOT))
+                                             for p in ROOT.glob("labs/*/lab.mk"))]:
+        h.update(f.encode() + b"\0" + (ROOT / f).read_bytes())
+    return h.hexdigest()[:16]
+
+
+def sync_mirror(files: list[str], objects: str) -> None:
+    """Make MIRROR hold exactly `files` of the repository, and of its object folders only
+    `objects`. A file whose content changed is rewritten (so it is newer than its objects
+    and make rebuilds them); an unchanged one keeps its time, so make does not."""
     wanted = set(files)
     for f in files:
         src, dst = ROOT / f, MIRROR / f
@@ -71,9 +85,12 @@ def sync_mirror(files: list[str]) -> None:
         dst.parent.mkdir(parents=True, exist_ok=True)
         shutil.copyfile(src, dst)
         shutil.copymode(src, dst)
+    for path in MIRROR.glob("obj-*"):
+        if path.name != objects:
+            shutil.rmtree(path)
     for path in MIRROR.rglob("*"):
         rel = path.relative_to(MIRROR)
-        if rel.parts[0] != "build" and path.is_file() and rel.as_posix() not in wanted:
+        if not rel.parts[0].startswith("obj-") and path.is_file() and rel.as_posix() not in wanted:
             path.unlink()
 
 
@@ -81,17 +98,28 @@ def build(targets: list[str], files: list[str]) -> tuple[dict[str, pathlib.Path]
     """Build `targets` in the mirror of `files`; (target -> binary for those that built, the
     build's output). One release at a time builds there (a lock)."""
     LOCK.parent.mkdir(parents=True, exist_ok=True)
+    opt = portable_opt()
+    objects = f"obj-{build_key(opt)}"
+    # Only the variables set here: none inherited from a make that runs us (MAKEFLAGS carries
+    # its command line's variables, e.g. CUDA_ARCH, which would build other binaries).
+    env = {k: v for k, v in os.environ.items() if k not in ("MAKEFLAGS", "MFLAGS", "MAKELEVEL")}
     with open(LOCK, "w") as lock:
         fcntl.flock(lock, fcntl.LOCK_EX)
-        sync_mirror(files)
+        sync_mirror(files, objects)
         for t in targets:  # phony targets relink anyway; a stale binary must not count as built
             (MIRROR / t).unlink(missing_ok=True)
         # -k: a GPU reference that cannot build (no nvcc) must not stop the CPU ones.
         # CURDIR=. sets RT_SOURCE_DIR (the default scene's folder) to the working directory.
-        p = subprocess.run(["make", "-k", "-s", "-C", str(MIRROR), "CURDIR=.",
-                            f"OPT={portable_opt()}", *targets],
-                           capture_output=True, text=True, errors="replace")
-        return {t: MIRROR / t for t in targets if (MIRROR / t).is_file()}, p.stdout + p.stderr
+        make = subprocess.Popen(["make", "-k", "-s", "-C", str(MIRROR), "CURDIR=.", f"OPT={opt}",
+                                 f"BUILD={objects}", *targets], env=env, text=True,
+                                errors="replace", stdout=subprocess.PIPE, stderr=subprocess.STDOUT)
+        try:
+            log = make.communicate()[0]
+        except BaseException:  # interrupted: make stops its compilers, removes half-built files
+            make.terminate()
+            make.wait()
+            raise
+        return {t: MIRROR / t for t in targets if (MIRROR / t).is_file()}, log
 
 
 def front_door(lab: str, prebuilt: list[str]) -> str:
