@@ -20,4 +20,4 @@ release:
 	    { echo "release: needs LAB=NN and OUT=DIR" >&2; exit 2; }
 	@test -f grading/release.py || \
 	    { echo "release: made from the course repository; this is a release" >&2; exit 2; }
-	$(PYTHON) -m grading.release '$(LAB)' '$(OUT)'
+	@$(PYTHON) -m grading.release '$(LAB)' '$(OUT)'

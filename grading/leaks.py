@@ -14,14 +14,17 @@ A release for lab NN leaks when it holds
 - a test that is not public (PUBLIC_TESTS);
 - an executable outside reference-bin/ (a binary built from solution sources, committed by
   accident);
-- the hidden scene's secret (GRADING_SECRET, grading/hidden.py), anywhere, in any file.
+- the hidden scene's secret (GRADING_SECRET, grading/hidden.py), anywhere, in any file, or
+  the scene made from it, as a scene file (what a saved copy of it would be).
 """
 from __future__ import annotations
 
 import fnmatch
 import importlib.util
+import json
 import pathlib
 
+from grading import hidden
 from grading.harness import ROOT
 
 
@@ -72,6 +75,13 @@ def is_marker(line: str) -> bool:
                 or skeletons.END.match(line) or skeletons.INSTRUCTOR_ONLY.match(line))
 
 
+def parsed_json(data: bytes):
+    try:
+        return json.loads(data)
+    except ValueError:
+        return None
+
+
 def leaks(release: pathlib.Path, lab: str, folders: dict[str, str],
           secret: str | None = None) -> list[str]:
     """Every reason `release` (a folder) may not be handed to students of lab `lab`, one line
@@ -83,6 +93,7 @@ def leaks(release: pathlib.Path, lab: str, folders: dict[str, str],
             problems.append(f"labs/{name}/solution/: lab {number}'s solution (lab {lab} and "
                             f"later ship as skeletons)")
     secret_bytes = secret.encode() if secret else None
+    secret_scene = hidden.hidden_scene(secret) if secret else None
     for path in sorted(p for p in release.rglob("*") if p.is_file() or p.is_symlink()):
         rel = path.relative_to(release).as_posix()
         if path.is_symlink():
@@ -97,6 +108,8 @@ def leaks(release: pathlib.Path, lab: str, folders: dict[str, str],
             problems.append(f"{rel}: an executable outside {REFERENCE_BIN}/")
         if secret_bytes and secret_bytes in data:
             problems.append(f"{rel}: holds the hidden scene's secret (GRADING_SECRET)")
+        if secret_scene and rel.endswith(".json") and parsed_json(data) == secret_scene:
+            problems.append(f"{rel}: is the hidden scene made from the secret")
         if not data.startswith(ELF_MAGIC) and not rel.endswith(".md") \
                 and not rel.startswith(tuple(solution_dirs)) and rel not in shared:
             text = data.decode(errors="replace")

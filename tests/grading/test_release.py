@@ -274,3 +274,15 @@ def test_leak_check_finds_a_planted_leak(tmp_path, pristine01, plant):
         target.write_text(target.read_text() + appended)
     problems = leaks.leaks(release, "01", FOLDERS)
     assert any(expected in line for line in problems), problems
+
+
+def test_leak_check_finds_the_hidden_scene(tmp_path, pristine01):
+    """The secret's scene saved among the scenes leaks the secret as surely as the secret."""
+    from grading import hidden, scenes
+    release = tmp_path / "release"
+    shutil.copytree(pristine01, release, symlinks=True)
+    secret = "0123456789abcdef0123456789abcdef"
+    assert not leaks.leaks(release, "01", FOLDERS, secret)
+    scenes.write_scene(release / "common" / "scenes" / "mine.json", hidden.hidden_scene(secret))
+    assert leaks.leaks(release, "01", FOLDERS, secret) == \
+        ["common/scenes/mine.json: is the hidden scene made from the secret"]
