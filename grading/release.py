@@ -121,16 +121,20 @@ read `handouts/{folders[lab]}.md` first.
 - Skeletons of labs {', '.join(later)}.
 - Solutions of labs {', '.join(earlier) or '(none: this is the first lab)'}: later labs build on them.
 - Reference binaries, prebuilt for x86-64 Linux, in `reference-bin/`: {', '.join(prebuilt)}.
-  `make labNN-ref` puts one at the top (GNUmakefile), as the grader does for lab01-ref;
+  `make labNN-ref` copies one to the top (GNUmakefile), which is how the grader gets them;
   earlier labs' references build from their solutions. Run them from this folder (their
   default scene is `./common/scenes/cornell.json`) or give `--scene`.
 
 ```sh
-make deps                 # what the labs need (JSON library, OpenMPI, pytest, numpy)
-make lab{lab}                # your code, into ./lab{lab}
-make grade LAB={lab}         # the autograder's checks on your code
-python3 -m pytest -q tests    # the public tests
+make deps                      # what the labs need (JSON library, OpenMPI, pytest, numpy)
+make lab{lab}                     # your code, into ./lab{lab}
+make grade LAB={lab}              # the autograder's checks on your code
+python3 -m pytest -q tests     # the public tests
+make test-unit                 # the unit tests of common/
 ```
+
+`make labs` and `make test` build every binary of the course, the references' benchmarks and
+variants included, and need the solutions this release does not have.
 """
 
 
