@@ -22,6 +22,7 @@ import os
 import pathlib
 import shutil
 import signal
+import subprocess
 import sys
 import tempfile
 
@@ -95,7 +96,8 @@ def add_references(stage: pathlib.Path, lab: str, files: list[str]) -> list[str]
                for t in names]
     built, log = reference_bins.build(targets, files)
     missing = [t for t in targets if t not in built]
-    cpu_missing = [t for t in missing if t[3:5] not in reference_bins.GPU_LABS]
+    gpu = {t for number in reference_bins.GPU_LABS for t in reference_bins.REFERENCES[number]}
+    cpu_missing = [t for t in missing if t not in gpu]
     if cpu_missing:
         last = (log.strip().splitlines() or ["(no output)"])[-1]
         raise ReleaseError(f"could not build {', '.join(cpu_missing)}: {last}")
@@ -186,7 +188,10 @@ def main(argv=None) -> int:
         # The instructor's fixed secret (grading/hidden.py); without one, each grade draws
         # its own and there is none to leak.
         out = make_release(args[0], pathlib.Path(args[1]), os.environ.get("GRADING_SECRET"))
-    except ReleaseError as e:
+    except (ReleaseError, reference_bins.BuildError) as e:
+        print(f"error: release: {e}", file=sys.stderr)
+        return 2
+    except (OSError, subprocess.CalledProcessError) as e:  # an unwritable OUT, no git, no make
         print(f"error: release: {e}", file=sys.stderr)
         return 2
     except KeyboardInterrupt:
