@@ -114,6 +114,8 @@ def add_references(stage: pathlib.Path, lab: str, files: list[str]) -> list[str]
 def release_notes(lab: str, folders: dict[str, str], prebuilt: list[str]) -> str:
     later = [f"{n} ({folders[n]})" for n in folders if n >= lab]
     earlier = [f"{n} ({folders[n]})" for n in folders if n < lab]
+    solutions = (f"Solutions of labs {', '.join(earlier)}: lab {lab} builds on them." if earlier
+                 else "No solutions: this is the first lab.")
     return f"""\
 # Lab {lab} release
 
@@ -121,7 +123,7 @@ Your lab: `labs/{folders[lab]}/skeleton/` (every place to fill in is marked `TOD
 read `handouts/{folders[lab]}.md` first.
 
 - Skeletons of labs {', '.join(later)}.
-- Solutions of labs {', '.join(earlier) or '(none: this is the first lab)'}: later labs build on them.
+- {solutions}
 - Reference binaries, prebuilt for x86-64 Linux, in `reference-bin/`: {', '.join(prebuilt)}.
   `make labNN-ref` copies one to the top (GNUmakefile), which is how the grader gets them;
   earlier labs' references build from their solutions. Run them from this folder (their

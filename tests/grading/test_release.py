@@ -113,7 +113,8 @@ def test_no_solution_source_of_the_lab_or_later(which, pristine01, pristine03):
         assert len(lines) >= 3, f"lab {lab}: too few distinctive solution lines to search for"
         found = lines & shipped
         if lab >= which:
-            assert not found, f"lab {which}'s release holds lab {lab}'s solution: {sorted(found)[:3]}"
+            assert not found, \
+                f"lab {which}'s release holds lab {lab}'s solution: {sorted(found)[:3]}"
         else:  # earlier labs' solutions ship: the search finds them, so it can find a leak
             assert found == lines, f"lab {which}'s release lacks lab {lab}'s solution"
     assert not leaks.leaks(release, which, FOLDERS)
@@ -250,7 +251,8 @@ PLANTS = {
     "a later lab's solution": ("labs/03-openmp/solution/render.cpp", None,
                                "labs/03-openmp/solution/"),
     "a solution region in a shared file": (
-        "common/host/timer.h", "\n// BEGIN SOLUTION\nint x;\n// SKELETON\n//> int x;\n// END SOLUTION\n",
+        "common/host/timer.h",
+        "\n// BEGIN SOLUTION\nint x;\n// SKELETON\n//> int x;\n// END SOLUTION\n",
         "common/host/timer.h:"),
     "an instructor-only line": ("labs/01-serial/skeleton/render.cpp", "\n//! solution: x\n",
                                 "labs/01-serial/skeleton/render.cpp:"),
