@@ -126,24 +126,33 @@ def build(targets: list[str], files: list[str]) -> tuple[dict[str, pathlib.Path]
 
 
 def front_door(lab: str, prebuilt: list[str]) -> str:
-    """The release's GNUmakefile: `make X` for a prebuilt X copies reference-bin/X into place;
-    every other goal is Makefile's, unchanged."""
+    """The release's GNUmakefile: `make X` for a prebuilt X copies reference-bin/X into place,
+    `make test` runs the release's own tests; every other goal is Makefile's, unchanged."""
     return f"""\
-# Lab {lab} release: GNU make reads this file before Makefile. Lab {lab} and the labs after it
-# come without their solution sources, so their reference binaries are not built here: they
-# ship prebuilt in reference-bin/ (x86-64 Linux), and `make labNN-ref` for one of them copies
-# it into place (which is how the grader gets it). Every other goal is Makefile's, unchanged.
+# Lab {lab} release: GNU make reads this file before Makefile.
+# - Lab {lab} and the labs after it come without their solution sources, so their reference
+#   binaries are not built here: they ship prebuilt in reference-bin/ (x86-64 Linux), and
+#   `make labNN-ref` for one of them copies it into place (which is how the grader gets it).
+# - `make test` and `make test-labs` run this release's tests: Makefile's first build every
+#   binary of the course, which needs the solutions.
+# Every other goal is Makefile's, unchanged.
 PREBUILT := {' '.join(prebuilt)}
-PREBUILT_GOALS := $(filter $(PREBUILT),$(MAKECMDGOALS))
+OWN_GOALS := $(filter $(PREBUILT) test test-labs,$(MAKECMDGOALS))
+PYTHON ?= python3
 
-ifeq ($(PREBUILT_GOALS),)
+ifeq ($(OWN_GOALS),)
 include Makefile
 else
-OTHER_GOALS := $(filter-out $(PREBUILT),$(MAKECMDGOALS))
+OTHER_GOALS := $(filter-out $(OWN_GOALS),$(MAKECMDGOALS))
 .PHONY: $(MAKECMDGOALS) makefile-goals
 # Copied, then renamed: a binary that is running (a grade in progress) cannot be overwritten.
-$(PREBUILT_GOALS):
+$(filter $(PREBUILT),$(OWN_GOALS)):
 	@cp reference-bin/$@ $@.partial-copy && mv -f $@.partial-copy $@
+test:
+	@$(MAKE) --no-print-directory -f Makefile deps test-unit
+	$(PYTHON) -m pytest -q tests
+test-labs:
+	$(PYTHON) -m pytest -q tests
 # The other goals of the same command line, in one run of Makefile.
 ifneq ($(OTHER_GOALS),)
 $(OTHER_GOALS): makefile-goals ; @:

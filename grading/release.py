@@ -20,11 +20,11 @@ from __future__ import annotations
 import fnmatch
 import os
 import pathlib
+import secrets
 import shutil
 import signal
 import subprocess
 import sys
-import tempfile
 
 from grading import leaks, reference_bins
 from grading.gradescope import repository_files
@@ -130,15 +130,14 @@ read `handouts/{folders[lab]}.md` first.
   default scene is `./common/scenes/cornell.json`) or give `--scene`.
 
 ```sh
-make deps                      # what the labs need (JSON library, OpenMPI, pytest, numpy)
-make lab{lab}                     # your code, into ./lab{lab}
-make grade LAB={lab}              # the autograder's checks on your code
-python3 -m pytest -q tests     # the public tests
-make test-unit                 # the unit tests of common/
+make deps                 # what the labs need (JSON library, OpenMPI, pytest, numpy)
+make lab{lab}                # your code, into ./lab{lab}
+make grade LAB={lab}         # the autograder's checks on your code
+make test                 # the public tests: make test-unit (common/), make test-labs
 ```
 
-`make labs` and `make test` build every binary of the course, the references' benchmarks and
-variants included, and need the solutions this release does not have.
+`make labs` builds every binary of the course, the references' benchmarks and variants
+included, and needs the solutions this release does not have.
 """
 
 
@@ -154,8 +153,16 @@ def make_release(lab: str, out: pathlib.Path, secret: str | None = None) -> path
         raise ReleaseError(f"no solution of lab {missing[0]} here: a release is made from the "
                            f"course repository, not from a release")
     out.parent.mkdir(parents=True, exist_ok=True)
-    stage = pathlib.Path(tempfile.mkdtemp(prefix=f".{out.name}.partial-", dir=out.parent))
+    # The folder's name is chosen before it is made, so that the cleanup knows it whenever an
+    # interrupt comes (a signal can arrive between any two steps, even while the handler's
+    # thread blocks it: numpy's threads take it).
+    stage = out.parent / f".{out.name}.partial-{secrets.token_hex(6)}"
     try:
+        try:
+            stage.mkdir(mode=0o700)  # private until complete
+        except FileExistsError:  # a clash of random names: someone else's, never removed
+            stage = None
+            raise ReleaseError("a folder of the same random name appeared; try again")
         files = repository_files()
         copy_sources(stage, lab, folders, files)
         prebuilt = add_references(stage, lab, files)
@@ -167,11 +174,15 @@ def make_release(lab: str, out: pathlib.Path, secret: str | None = None) -> path
             raise ReleaseError(f"refusing to release lab {lab}: {problems[0]}{more}")
         umask = os.umask(0)
         os.umask(umask)
-        stage.chmod(0o777 & ~umask)  # mkdtemp's folder is private; a repository is not
+        stage.chmod(0o777 & ~umask)
         check_out(out)  # again: something may have written there meanwhile
         os.rename(stage, out)  # replaces an empty folder, atomically
-    except BaseException:
-        shutil.rmtree(stage, ignore_errors=True)
+    except BaseException as e:
+        if isinstance(e, KeyboardInterrupt) and stage is not None and not stage.exists() \
+                and out.is_dir():
+            return out  # it came just after the rename: the release is complete
+        if stage is not None:
+            shutil.rmtree(stage, ignore_errors=True)
         raise
     return out
 
