@@ -1,6 +1,7 @@
 """`make release LAB=NN OUT=DIR` (grading/release.py): releases for labs 01 and 03 are made in
-a scratch folder, searched for solutions, and used there as a student would: the public tests,
-`make grade` (lab 01), the references built or served prebuilt. Then every way it must refuse.
+a scratch folder, searched for solutions, and used there as a student would: the public tests
+(`make test-labs` in lab 03's), `make grade` (lab 01), the references built or served
+prebuilt. Then every way it must refuse, and the leak check on leaks planted in a copy.
 
 Lab 03's `make grade` is not run here: its skeleton is a correct serial renderer, graded on
 parallel speedup, which a busy machine cannot measure (it then awards provisional points)
@@ -27,10 +28,9 @@ CLEAN_ENV = {k: v for k, v in os.environ.items()
              if k not in ("MAKEFLAGS", "MFLAGS", "MAKELEVEL", "PYTHONPATH", "GRADING_SECRET")}
 
 
-def make_release(lab, out, *extra, env=None):
-    return subprocess.run(["make", "-s", "-C", str(ROOT), "release", f"LAB={lab}", f"OUT={out}",
-                           *extra], capture_output=True, text=True, timeout=900,
-                          env={**CLEAN_ENV, **(env or {})})
+def make_release(lab, out):
+    return subprocess.run(["make", "-s", "-C", str(ROOT), "release", f"LAB={lab}", f"OUT={out}"],
+                          capture_output=True, text=True, timeout=900, env=CLEAN_ENV)
 
 
 @pytest.fixture(scope="module")
