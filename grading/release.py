@@ -141,6 +141,19 @@ included, and needs the solutions this release does not have.
 """
 
 
+def check_skeletons() -> None:
+    """The shipped skeletons must be what tools/skeletons.py makes of the solutions now: a
+    solution changed without `make skeletons` would give students a skeleton of the old one."""
+    try:
+        generated = list(leaks.skeletons.generated_files())
+    except leaks.skeletons.MarkerError as e:
+        raise ReleaseError(f"a solution's markers are broken: {e}") from None
+    stale = [path.relative_to(ROOT).as_posix() for path, text in generated
+             if not path.is_file() or path.read_text() != text]
+    if stale:
+        raise ReleaseError(f"skeletons out of date (run make skeletons): {', '.join(stale)}")
+
+
 def make_release(lab: str, out: pathlib.Path, secret: str | None = None) -> pathlib.Path:
     """Write lab `lab`'s release to `out` (which must not exist or be empty); ReleaseError
     says why not. `secret`: the hidden scene's secret, which no file may contain."""
@@ -152,6 +165,7 @@ def make_release(lab: str, out: pathlib.Path, secret: str | None = None) -> path
     if missing:
         raise ReleaseError(f"no solution of lab {missing[0]} here: a release is made from the "
                            f"course repository, not from a release")
+    check_skeletons()
     out.parent.mkdir(parents=True, exist_ok=True)
     # The folder's name is chosen before it is made, so that the cleanup knows it whenever an
     # interrupt comes (a signal can arrive between any two steps, even while the handler's

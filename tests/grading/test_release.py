@@ -225,6 +225,18 @@ def test_refuses_a_non_empty_out(tmp_path):
     assert_refused(run_tool("01", str(tmp_path / "file")), "is not a folder", tmp_path / "file")
 
 
+def test_stale_skeletons_refuse_the_release(tmp_path, monkeypatch):
+    """A solution edited without `make skeletons`: its students would get the old skeleton."""
+    from grading import release
+    generated = list(leaks.skeletons.generated_files())
+    path, text = generated[0]
+    monkeypatch.setattr(leaks.skeletons, "generated_files",
+                        lambda: [(path, text + "// changed\n"), *generated[1:]])
+    with pytest.raises(release.ReleaseError, match="skeletons out of date .*" + path.name):
+        release.make_release("01", tmp_path / "out")
+    assert list(tmp_path.iterdir()) == []
+
+
 def test_a_leaked_secret_refuses_the_release(tmp_path, release01):
     """A secret that a shipped file holds (as if the instructor's GRADING_SECRET had been
     committed in one): the release is refused and nothing is left."""
