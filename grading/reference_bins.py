@@ -95,9 +95,9 @@ def sync_mirror(files: list[str], objects: str) -> None:
             path.unlink()
 
 
-def build(targets: list[str], files: list[str]) -> tuple[dict[str, pathlib.Path], str]:
-    """Build `targets` in the mirror of `files`; (target -> binary for those that built, the
-    build's output). One release at a time builds there (a lock)."""
+def build(targets: list[str], files: list[str], dest: pathlib.Path) -> tuple[list[str], str]:
+    """Build `targets` in the mirror of `files` and copy those that built into `dest`; (their
+    names, the build's output). One release at a time builds and copies there (a lock)."""
     LOCK.parent.mkdir(parents=True, exist_ok=True)
     opt = portable_opt()
     objects = f"obj-{build_key(opt)}"
@@ -122,7 +122,11 @@ def build(targets: list[str], files: list[str]) -> tuple[dict[str, pathlib.Path]
             make.terminate()
             make.wait()
             raise
-        return {t: MIRROR / t for t in targets if (MIRROR / t).is_file()}, log
+        built = [t for t in targets if (MIRROR / t).is_file()]
+        dest.mkdir(parents=True, exist_ok=True)
+        for t in built:
+            shutil.copy2(MIRROR / t, dest / t)
+        return built, log
 
 
 def front_door(lab: str, prebuilt: list[str]) -> str:

@@ -94,7 +94,7 @@ def add_references(stage: pathlib.Path, lab: str, files: list[str]) -> list[str]
     a GPU one is left out, saying so, where it cannot."""
     targets = [t for number, names in reference_bins.REFERENCES.items() if number >= lab
                for t in names]
-    built, log = reference_bins.build(targets, files)
+    built, log = reference_bins.build(targets, files, stage / leaks.REFERENCE_BIN)
     missing = [t for t in targets if t not in built]
     gpu = {t for number in reference_bins.GPU_LABS for t in reference_bins.REFERENCES[number]}
     cpu_missing = [t for t in missing if t not in gpu]
@@ -104,10 +104,6 @@ def add_references(stage: pathlib.Path, lab: str, files: list[str]) -> list[str]
     if missing:
         print(f"release: left out {', '.join(missing)} (the CUDA toolkit is missing or the "
               f"build failed); those labs ship without a reference binary", file=sys.stderr)
-    bin_dir = stage / leaks.REFERENCE_BIN
-    bin_dir.mkdir()
-    for name, binary in built.items():
-        shutil.copy2(binary, bin_dir / name)
     return sorted(built)
 
 

@@ -185,6 +185,18 @@ def test_lab03_release_builds_earlier_references_and_serves_its_own(release03):
     assert p.returncode == 0 and " passed" in p.stdout, p.stdout + p.stderr
 
 
+def test_without_nvcc_the_gpu_references_are_left_out(tmp_path, release01):
+    """Where the CUDA toolkit is missing, a release still comes, saying what it lacks."""
+    path = os.pathsep.join(d for d in os.environ["PATH"].split(os.pathsep)
+                           if not (pathlib.Path(d) / "nvcc").exists())
+    p = subprocess.run([sys.executable, "-m", "grading.release", "05", str(tmp_path / "out")],
+                       cwd=ROOT, capture_output=True, text=True, timeout=900,
+                       env={**CLEAN_ENV, "PATH": path})
+    assert p.returncode == 0, p.stderr
+    assert "left out lab05-ref, lab06-ref, lab07-ref" in p.stderr
+    assert list((tmp_path / "out" / "reference-bin").iterdir()) == []
+
+
 # ---- refusals: one line, exit status 2, nothing written ---------------------------------
 
 def run_tool(*args, env=None):
