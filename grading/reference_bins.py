@@ -9,15 +9,16 @@ built from their shipped solutions, as in the course repository.
 
 The binaries are built in a copy of the repository under build/release/ (kept between
 releases, so a second release only relinks; its objects are keyed by the build's flags and
-make files) with two changes that make them run on the
-students' machines rather than this one:
+make files) with three changes that make them run on the students' machines rather than on
+this one:
 - `-march=native` becomes `-march=x86-64-v2` (any x86-64 CPU of the last fifteen years; the
   AVX2 code of lab 02 is compiled with -mavx2 anyway and checks the CPU at run time). The
   flags keep -ffp-contract=off, so the images are the same bits as a native build's.
 - the default scene path compiled in (RT_SOURCE_DIR, the source tree's absolute path) becomes
   ".", so `./labNN-ref` with no --scene finds common/scenes/cornell.json from the release's
   root, as the grader runs it.
-CUDA binaries carry machine code for the fallback architectures of cuda.mk (no GPU here).
+- CUDA code is compiled for cuda.mk's fallback architectures (sm_75 to sm_90 and compute_90
+  PTX), not for the GPUs of this machine, if it has any.
 They need x86-64 Linux with the libraries `make deps` installs (OpenMPI for lab 04).
 """
 from __future__ import annotations
@@ -48,11 +49,18 @@ class BuildError(RuntimeError):
     pass
 
 
+def make_environment() -> dict[str, str]:
+    """This process's environment without what a make that runs us passes on (MAKEFLAGS
+    carries its command line's variables, e.g. OPT=...): the references are built with the
+    Makefile's own flags, and only the changes made here."""
+    return {k: v for k, v in os.environ.items() if k not in ("MAKEFLAGS", "MFLAGS", "MAKELEVEL")}
+
+
 def make_variable(name: str) -> str:
     """A variable of the repository's Makefile as make computes it."""
     rule = f"print-release-var: ; @echo $({name})"
     p = subprocess.run(["make", "-s", "-C", str(ROOT), f"--eval={rule}", "print-release-var"],
-                       capture_output=True, text=True, check=True)
+                       capture_output=True, text=True, check=True, env=make_environment())
     return p.stdout.strip()
 
 
@@ -63,11 +71,11 @@ def portable_opt() -> str:
     return " ".join(PORTABLE_ARCH if flag == "-march=native" else flag for flag in opt.split())
 
 
-def build_key(opt: str) -> str:
+def build_key(opt: str, cuda_arch: str) -> str:
     """Names the mirror's object folder. make does not rebuild an object when only its flags
     change, so objects built under other flags or other make rules must never be reused:
     anything that changes them changes the key, and the build starts afresh."""
-    h = hashlib.sha256(opt.encode())
+    h = hashlib.sha256(f"{opt}\0{cuda_arch}".encode())
     for f in ["Makefile", "cuda.mk", *sorted(str(p.relative_to(ROOT))
                                              for p in ROOT.glob("labs/*/lab.mk"))]:
         h.update(f.encode() + b"\0" + (ROOT / f).read_bytes())
@@ -100,10 +108,8 @@ def build(targets: list[str], files: list[str], dest: pathlib.Path) -> tuple[lis
     names, the build's output). One release at a time builds and copies there (a lock)."""
     LOCK.parent.mkdir(parents=True, exist_ok=True)
     opt = portable_opt()
-    objects = f"obj-{build_key(opt)}"
-    # Only the variables set here: none inherited from a make that runs us (MAKEFLAGS carries
-    # its command line's variables, e.g. CUDA_ARCH, which would build other binaries).
-    env = {k: v for k, v in os.environ.items() if k not in ("MAKEFLAGS", "MFLAGS", "MAKELEVEL")}
+    cuda_arch = make_variable("CUDA_FALLBACK_ARCH")
+    objects = f"obj-{build_key(opt, cuda_arch)}"
     with open(LOCK, "w") as lock:
         fcntl.flock(lock, fcntl.LOCK_EX)
         sync_mirror(files, objects)
@@ -114,8 +120,9 @@ def build(targets: list[str], files: list[str], dest: pathlib.Path) -> tuple[lis
         # CURDIR=. sets RT_SOURCE_DIR (the default scene's folder) to the working directory.
         cores = len(os.sched_getaffinity(0))
         make = subprocess.Popen(["make", "-k", "-s", f"-j{cores}", "-C", str(MIRROR), "CURDIR=.",
-                                 f"OPT={opt}", f"BUILD={objects}", *targets], env=env, text=True,
-                                errors="replace", stdout=subprocess.PIPE, stderr=subprocess.STDOUT)
+                                 f"OPT={opt}", f"CUDA_ARCH={cuda_arch}", f"BUILD={objects}",
+                                 *targets], env=make_environment(), text=True, errors="replace",
+                                stdout=subprocess.PIPE, stderr=subprocess.STDOUT)
         try:
             log = make.communicate()[0]
         except BaseException:  # interrupted: make stops its compilers, removes half-built files
