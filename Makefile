@@ -46,6 +46,7 @@ help:
 	@echo "make check-nvcc   compile every header of common/core for the GPU (needs nvcc)"
 	@echo "make kernel-report registers, spills, stack and shared memory of every CUDA kernel"
 	@echo "make gpu-check OUT=DIR  on a GPU machine: build, test and benchmark the CUDA labs"
+	@echo "make release LAB=NN OUT=DIR  the student repository for lab NN (grading/README.md)"
 	@echo "make lab05-bench  the lab-05 kernel shapes the handout measures (needs a GPU)"
 	@echo "make test         build everything and run every test"
 	@echo "make bench        time the lab-01 reference on the Cornell baseline (minutes)"
