@@ -219,6 +219,42 @@ def test_gpu_binds_are_built_from_what_exists(tmp_path):
     assert gpu.sandbox_args(dev=str(empty), libs=libs) == []
 
 
+def test_sandboxed_cuda_builds_target_the_gpu_here(monkeypatch, tmp_path):
+    """A submission's CUDA build in the sandbox (where nvidia-smi cannot reach the driver)
+    gets the architecture of the GPU the grader sees, not cuda.mk's six-target fallback; with
+    no GPU, nothing is passed and the fallback stands."""
+    from grading import compile as grading_compile
+    seen = []
+
+    class Recorder:
+        def __init__(self, **_):
+            pass
+
+        def __enter__(self):
+            return self
+
+        def __exit__(self, *_):
+            return False
+
+        def bind(self, *_args, **_kwargs):
+            pass
+
+        def run(self, command, _limits):
+            seen.append(command)
+            return sandbox.Outcome(returncode=2, stdout="", stderr="stand-in", wall_seconds=0,
+                                   cpu_seconds=None)
+
+    monkeypatch.setattr(grading_compile, "Runner", Recorder)
+    monkeypatch.setattr(gpu, "cuda_arch_flags", lambda: "-gencode arch=compute_90,code=sm_90")
+    grading_compile.build_in_sandbox("05-cuda-mega", tmp_path, target="cuda-variant")
+    assert "CUDA_ARCH=-gencode arch=compute_90,code=sm_90" in seen[-1], seen[-1]
+    monkeypatch.setattr(gpu, "cuda_arch_flags", lambda: "")
+    grading_compile.build_in_sandbox("05-cuda-mega", tmp_path, target="cuda-variant")
+    assert not any(a.startswith("CUDA_ARCH=") for a in seen[-1]), seen[-1]
+    grading_compile.build_in_sandbox("01-serial", tmp_path)  # a CPU lab: never
+    assert not any(a.startswith("CUDA_ARCH=") for a in seen[-1]), seen[-1]
+
+
 def test_only_gpu_runs_see_the_gpu(monkeypatch):
     """A CPU lab's sandbox gets no GPU binds; a GPU lab's gets them after `--dev /dev` (which
     would hide them) and `--clearenv` (which would drop LD_LIBRARY_PATH)."""
