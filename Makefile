@@ -42,7 +42,7 @@ help:
 	@echo "make render       install what is missing, render the default scene to cornell.ppm"
 	@echo "                  with the fastest reference here (GPU, else OpenMP+AVX2)"
 	@echo "make deps         install what is missing (JSON library, OpenMPI, pytest, numpy, matplotlib)"
-	@echo "make grade LAB=NN grade your lab NN code (01-04): score table and results.json"
+	@echo "make grade LAB=NN grade your lab NN code (01-07): score table and results.json"
 	@echo "make check-nvcc   compile every header of common/core for the GPU (needs nvcc)"
 	@echo "make kernel-report registers, spills, stack and shared memory of every CUDA kernel"
 	@echo "make gpu-check OUT=DIR  on a GPU machine: build, test and benchmark the CUDA labs"
