@@ -49,18 +49,20 @@ help:
 	@echo "                  labs: $(LAB_BINARIES)"
 	@echo "make render       install what is missing, render the default scene to cornell.ppm"
 	@echo "                  with the fastest reference here (GPU, else OpenMP+AVX2)"
-	@echo "make deps         install what is missing (JSON library, OpenMPI, pytest, numpy)"
-	@echo "make grade LAB=NN grade your lab NN code (01-04): score table and results.json"
+	@echo "make deps         install what is missing (JSON library, OpenMPI, pytest, numpy, matplotlib)"
+	@echo "make grade LAB=NN grade your lab NN code (01-07): score table and results.json"
 	@echo "make check-nvcc   compile every header of common/core for the GPU (needs nvcc)"
 	@echo "make kernel-report registers, spills, stack and shared memory of every CUDA kernel"
 	@echo "make gpu-check OUT=DIR  on a GPU machine: build, test and benchmark the CUDA labs"
+	@echo "make release LAB=NN OUT=DIR  the student repository for lab NN (grading/README.md)"
 	@echo "make lab05-bench  the lab-05 kernel shapes the handout measures (needs a GPU)"
 	@echo "make test         build everything and run every test"
 	@echo "make bench        time the lab-01 reference on the Cornell baseline (minutes)"
 	@echo "make bench-cpu    the CPU labs side by side (the report's Table 4 for this machine)"
 	@echo "make bench-micro  Google Benchmark of the inner loops (closest hit, shadow ray, path)"
 	@echo "make count-work   instructions per camera path, split by query (needs valgrind)"
-	@echo "make tradeoff     error against time: RMSE vs spp for the lab-01 reference"
+	@echo "make tradeoff     speed against accuracy: error vs time of every lab here, bias vs"
+	@echo "                  bounces, fast math, ray offsets; checked, plotted (QUICK=1: CI size)"
 	@echo "make lab01-ref-double  lab 01's reference computing in double (lab05-ref-double: GPU)"
 	@echo "make bench-precision  float against double: time and error of lab 01's reference"
 	@echo "make golden       regenerate the golden images in reference/ (minutes)"
@@ -188,8 +190,12 @@ count-work:
 bench-micro: $(BUILD)/intersect_bench
 	$(BUILD)/intersect_bench --benchmark_min_time=0.2
 
+# Speed against accuracy (tools/tradeoff.py): error against time for every renderer here,
+# bias against bounces, fast math and ray offsets; fails when a check does. CSV, Markdown and
+# PNG plots go to REPORTS. QUICK=1 is the CI size (tests/tools/test_tradeoff.py runs it).
+REPORTS ?= $(BUILD)/reports
 tradeoff: lab01-ref
-	$(PYTHON) tools/bench_serial.py tradeoff
+	$(PYTHON) tools/tradeoff.py --out $(REPORTS) $(if $(filter 1 true yes,$(QUICK)),--quick)
 
 # Float against double: time and error of lab01-ref and lab01-ref-double (tools/bench_precision.py).
 bench-precision: lab01-ref lab01-ref-double

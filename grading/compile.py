@@ -15,6 +15,7 @@ from __future__ import annotations
 import pathlib
 import shutil
 
+from grading import gpu
 from grading.harness import ROOT
 from grading.sandbox import Limits, Runner
 
@@ -46,6 +47,8 @@ def build_in_sandbox(variant_lab: str, src: pathlib.Path,
     # and the toolkit (under /usr/local) is visible but not on it.
     nvcc = shutil.which("nvcc")
     extra = [f"NVCC={nvcc}"] if target == "cuda-variant" and nvcc else []
+    if target == "cuda-variant" and (arch := gpu.cuda_arch_flags()):
+        extra.append(f"CUDA_ARCH={arch}")  # the GPU here only (gpu.cuda_arch_flags says why)
     with Runner(trusted=False) as r:
         for path in visible_tree(variant_lab):
             r.bind(path)

@@ -50,6 +50,26 @@ def missing_gpu() -> str | None:
     return None
 
 
+@functools.lru_cache(maxsize=None)
+def cuda_arch_flags() -> str:
+    """nvcc's target for the GPUs here ("-gencode arch=compute_90,code=sm_90" for an H200), or
+    "" where nvidia-smi lists none. A submission's CUDA sources are compiled in the sandbox,
+    where nvidia-smi cannot reach the driver, so cuda.mk would build for its whole fallback
+    list (five architectures and PTX): six compilations for a program that runs here only,
+    in parallel threads of one nvcc that then need more address space than the sandbox's
+    limit leaves it."""
+    if missing_gpu():
+        return ""
+    try:
+        p = subprocess.run(["nvidia-smi", "--query-gpu=compute_cap", "--format=csv,noheader"],
+                           capture_output=True, text=True, timeout=60)
+    except (OSError, subprocess.TimeoutExpired):
+        return ""
+    caps = sorted({line.strip().replace(".", "") for line in p.stdout.splitlines()
+                   if line.strip().replace(".", "").isdigit()})
+    return " ".join(f"-gencode arch=compute_{c},code=sm_{c}" for c in caps)
+
+
 def device_nodes(dev: str = DEV) -> list[str]:
     """The NVIDIA device nodes present (names below `dev`): nvidiactl, nvidia-uvm,
     nvidia-uvm-tools, nvidia0, nvidia1, ..., and the nvidia-caps folder (MIG)."""

@@ -1,7 +1,7 @@
 # The grader's make targets (make grade, gradescope, release, grade-batch).
 # `make grade` itself is in the Makefile; grading/README.md explains the grader.
 
-.PHONY: gradescope grade-batch
+.PHONY: gradescope grade-batch release
 
 # make gradescope LAB=NN: the Gradescope autograder zip for lab NN in build/.
 gradescope:
@@ -12,3 +12,12 @@ gradescope:
 grade-batch:
 	@test -n "$(SUBMISSIONS)" || { echo "grade-batch: needs SUBMISSIONS=DIR" >&2; exit 2; }
 	$(PYTHON) -m grading.batch $(LAB) $(SUBMISSIONS) --out $(or $(REPORT),grades)
+
+# make release LAB=NN OUT=DIR: the student repository for lab NN (grading/release.py). LAB and
+# OUT have defaults in the Makefiles (for make grade, make gpu-check); a release must name both.
+release:
+	@test "$(origin LAB)" != file -a "$(origin OUT)" != file -a -n "$(OUT)" || \
+	    { echo "release: needs LAB=NN and OUT=DIR" >&2; exit 2; }
+	@test -f grading/release.py || \
+	    { echo "release: made from the course repository; this is a release" >&2; exit 2; }
+	@$(PYTHON) -m grading.release '$(LAB)' '$(OUT)'

@@ -2,12 +2,12 @@
 # Installs what the labs need and is missing; says what it installs; safe to run again.
 # Compilers (g++, nvcc where present) come with the machine; this adds the JSON library,
 # GoogleTest, Google Benchmark, OpenMPI, bubblewrap (the grader's sandbox) and the Python test
-# packages.
+# packages (matplotlib: the plots of `make tradeoff`).
 set -euo pipefail
 
 debian_packages=(g++ make nlohmann-json3-dev libgtest-dev libbenchmark-dev openmpi-bin
                  libopenmpi-dev iproute2 bubblewrap)
-python_modules=(pytest numpy)
+python_modules=(pytest numpy matplotlib)
 
 missing=()
 for p in "${debian_packages[@]}"; do

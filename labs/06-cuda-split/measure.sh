@@ -22,11 +22,14 @@ bench() {  # bench NAME FLAGS...: one JSON per scene
     echo "measure: lab07-bench $*"
     timeout 240 ./lab07-bench --repeat "${WAVEFRONT_REPEAT:-3}" "$@" > "$out/bench-$name.json" || status=1
 }
+# WAVEFRONT_ONLY=NAME,...: only those configurations on the three scenes after the baseline
+# (a short lease; the baseline always gets them all).
+only=(${WAVEFRONT_ONLY:+--only "$WAVEFRONT_ONLY"})
 if [[ $steps == *" bench "* ]]; then
     bench cornell
-    bench cornell-16 --bounces 16
-    bench showcase --scene common/scenes/showcase.json
-    bench showcase-16 --scene common/scenes/showcase.json --bounces 16
+    bench cornell-16 --bounces 16 "${only[@]}"
+    bench showcase --scene common/scenes/showcase.json "${only[@]}"
+    bench showcase-16 --scene common/scenes/showcase.json --bounces 16 "${only[@]}"
 fi
 
 ncu_bin=$(command -v ncu || ls /opt/nvidia/nsight-compute/*/ncu /usr/local/cuda/bin/ncu 2>/dev/null | head -1)

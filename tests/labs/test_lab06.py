@@ -224,10 +224,10 @@ def test_baseline_is_finite_and_summarised(gpu, lab06_ref):
     assert 0 < run.json["seconds"] < wall
 
 
-# The bar is not met: 322.7 ms measured on the H200 (reference/gpu/h200-2026-12-02-labs05-07;
+# The bar is not met: 162 ms measured on the H200 (reference/gpu/h200-2026-12-02-experiments;
 # handouts/06-cuda-split.md says where the time goes). Strict: once it passes, this marker
 # must go.
-@pytest.mark.xfail(strict=True, reason="lab 06's reference takes ~323 ms on the H200, bar 80 ms")
+@pytest.mark.xfail(strict=True, reason="lab 06's reference takes ~162 ms on the H200, bar 80 ms")
 def test_h200_bar(lab06_ref):
     """On an H200, the baseline's kernels take at most 80 ms (best of 3)."""
     on_h200()

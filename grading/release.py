@@ -1,0 +1,228 @@
+"""The student repository for one lab.
+
+    make release LAB=03 OUT=../lab03-release
+
+A release for lab NN holds the skeletons of lab NN and every later lab, the solutions of the
+earlier labs (lab NN builds on them), common/ with the solution regions of lab NN and later
+replaced by their skeleton form (tools/skeletons.py), the scenes, the golden images, the
+handouts, the public tests, the grader (students run `make grade LAB=NN`, trusted) and the
+reference binaries of lab NN and later, prebuilt (grading/reference_bins.py says why and how).
+It holds no solution source of lab NN or later, no test that is not public, no instructor
+tool and no secret: grading/leaks.py checks the finished folder, and the release is refused
+when it finds anything.
+
+The release is written atomically: it is assembled in a hidden folder beside OUT and renamed
+to OUT only once complete and checked; OUT must not exist or be an empty folder. Every
+refusal is one line on stderr and exit status 2.
+"""
+from __future__ import annotations
+
+import fnmatch
+import os
+import pathlib
+import secrets
+import shutil
+import signal
+import subprocess
+import sys
+
+from grading import leaks, reference_bins
+from grading.gradescope import repository_files
+from grading.harness import ROOT
+
+# Top-level entries of the repository that ship (then filtered by leaks.NEVER_SHIPPED and
+# leaks.PUBLIC_TESTS): anything else, such as a stray binary at the root, does not.
+SHIPPED_TOP = ("Makefile", "cuda.mk", "README.md", "DESIGN.md", ".gitignore", "common", "labs",
+               "grading", "handouts", "reference", "tests", "tools", "bench")
+
+
+class ReleaseError(Exception):
+    """Why no release was written: one line for the user."""
+
+
+def parse_lab(lab: str, folders: dict[str, str]) -> str:
+    if lab not in folders:
+        raise ReleaseError(f"LAB must be one of {', '.join(folders)} (got {lab!r})")
+    return lab
+
+
+def check_out(out: pathlib.Path) -> None:
+    if out.is_symlink() or (out.exists() and not out.is_dir()):
+        raise ReleaseError(f"OUT={out} exists and is not a folder; give a new folder")
+    if out.is_dir() and any(out.iterdir()):
+        raise ReleaseError(f"OUT={out} is not empty; give a new or empty folder "
+                           f"(a release never overwrites one)")
+
+
+def shipped(path: str, lab: str, folders: dict[str, str]) -> bool:
+    """Whether a file of the repository belongs in lab `lab`'s release."""
+    if path.split("/")[0] not in SHIPPED_TOP:
+        return False
+    if any(fnmatch.fnmatch(path, p) for p in leaks.NEVER_SHIPPED):
+        return False
+    if path.startswith("tests/") and not any(fnmatch.fnmatch(path, p) for p in leaks.PUBLIC_TESTS):
+        return False
+    return not any(path.startswith(f"labs/{name}/solution/")
+                   for number, name in folders.items() if number >= lab)
+
+
+def skeleton_form(lab: str, folders: dict[str, str]) -> set[str]:
+    """Shared files whose solution regions belong to lab `lab` or later: they ship as their
+    skeleton (common/core/path_tracer.h is lab 01's, so only a lab-01 release ships it so)."""
+    return {path for number, name in folders.items() if number >= lab
+            for path in leaks.skeletons.SHARED_SOURCES.get(name, [])}
+
+
+def copy_sources(stage: pathlib.Path, lab: str, folders: dict[str, str],
+                 files: list[str]) -> None:
+    as_skeleton = skeleton_form(lab, folders)
+    for f in files:
+        if not shipped(f, lab, folders):
+            continue
+        src, dst = ROOT / f, stage / f
+        dst.parent.mkdir(parents=True, exist_ok=True)
+        if f in as_skeleton:
+            dst.write_text(leaks.skeletons.skeleton_text(src.read_text(), f))
+            shutil.copymode(src, dst)
+        else:
+            shutil.copy2(src, dst)
+
+
+def add_references(stage: pathlib.Path, lab: str, files: list[str]) -> list[str]:
+    """Build and copy the prebuilt references of lab `lab` and later into reference-bin/;
+    returns their names. A CPU reference must build (the grader needs lab01-ref, lab04-ref);
+    a GPU one is left out, saying so, where it cannot."""
+    targets = [t for number, names in reference_bins.REFERENCES.items() if number >= lab
+               for t in names]
+    built, log = reference_bins.build(targets, files, stage / leaks.REFERENCE_BIN)
+    missing = [t for t in targets if t not in built]
+    gpu = {t for number in reference_bins.GPU_LABS for t in reference_bins.REFERENCES[number]}
+    cpu_missing = [t for t in missing if t not in gpu]
+    if cpu_missing:
+        last = (log.strip().splitlines() or ["(no output)"])[-1]
+        raise ReleaseError(f"could not build {', '.join(cpu_missing)}: {last}")
+    if missing:
+        print(f"release: left out {', '.join(missing)} (the CUDA toolkit is missing or the "
+              f"build failed); those labs ship without a reference binary", file=sys.stderr)
+    return sorted(built)
+
+
+def release_notes(lab: str, folders: dict[str, str], prebuilt: list[str]) -> str:
+    later = [f"{n} ({folders[n]})" for n in folders if n >= lab]
+    earlier = [f"{n} ({folders[n]})" for n in folders if n < lab]
+    solutions = (f"Solutions of labs {', '.join(earlier)}: lab {lab} builds on them." if earlier
+                 else "No solutions: this is the first lab.")
+    return f"""\
+# Lab {lab} release
+
+Your lab: `labs/{folders[lab]}/skeleton/` (every place to fill in is marked `TODO(lab{lab})`);
+read `handouts/{folders[lab]}.md` first.
+
+- Skeletons of labs {', '.join(later)}.
+- {solutions}
+- Reference binaries, prebuilt for x86-64 Linux, in `reference-bin/`: {', '.join(prebuilt)}.
+  `make labNN-ref` copies one to the top (GNUmakefile), which is how the grader gets them;
+  earlier labs' references build from their solutions. Run them from this folder (their
+  default scene is `./common/scenes/cornell.json`) or give `--scene`.
+
+```sh
+make deps                 # what the labs need (JSON library, OpenMPI, pytest, numpy)
+make lab{lab}                # your code, into ./lab{lab}
+make grade LAB={lab}         # the autograder's checks on your code
+make test                 # the public tests: make test-unit (common/), make test-labs
+```
+
+`make labs` builds every binary of the course, the references' benchmarks and variants
+included, and needs the solutions this release does not have.
+"""
+
+
+def check_skeletons() -> None:
+    """The shipped skeletons must be what tools/skeletons.py makes of the solutions now: a
+    solution changed without `make skeletons` would give students a skeleton of the old one."""
+    try:
+        generated = list(leaks.skeletons.generated_files())
+    except leaks.skeletons.MarkerError as e:
+        raise ReleaseError(f"a solution's markers are broken: {e}") from None
+    stale = [path.relative_to(ROOT).as_posix() for path, text in generated
+             if not path.is_file() or path.read_text() != text]
+    if stale:
+        raise ReleaseError(f"skeletons out of date (run make skeletons): {', '.join(stale)}")
+
+
+def make_release(lab: str, out: pathlib.Path, secret: str | None = None) -> pathlib.Path:
+    """Write lab `lab`'s release to `out` (which must not exist or be empty); ReleaseError
+    says why not. `secret`: the hidden scene's secret, which no file may contain."""
+    folders = leaks.lab_folders(ROOT)
+    lab = parse_lab(lab, folders)
+    out = out.absolute()
+    check_out(out)
+    missing = [n for n, name in folders.items() if not (ROOT / "labs" / name / "solution").is_dir()]
+    if missing:
+        raise ReleaseError(f"no solution of lab {missing[0]} here: a release is made from the "
+                           f"course repository, not from a release")
+    check_skeletons()
+    out.parent.mkdir(parents=True, exist_ok=True)
+    # The folder's name is chosen before it is made, so that the cleanup knows it whenever an
+    # interrupt comes (a signal can arrive between any two steps, even while the handler's
+    # thread blocks it: numpy's threads take it).
+    stage = out.parent / f".{out.name}.partial-{secrets.token_hex(6)}"
+    try:
+        try:
+            stage.mkdir(mode=0o700)  # private until complete
+        except FileExistsError:  # a clash of random names: someone else's, never removed
+            stage = None
+            raise ReleaseError("a folder of the same random name appeared; try again")
+        files = repository_files()
+        copy_sources(stage, lab, folders, files)
+        prebuilt = add_references(stage, lab, files)
+        (stage / "GNUmakefile").write_text(reference_bins.front_door(lab, prebuilt))
+        (stage / "RELEASE.md").write_text(release_notes(lab, folders, prebuilt))
+        problems = leaks.leaks(stage, lab, folders, secret)
+        if problems:
+            more = f" (and {len(problems) - 1} more)" if len(problems) > 1 else ""
+            raise ReleaseError(f"refusing to release lab {lab}: {problems[0]}{more}")
+        umask = os.umask(0)
+        os.umask(umask)
+        stage.chmod(0o777 & ~umask)
+        check_out(out)  # again: something may have written there meanwhile
+        os.rename(stage, out)  # replaces an empty folder, atomically
+    except BaseException as e:
+        if isinstance(e, KeyboardInterrupt) and stage is not None and not stage.exists() \
+                and out.is_dir():
+            return out  # it came just after the rename: the release is complete
+        if stage is not None:
+            shutil.rmtree(stage, ignore_errors=True)
+        raise
+    return out
+
+
+def main(argv=None) -> int:
+    args = sys.argv[1:] if argv is None else argv
+    if len(args) != 2 or not args[1]:
+        print("error: release: usage: python3 -m grading.release NN OUT_DIR "
+              "(make release LAB=NN OUT=DIR)", file=sys.stderr)
+        return 2
+
+    def interrupted(signum, _frame):
+        raise KeyboardInterrupt(signal.Signals(signum).name)
+    signal.signal(signal.SIGTERM, interrupted)
+    try:
+        # The instructor's fixed secret (grading/hidden.py); without one, each grade draws
+        # its own and there is none to leak.
+        out = make_release(args[0], pathlib.Path(args[1]), os.environ.get("GRADING_SECRET"))
+    except (ReleaseError, reference_bins.BuildError) as e:
+        print(f"error: release: {e}", file=sys.stderr)
+        return 2
+    except (OSError, subprocess.CalledProcessError) as e:  # an unwritable OUT, no git, no make
+        print(f"error: release: {e}", file=sys.stderr)
+        return 2
+    except KeyboardInterrupt:
+        print("error: release: interrupted; nothing written", file=sys.stderr)
+        return 130
+    print(f"wrote {out}: the lab {args[0]} release")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

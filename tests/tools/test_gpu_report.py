@@ -1,0 +1,59 @@
+"""tools/gpu_report.py's summary, on the CPU: the tables it makes of a recorded gpu-check.json
+(the H200 call of reference/gpu/h200-2026-12-02-labs05-07), and its one-line error."""
+import copy
+import json
+import pathlib
+import subprocess
+import sys
+
+ROOT = pathlib.Path(__file__).resolve().parents[2]
+sys.path.insert(0, str(ROOT / "tools"))
+import gpu_report  # noqa: E402
+
+RECORDED = ROOT / "reference" / "gpu" / "h200-2026-12-02-labs05-07"
+
+
+def recorded() -> dict:
+    return json.loads((RECORDED / "gpu-check.json").read_text())
+
+
+def test_summary_of_a_recorded_call_is_the_recorded_summary():
+    assert gpu_report.summary(recorded()) == (RECORDED / "summary.md").read_text()
+
+
+def test_summary_counts_tests_and_names_each_failure():
+    result = recorded()
+    text = gpu_report.summary(result)
+    assert "Tests: 77 passed, 1 failed, 0 errors, 0 skipped" in text
+    assert "- test_h200_bar: failure" in text
+    result = copy.deepcopy(result)
+    result["tests"][0]["result"] = "failure: planted"
+    text = gpu_report.summary(result)
+    assert "Tests: 76 passed, 2 failed" in text
+    assert f"- {result['tests'][0]['test']}: failure: planted" in text
+
+
+def test_summary_lists_every_benchmark_shape_with_its_time():
+    result = recorded()
+    text = gpu_report.summary(result)
+    for v in result["bench"]["variants"]:
+        assert f"| {v['name']} | {v['change']} |" in text
+        assert f"| {v['best_ms']:.2f} |" in text
+
+
+def test_missing_steps_are_said_not_crashed_on():
+    result = recorded()
+    result["bench"] = {"error": "bench.json: no such file"}
+    result["ncu"] = [{"run": "cornell", "error": "no CSV"}]
+    text = gpu_report.summary(result)
+    assert "| shape | change |" not in text
+    assert "| cornell | error: no CSV |" in text
+
+
+def test_unreadable_json_is_one_line_and_status_2(tmp_path):
+    bad = tmp_path / "gpu-check.json"
+    bad.write_text("{not json")
+    p = subprocess.run([sys.executable, str(ROOT / "tools" / "gpu_report.py"), "--summary", str(bad)],
+                       capture_output=True, text=True)
+    assert p.returncode == 2
+    assert len(p.stderr.strip().splitlines()) == 1 and "cannot read" in p.stderr

@@ -1,0 +1,167 @@
+"""What `make tradeoff` measures: one Series per renderer, each built here or marked
+unavailable with the reason (which the report prints).
+
+- the CPU references this host can build and run (lab01-ref ... lab04-simd-ref);
+- the GPU reference (lab05-ref) where nvidia-smi lists a GPU and it builds;
+- variants of the lab-01 reference built by `make variant` (grading/variants.py): fast math,
+  and a fixed world-space epsilon instead of the scale-aware ray offset of common/core/ray.h.
+  A variant is one entry of VARIANTS: a name, what it changes, the files it stands in for
+  and the make arguments. "double" is listed and not built: the renderer has no precision
+  switch yet. When it has, its entry gets a `build` like the others and a row appears.
+"""
+from __future__ import annotations
+
+import dataclasses
+import os
+import pathlib
+import re
+import shutil
+import subprocess
+import sys
+from typing import Callable
+
+ROOT = pathlib.Path(__file__).resolve().parent.parent
+sys.path.insert(0, str(ROOT))
+from grading.checks import mpirun  # noqa: E402
+from grading.variants import build_sources, lab_sources  # noqa: E402
+
+VARIANT_DIR = ROOT / "build" / "tradeoff" / "variants"
+# Open MPI refuses to start as root unless told (containers, CI); as tools/bench_cpu.py does.
+os.environ.setdefault("OMPI_ALLOW_RUN_AS_ROOT", "1")
+os.environ.setdefault("OMPI_ALLOW_RUN_AS_ROOT_CONFIRM", "1")
+
+
+@dataclasses.dataclass
+class Series:
+    name: str                          # the row's label, e.g. "lab03-ref"
+    what: str                          # one phrase for the report
+    binary: pathlib.Path | None = None
+    launcher: tuple = ()
+    checked: bool = True               # must show slope -1/2 (references); variants are shown
+    unavailable: str | None = None     # why there is no row, e.g. "double: not built yet"
+
+
+# name, what it is, launcher. Each is `make NAME`; lab 04's run under mpirun with 2 ranks.
+CPU_REFERENCES = [
+    ("lab01-ref", "serial", ()),
+    ("lab02a-ref", "serial, SSE Vec3 (lab 02 Part A)", ()),
+    ("lab02-ref", "AVX2, 8 paths per packet, 1 thread", ()),
+    ("lab03-ref", "OpenMP, every core", ()),
+    ("lab03-simd-ref", "OpenMP + AVX2 packets, every core", ()),
+    ("lab04-ref", "MPI, 2 ranks (mpirun)", tuple(mpirun(2))),
+    ("lab04-simd-ref", "MPI + AVX2 packets, 2 ranks (mpirun)", tuple(mpirun(2))),
+]
+
+
+def first_words(text: str) -> str:
+    """The first line of a program's message that says something (Open MPI opens with a row
+    of dashes)."""
+    return next((line.strip() for line in text.splitlines() if any(c.isalpha() for c in line)),
+                "no message")
+
+
+def make(target: str) -> str | None:
+    """Builds `target`; returns None, or the last line of what make said when it failed."""
+    p = subprocess.run(["make", "-s", "-C", str(ROOT), target], capture_output=True, text=True)
+    if p.returncode == 0:
+        return None
+    lines = (p.stderr or p.stdout).strip().splitlines()
+    return f"does not build here: {lines[-1] if lines else 'make failed'}"
+
+
+def cpu_references(names=None) -> list[Series]:
+    out = []
+    for name, what, launcher in CPU_REFERENCES:
+        if names is not None and name not in names:
+            continue
+        s = Series(name, what, launcher=launcher)
+        if launcher and shutil.which(launcher[0]) is None:
+            s.unavailable = f"no {launcher[0]} on this machine"
+        else:
+            s.unavailable = make(name)
+        if s.unavailable is None:
+            s.binary = ROOT / name
+        out.append(s)
+    return out
+
+
+def gpu_missing() -> str | None:
+    """Why nothing runs on a GPU here, or None (asks nvidia-smi, like tests/labs/cuda_env.py)."""
+    if shutil.which("nvidia-smi") is None:
+        return "no NVIDIA GPU here (nvidia-smi not found)"
+    p = subprocess.run(["nvidia-smi", "--query-gpu=name", "--format=csv,noheader"],
+                       capture_output=True, text=True)
+    if p.returncode != 0 or not p.stdout.strip():
+        return "no NVIDIA GPU here (nvidia-smi lists none)"
+    return None
+
+
+def gpu_references() -> list[Series]:
+    s = Series("lab05-ref", "CUDA megakernel (GPU)")
+    s.unavailable = gpu_missing() or make("lab05-ref")
+    if s.unavailable is None:
+        s.binary = ROOT / "lab05-ref"
+    return [s]
+
+
+# ---- variants of the lab-01 reference -------------------------------------------------------
+
+FIXED_EPSILON = 1e-4  # world units: a typical hand-picked value, right for a unit-sized scene
+_OFFSET_RETURN = re.compile(r"return p \+ n \* \(scale \* kRelativeOffset\);")
+
+
+def fixed_epsilon_ray_h() -> str:
+    """common/core/ray.h with offset_ray_origin moving the origin a fixed FIXED_EPSILON along
+    the normal, whatever the scale. Made from the current ray.h (not a copy kept in the
+    tree), so the variant changes that one line and follows every other edit of ray.h."""
+    text = (ROOT / "common" / "core" / "ray.h").read_text()
+    new, count = _OFFSET_RETURN.subn(
+        f"(void)scale; return p + n * {FIXED_EPSILON!r}f;  // tradeoff variant: fixed epsilon",
+        text)
+    if count != 1:
+        raise RuntimeError("common/core/ray.h: offset_ray_origin's return line changed; "
+                           "update tools/tradeoff_series.py's fixed-epsilon variant")
+    return new
+
+
+@dataclasses.dataclass
+class Variant:
+    name: str
+    what: str
+    # Files standing in for the lab's (by bare name: ray.h, render.cpp...), and make variables.
+    files: Callable[[], dict[str, str]] | None = None
+    make_args: tuple = ()
+    not_built: str | None = None  # why it has no build yet
+
+
+VARIANTS = [
+    Variant("lab01 fast-math", "lab01-ref's renderer compiled with -ffast-math",
+            files=dict, make_args=("VARIANT_FLAGS_01-serial=-ffast-math",)),
+    Variant("lab01 fixed-epsilon",
+            f"lab01-ref with a fixed ray offset of {FIXED_EPSILON:g} along the normal "
+            "(common/core/ray.h: scale-aware)",
+            files=lambda: {"ray.h": fixed_epsilon_ray_h()}),
+    Variant("lab01 double", "lab01-ref in double precision",
+            not_built="not built yet (the renderer has no precision switch yet)"),
+]
+
+
+def build_variant(v: Variant, log=print) -> Series:
+    s = Series(v.name, v.what, checked=False)
+    if v.not_built:
+        s.unavailable = v.not_built
+        return s
+    workdir = VARIANT_DIR / v.name.replace(" ", "-")
+    if workdir.exists():
+        shutil.rmtree(workdir)  # a stale file of an earlier variant must not stand in
+    log(f"  building variant '{v.name}' (make variant) ...")
+    try:
+        s.binary = build_sources("01-serial", workdir, {**lab_sources("01-serial"), **v.files()},
+                                 make_args=v.make_args)
+    except RuntimeError as e:
+        s.unavailable = f"does not build: {str(e).strip().splitlines()[-1]}"
+    return s
+
+
+def variants(log=print) -> list[Series]:
+    return [build_variant(v, log) for v in VARIANTS]
