@@ -6,9 +6,10 @@
 #include <ray.h>
 
 // Four 16-byte rows (32-byte rows in the double build), 16-byte aligned: what the cheap cull
-// reads (normal and plane offset) is the first row, each vertex starts a row. A GPU then loads a row with one vector load (one
-// LDS.128 from shared memory instead of four scalar loads: the megakernel is bound by
-// instruction issue), and a CPU finds the whole triangle in one 64-byte cache line.
+// reads (normal and plane offset) is the first row, each vertex starts a row. A GPU then
+// loads a row with one vector load (one LDS.128 from shared memory instead of four scalar
+// loads: the megakernel is bound by instruction issue), and a CPU finds the whole triangle
+// in one 64-byte cache line.
 struct alignas(16) Triangle {
     Vec3 normal;         // unit geometric normal, or zero for a degenerate triangle
     real plane_offset;   // dot(normal, v0): the plane is dot(normal, p) == plane_offset
