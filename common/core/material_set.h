@@ -5,7 +5,7 @@
 // and refraction push the megakernel past its register budget into spills). A renderer
 // instantiated for the scene's own set carries only what the scene uses.
 //
-// Each set is a type, so the choice is made once per render by dispatch (materials_used) and
+// Each set is a type, so the choice is made once per render by dispatch (has_specular_material) and
 // the compiler removes the unused branches (`if constexpr` in bounce_step).
 #pragma once
 
