@@ -105,7 +105,8 @@ include grading/grading.mk
 # Lab 01's reference in double, with the same scene files and command line (--json says
 # "precision": "double").
 $(DOUBLE_BUILD)/labs/01-serial/solution/%.o: LAB_INCLUDES = -Ilabs/01-serial/solution
-lab01-ref-double: $(DOUBLE_BUILD)/labs/01-serial/solution/render.o $(DOUBLE_COMMON_OBJ)
+lab01-ref-double: $(patsubst %.cpp,$(DOUBLE_BUILD)/%.o,$(wildcard labs/01-serial/solution/*.cpp)) \
+                  $(DOUBLE_COMMON_OBJ)
 	$(CXX) $(CXXFLAGS) $^ -o $@
 .PHONY: lab01-ref-double
 LAB_BINARIES += lab01-ref-double
