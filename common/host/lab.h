@@ -27,6 +27,12 @@ struct RenderStats {
 
 // Implemented once per lab (skeleton and solution alike).
 extern const char* const kLabName;  // e.g. "01-serial"
+#if defined(RT_DOUBLE)
+// A lab compiled in double (real.h) linked with the float driver, or the reverse, would mix
+// two layouts of Vec3 without a word. In the double build render() has another symbol name,
+// so such a link fails instead (undefined reference to render_double or render).
+#define render render_double
+#endif
 RenderStats render(const RenderJob& job, Image& image);
 
 // How a lab that runs as several processes (lab 04's MPI ranks) uses the shared main. The

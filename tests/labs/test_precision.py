@@ -10,7 +10,7 @@ import subprocess
 import pytest
 
 from grading import checks, scenes
-from grading.harness import build, run_lab
+from grading.harness import ROOT, build, run_lab
 
 
 @pytest.fixture(scope="module")
@@ -92,3 +92,16 @@ def test_lab05_double_builds(nvcc):
     runs that file)."""
     binary = build("lab05-ref-double")[0]
     assert os.access(binary, os.X_OK)
+
+
+def test_mixing_double_and_float_objects_fails_to_link(tmp_path):
+    """Lab 01's solution compiled in double and linked with the float driver (`make variant`
+    with -DRT_DOUBLE) would read pixels of another layout: the link must fail instead."""
+    (tmp_path / "render.cpp").write_text(
+        (ROOT / "labs" / "01-serial" / "solution" / "render.cpp").read_text())
+    p = subprocess.run(["make", "-s", "-C", str(ROOT), "variant", "VARIANT_LAB=01-serial",
+                        f"VARIANT={tmp_path}", "VARIANT_FLAGS_01-serial=-DRT_DOUBLE"],
+                       capture_output=True, text=True, timeout=300)
+    assert p.returncode != 0 and "undefined reference to `render(" in p.stderr, \
+        p.stdout + p.stderr
+    assert not (tmp_path / "lab").exists()
