@@ -44,6 +44,21 @@ struct WavefrontConfig {
 // and its threads stride over their queue.
 constexpr int kStageThreads = 128;
 
+// The most threads one multiprocessor holds, for the architecture being compiled (CUDA's
+// occupancy tables): 1024 on Turing, 1536 on consumer Ampere and Ada, 2048 on A100 and Hopper.
+// A __launch_bounds__ that asks for more blocks than fit is an error for ptxas, so a Config's
+// kMinBlocksPerSM (a measurement made on an H200) is capped at what each target holds.
+#if defined(__CUDA_ARCH__) && __CUDA_ARCH__ == 750
+constexpr int kMaxThreadsPerSM = 1024;
+#elif defined(__CUDA_ARCH__) && (__CUDA_ARCH__ == 860 || __CUDA_ARCH__ == 870 || __CUDA_ARCH__ == 890)
+constexpr int kMaxThreadsPerSM = 1536;
+#else
+constexpr int kMaxThreadsPerSM = 2048;
+#endif
+constexpr int min_blocks_per_sm(int wanted) {
+    return wanted * kStageThreads <= kMaxThreadsPerSM ? wanted : kMaxThreadsPerSM / kStageThreads;
+}
+
 template <class C>
 __device__ inline void enqueue(const PathQueue& queue, int id) {
     if constexpr (C::kAggregatedPush) {
@@ -56,7 +71,7 @@ __device__ inline void enqueue(const PathQueue& queue, int id) {
 // GEN: the camera ray of every slot of the wave, as render_pixel makes it (the same jitter
 // numbers), and every path onto the first active queue.
 template <class C>
-__global__ void __launch_bounds__(kStageThreads, C::kMinBlocksPerSM)
+__global__ void __launch_bounds__(kStageThreads, min_blocks_per_sm(C::kMinBlocksPerSM))
     generate_camera_paths(const WavefrontArgs args, const Wave wave, const typename C::Pool pool,
                           const PathQueue active) {
     const int threads = static_cast<int>(gridDim.x * blockDim.x);
@@ -66,7 +81,8 @@ __global__ void __launch_bounds__(kStageThreads, C::kMinBlocksPerSM)
         const uint64_t pixel = wave.pixel_of(slot);
         const int x = static_cast<int>(pixel % args.settings.width);
         const int y = static_cast<int>(pixel / args.settings.width);
-        const Ray ray = args.camera.ray_through(x + rng.at(kDimPixelX), y + rng.at(kDimPixelY));
+        const Ray ray = args.camera.ray_through(x + real(rng.at(kDimPixelX)),
+                                                y + real(rng.at(kDimPixelY)));
         const PathState path = start_path(ray, args.settings.bounces);
         pool.start_path(slot, path);
         if (path.alive) enqueue<C>(active, slot);
@@ -75,7 +91,7 @@ __global__ void __launch_bounds__(kStageThreads, C::kMinBlocksPerSM)
 
 // CHIT: the nearest surface on each active path's ray.
 template <class C>
-__global__ void __launch_bounds__(kStageThreads, C::kMinBlocksPerSM)
+__global__ void __launch_bounds__(kStageThreads, min_blocks_per_sm(C::kMinBlocksPerSM))
     find_closest_hits(const WavefrontArgs args, const typename C::Pool pool, const PathQueue active) {
     extern __shared__ float4 shared_scene[];  // used when the scene is in shared memory
     const SceneView scene = scene_in<C::kSceneMemory>(args.layout, args.scene_pool, shared_scene);
@@ -90,7 +106,7 @@ __global__ void __launch_bounds__(kStageThreads, C::kMinBlocksPerSM)
 // background, for a path that escapes) joins the slot's radiance afterwards: the same single
 // addition the core's loop makes, and no radiance read or written for the other paths.
 template <class C>
-__global__ void __launch_bounds__(kStageThreads, C::kMinBlocksPerSM)
+__global__ void __launch_bounds__(kStageThreads, min_blocks_per_sm(C::kMinBlocksPerSM))
     shade_hits(const WavefrontArgs args, const Wave wave, const typename C::Pool pool, int bounce,
                const PathQueue active, const PathQueue next, const PathQueue shadows) {
     extern __shared__ float4 shared_scene[];
@@ -118,7 +134,7 @@ __global__ void __launch_bounds__(kStageThreads, C::kMinBlocksPerSM)
 // Only this kernel writes a queued path's radiance between two shade_hits launches, so the
 // addition needs no atomic.
 template <class C>
-__global__ void __launch_bounds__(kStageThreads, C::kMinBlocksPerSM)
+__global__ void __launch_bounds__(kStageThreads, min_blocks_per_sm(C::kMinBlocksPerSM))
     trace_shadow_rays(const WavefrontArgs args, const typename C::Pool pool, const PathQueue shadows) {
     extern __shared__ float4 shared_scene[];
     const SceneView scene = scene_in<C::kSceneMemory>(args.layout, args.scene_pool, shared_scene);
@@ -133,7 +149,7 @@ __global__ void __launch_bounds__(kStageThreads, C::kMinBlocksPerSM)
 // render_pixel's, bit for bit in the double sums; `means`, when given (the band's last wave),
 // receives sum.mean(spp). One thread per pixel: no atomics, no order to depend on.
 template <class C>
-__global__ void __launch_bounds__(kStageThreads, C::kMinBlocksPerSM)
+__global__ void __launch_bounds__(kStageThreads, min_blocks_per_sm(C::kMinBlocksPerSM))
     accumulate_samples(const Wave wave, const typename C::Pool pool, SampleSum* sums, Vec3* means,
                        int spp) {
     const int threads = static_cast<int>(gridDim.x * blockDim.x);
