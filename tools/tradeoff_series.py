@@ -5,9 +5,10 @@ unavailable with the reason (which the report prints).
 - the GPU reference (lab05-ref) where nvidia-smi lists a GPU and it builds;
 - variants of the lab-01 reference built by `make variant` (grading/variants.py): fast math,
   and a fixed world-space epsilon instead of the scale-aware ray offset of common/core/ray.h.
-  A variant is one entry of VARIANTS: a name, what it changes, the files it stands in for
-  and the make arguments. "double" is listed and not built: the renderer has no precision
-  switch yet. When it has, its entry gets a `build` like the others and a row appears.
+  A variant is one entry of VARIANTS: a name, what it changes, and either the files it
+  stands in for and the make arguments, or a make target of its own (the double build,
+  `make lab01-ref-double`: a `make variant` cannot mix double objects with the float driver,
+  on purpose).
 """
 from __future__ import annotations
 
@@ -131,6 +132,7 @@ class Variant:
     # Files standing in for the lab's (by bare name: ray.h, render.cpp...), and make variables.
     files: Callable[[], dict[str, str]] | None = None
     make_args: tuple = ()
+    target: str | None = None     # a make target that builds it (its binary has that name)
     not_built: str | None = None  # why it has no build yet
 
 
@@ -141,8 +143,8 @@ VARIANTS = [
             f"lab01-ref with a fixed ray offset of {FIXED_EPSILON:g} along the normal "
             "(common/core/ray.h: scale-aware)",
             files=lambda: {"ray.h": fixed_epsilon_ray_h()}),
-    Variant("lab01 double", "lab01-ref in double precision",
-            not_built="not built yet (the renderer has no precision switch yet)"),
+    Variant("lab01 double", "lab01-ref in double precision (-DRT_DOUBLE, common/core/real.h)",
+            target="lab01-ref-double"),
 ]
 
 
@@ -150,6 +152,14 @@ def build_variant(v: Variant, log=print) -> Series:
     s = Series(v.name, v.what, checked=False)
     if v.not_built:
         s.unavailable = v.not_built
+        return s
+    if v.target:
+        log(f"  building variant '{v.name}' (make {v.target}) ...")
+        p = subprocess.run(["make", "-s", "-C", str(ROOT), v.target], capture_output=True, text=True)
+        if p.returncode != 0:
+            s.unavailable = f"does not build: {first_words(p.stderr or p.stdout)}"
+        else:
+            s.binary = ROOT / v.target
         return s
     workdir = VARIANT_DIR / v.name.replace(" ", "-")
     if workdir.exists():
