@@ -281,8 +281,9 @@ RT_HD inline Vec3 direct_light(const SceneView& scene, const Geometry& geometry,
 }
 
 // The estimate of one pixel: the mean of spp paths through uniformly jittered points of the
-// pixel (a box filter). Pixel index and sample number key the random numbers.
-template <class Geometry>
+// pixel (a box filter). Pixel index and sample number key the random numbers. Materials: the
+// material kinds compiled in (material_set.h), passed on to trace_path.
+template <class Materials = AnyMaterial, class Geometry>
 RT_HD inline Vec3 render_pixel(const SceneView& scene, const Geometry& geometry,
                                const Camera& camera, const RenderSettings& settings, int x, int y) {
     const uint64_t pixel = static_cast<uint64_t>(y) * settings.width + x;
@@ -293,7 +294,7 @@ RT_HD inline Vec3 render_pixel(const SceneView& scene, const Geometry& geometry,
         // real(...): the double build places the jitter in double (the random number is float).
         const Ray ray =
             camera.ray_through(x + real(rng.at(kDimPixelX)), y + real(rng.at(kDimPixelY)));
-        sum.add(trace_path(scene, geometry, ray, rng, settings.bounces));
+        sum.add(trace_path<Materials>(scene, geometry, ray, rng, settings.bounces));
     }
     return sum.mean(settings.spp);
     // SKELETON
@@ -301,7 +302,8 @@ RT_HD inline Vec3 render_pixel(const SceneView& scene, const Geometry& geometry,
     //> // (SampleStream(settings.seed, pixel, s), dimensions kDimPixelX/kDimPixelY).
     //> // Until then: one path through the pixel's corner.
     //> const SampleStream rng(settings.seed, pixel, 0);
-    //> sum.add(trace_path(scene, geometry, camera.ray_through(x, y), rng, settings.bounces));
+    //> sum.add(trace_path<Materials>(scene, geometry, camera.ray_through(x, y), rng,
+    //>                               settings.bounces));
     //> return sum.mean(1);
     // END SOLUTION
 }
@@ -317,7 +319,8 @@ RT_HD inline Vec3 trace_path(const SceneView& scene, Ray ray, const Rng& rng, in
     return trace_path<Materials>(scene, scene, ray, rng, max_bounces);
 }
 
+template <class Materials = AnyMaterial>
 RT_HD inline Vec3 render_pixel(const SceneView& scene, const Camera& camera,
                                const RenderSettings& settings, int x, int y) {
-    return render_pixel(scene, scene, camera, settings, x, y);
+    return render_pixel<Materials>(scene, scene, camera, settings, x, y);
 }
