@@ -28,7 +28,7 @@ import time
 
 import numpy as np
 
-from grading import scenes
+from grading import scenes, symptoms
 from grading.compare import compare
 from grading.harness import ImageError, golden, run_lab
 
@@ -77,7 +77,8 @@ def check_golden(binary, scene: str, *, seed: int = 7, spp: int = GOLDEN_TEST_SP
     heatmap = heatmap_dir / f"{scene}-diff.png" if heatmap_dir else None
     report = compare(run.image, spp, g.mean, g.variance, g.meta["golden_spp"],
                      heatmap_path=heatmap)
-    return CheckResult(f"golden image '{scene}'", report.passed, report.summary())
+    hint = "" if report.passed else symptoms.named(run.image, g.mean)
+    return CheckResult(f"golden image '{scene}'", report.passed, report.summary() + hint)
 
 
 # The sphere interior both checks below render: albedo, radius, light intensity.
@@ -155,12 +156,10 @@ def check_lit_plane(binary) -> CheckResult:
     ok, err = right(image.mean(axis=2))
     symptom = ""
     if not ok:
-        # The light stands off the axes, so the image is not symmetric: if it is right with
-        # x and y swapped, the pixels went to the wrong places, not the light to the wrong
-        # values.
-        symptom = black_pixels(image) or (
-            "; the image is right with x and y swapped: check the pixel index arithmetic"
-            if right(image.mean(axis=2).T)[0] else "")
+        # The light stands off the axes, so the image has no symmetry: a flipped or transposed
+        # image that matches once turned back means the pixels went to the wrong places, not
+        # the light to the wrong values (grading/symptoms.py).
+        symptom = black_pixels(image) or symptoms.named(image, want)
     return CheckResult("analytic lit plane", ok,
                        f"relative error mean {err.mean():.2e}, max {err.max():.2e}"
                        f" (allowed 3e-3, 2e-2)" + symptom)

@@ -21,7 +21,7 @@ import tempfile
 
 import numpy as np
 
-from grading import scenes
+from grading import scenes, symptoms
 from grading.compare import compare
 from grading.harness import RunPolicy, available_cores, policy, run_lab
 
@@ -90,7 +90,8 @@ def check_hidden(binary, reference, secret: str, *, launcher=(), threads=None,
                             seed=7, launcher=launcher, threads=threads).image
         heatmap = heatmap_dir / "hidden-diff.png" if heatmap_dir else None
         report = compare(image, TEST_SPP, g.mean, g.variance, g.golden_spp, heatmap_path=heatmap)
-        return CheckResult("hidden scene", report.passed, report.summary())
+        hint = "" if report.passed else symptoms.named(image, g.mean)
+        return CheckResult("hidden scene", report.passed, report.summary() + hint)
     return run()
 
 

@@ -7,6 +7,7 @@ from __future__ import annotations
 
 import pathlib
 import subprocess
+import sys
 
 from grading.harness import ROOT
 
@@ -142,3 +143,31 @@ def golden_copier(folder) -> pathlib.Path:
         cases.append(f'  *{scene}.json) base64 -d > "$pfm" <<END\n{data}\nEND\n  ;;')
     return script(folder, FIND_ARGS + 'case "$scene" in\n' + "\n".join(cases) +
                   '\n  *) exit 1;;\nesac\necho \'{"lab": "copy", "seconds": 0.001}\'\n')
+
+
+# The lab-01 reference with its image changed after the fact (`change`: a Python expression of
+# `image`, the H x W x 3 array it wrote), as a mistake would have changed it: the symptoms'
+# tests. It runs the repository's Python and reference, so it is graded trusted (outside the
+# sandbox, which shows a submission none of that).
+ALTERED = """#!{python}
+import subprocess, sys
+import numpy as np
+sys.path.insert(0, {root!r})
+from grading.pfm import read_pfm, write_pfm
+args = sys.argv[1:]
+p = subprocess.run([{reference!r}, *args])
+if p.returncode:
+    sys.exit(p.returncode)
+pfm = args[args.index("--pfm") + 1]
+image = read_pfm(pfm)
+write_pfm(pfm, {change})
+"""
+
+
+def altered_reference(folder: pathlib.Path, change: str,
+                      reference: pathlib.Path = REFERENCE) -> pathlib.Path:
+    path = folder / "lab"
+    path.write_text(ALTERED.format(python=sys.executable, root=str(ROOT),
+                                   reference=str(reference), change=change))
+    path.chmod(0o755)
+    return path

@@ -29,6 +29,7 @@ from grading import checks, gpu, sandbox
 from grading.grade import (GOLDENS, GPU_TIMED_SCALE, RUBRICS, describe, grade, grading_order,
                            passed_by_check)
 from grading.harness import ROOT, build
+from tests.grading import submissions
 from tests.grading.gpu_mutants import LAB, MUTANTS, build_cuda_folder, mutant_sources
 from tests.labs.cuda_env import missing_gpu, missing_nvcc
 
@@ -308,26 +309,8 @@ def test_a_sandboxed_run_sees_the_gpu_binds(open_folder, monkeypatch):
 # The GPU mutants' symptoms, shown by lab 01's reference with its image altered after the
 # fact: all black (read back before written), or transposed (x and y swapped).
 
-ALTERED = """#!{python}
-import subprocess, sys
-sys.path.insert(0, {root!r})
-from grading.pfm import read_pfm, write_pfm
-args = sys.argv[1:]
-p = subprocess.run([{reference!r}, *args])
-if p.returncode:
-    sys.exit(p.returncode)
-pfm = args[args.index("--pfm") + 1]
-image = read_pfm(pfm)
-write_pfm(pfm, {change})
-"""
-
-
 def altered_reference(folder: pathlib.Path, change: str) -> pathlib.Path:
-    path = folder / "lab"
-    path.write_text(ALTERED.format(python=sys.executable, root=str(ROOT),
-                                   reference=str(build("lab01-ref")[0]), change=change))
-    path.chmod(0o755)
-    return path
+    return submissions.altered_reference(folder, change, build("lab01-ref")[0])
 
 
 def test_black_pixels_are_named(tmp_path):
