@@ -34,7 +34,8 @@ import sys
 ROOT = pathlib.Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(ROOT))
 from grading.checks import mpirun  # noqa: E402
-from grading.harness import RunError, ImageError, available_cores, cpu_has_avx2, run_lab  # noqa: E402
+from grading.harness import (RunError, ImageError, available_cores, cpu_has_avx2,  # noqa: E402
+                             measure_parallel, run_lab)
 
 import bench_report_data as report  # noqa: E402
 import tradeoff_report  # noqa: E402  (Machine: CPU model, cores, date, load)
@@ -202,13 +203,29 @@ def render(impl: Impl, path: pathlib.Path, setting) -> dict:
     return r.json
 
 
-def measure(plan: Plan, impls: list[Impl], bin_dir: pathlib.Path, log) -> list[dict]:
-    """Rows {binary, label, side, spp, bounces, seconds (best), runs, device}: rounds
-    outermost, then settings, then implementations (interleaved, see the module's doc)."""
+def capacity(serial: Impl, bin_dir: pathlib.Path, setting) -> float:
+    """Cores' worth of throughput this run gets now: one lab01-ref render against one per
+    core at once (grading.harness.measure_parallel, as the grader measures it). On a shared
+    machine it is what bounds every parallel lab's speedup in the same round."""
+    one = lambda: render(serial, bin_dir / serial.binary, setting)["seconds"]  # noqa: E731
+    return measure_parallel(one, {}, rounds=1).capacity
+
+
+def measure(plan: Plan, impls: list[Impl], bin_dir: pathlib.Path, log) -> tuple[list, list]:
+    """(rows {binary, label, side, spp, bounces, seconds (best), runs, device}, capacity per
+    round): rounds outermost, then settings, then implementations (interleaved, see the
+    module's doc)."""
     settings = plan.settings()
     runs: dict[tuple, list[float]] = {}
     device: dict[tuple, str] = {}
+    caps = []
+    serial = next((i for i in impls if i.binary == SERIAL), None)
+    smallest = min(settings, key=lambda s: s[0] * s[0] * s[1] * s[2])
     for rnd in range(plan.repeat):
+        if serial is not None and available_cores() > 1:
+            caps.append(capacity(serial, bin_dir, smallest))
+            log(f"  round {rnd + 1}/{plan.repeat}: capacity {caps[-1]:.2f} of "
+                f"{available_cores()} cores")
         for setting in settings:
             line = []
             for impl in impls:
@@ -226,7 +243,7 @@ def measure(plan: Plan, impls: list[Impl], bin_dir: pathlib.Path, log) -> list[d
             rows.append({"binary": impl.binary, "label": impl.label, "gpu": impl.gpu,
                          "side": setting[0], "spp": setting[1], "bounces": setting[2],
                          "seconds": min(t), "runs": t, "device": device[(impl.binary, setting)]})
-    return rows
+    return rows, caps
 
 
 def machine_dict() -> dict:
@@ -340,8 +357,9 @@ def main(argv=None) -> int:
         if a.gpu_only and not impls:
             raise BadInput("--gpu-only: no GPU lab runs here: " + "; ".join(
                 f"{b}: {w}" for b, w in skipped.items()))
-        rows = measure(plan, impls, bin_dir or ROOT, log)
+        rows, caps = measure(plan, impls, bin_dir or ROOT, log)
         machine["load_after"] = tradeoff_report.load()
+        machine["capacity"] = caps
         data = {"format": FORMAT, "plan": dataclasses.asdict(plan), "machine": machine,
                 "note": a.note, "rows": rows, "skipped": skipped}
         if a.gpu_only:

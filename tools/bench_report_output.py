@@ -94,6 +94,11 @@ def machines(data: dict) -> list[str]:
              + (f", GPU {m['gpu']}" if m.get("gpu") else ", no GPU") + f"; {m['date']}; "
              f"load average {m.get('load_before', '?')} at the start, "
              f"{m.get('load_after', '?')} at the end."]
+    if m.get("capacity"):
+        lines.append(f"- Capacity at the start of each round (cores' worth of throughput: "
+                     f"{m['cores']} lab01-ref renders at once against one alone, as the grader "
+                     f"measures it; it bounds every parallel speedup here): "
+                     + ", ".join(f"{c:.2f}" for c in m["capacity"]) + f" of {m['cores']}.")
     for merged in data.get("merged", []):
         g = merged["machine"]
         lines.append(f"- Merged from another machine ({', '.join(merged['binaries'])}): "
