@@ -38,7 +38,7 @@ DOUBLE_LIB_OBJ    := $(LIB_OBJ:$(BUILD)/%=$(DOUBLE_BUILD)/%)
 DOUBLE_COMMON_OBJ := $(COMMON_OBJ:$(BUILD)/%=$(DOUBLE_BUILD)/%)
 
 PHONY_EXTRA := variant
-PHONY_EXTRA += render grade check-nvcc bench-micro bench-cpu count-work bench-precision
+PHONY_EXTRA += render grade check-nvcc bench-micro bench-cpu bench-serial count-work bench-precision
 .PHONY: all help deps labs $(PHONY_EXTRA) test test-unit test-labs skeletons check-skeletons golden bench tradeoff \
         clean
 .DEFAULT_GOAL := help
@@ -57,7 +57,9 @@ help:
 	@echo "make release LAB=NN OUT=DIR  the student repository for lab NN (grading/README.md)"
 	@echo "make lab05-bench  the lab-05 kernel shapes the handout measures (needs a GPU)"
 	@echo "make test         build everything and run every test"
-	@echo "make bench        time the lab-01 reference on the Cornell baseline (minutes)"
+	@echo "make bench        the report's Tables 4-7 here: every lab, baseline + 3 sweeps, with"
+	@echo "                  plots (QUICK=1: CI size; SCALE=K: sides / K; full: ~2 h on 2 cores)"
+	@echo "make bench-serial time the lab-01 reference on the Cornell baseline (minutes)"
 	@echo "make bench-cpu    the CPU labs side by side (the report's Table 4 for this machine)"
 	@echo "make bench-micro  Google Benchmark of the inner loops (closest hit, shadow ray, path)"
 	@echo "make count-work   instructions per camera path, split by query (needs valgrind)"
@@ -172,7 +174,14 @@ grade:
 golden: lab01-ref
 	$(PYTHON) tools/make_golden.py
 
+# The course report's Tables 4-7 for this machine (tools/bench_report.py): every lab this host
+# runs, baseline and three sweeps, beside the report's numbers; CSV, Markdown and PNG plots go
+# to REPORTS/bench. QUICK=1 is the CI size; SCALE=K divides every image side by K.
 bench: lab01-ref
+	$(PYTHON) tools/bench_report.py --out $(REPORTS)/bench \
+	    $(if $(filter 1 true yes,$(QUICK)),--quick) $(if $(SCALE),--scale $(SCALE))
+
+bench-serial: lab01-ref
 	$(PYTHON) tools/bench_serial.py baseline
 
 $(BUILD)/intersect_bench: $(BUILD)/bench/intersect_bench.o $(LIB_OBJ)

@@ -1,7 +1,7 @@
 #!/usr/bin/env python3
 """Benchmarks of the lab-01 reference (the baseline every speedup is measured against).
 
-    make bench       the Cornell baseline (600x600, 512 spp, 4 bounces), best of --repeat
+    make bench-serial the Cornell baseline (600x600, 512 spp, 4 bounces), best of --repeat
     make tradeoff    error against time: RMSE vs the golden image as spp grows
 
 Prints tables; asserts nothing. Report only what it printed, with the machine it names.
