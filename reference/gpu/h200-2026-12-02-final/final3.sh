@@ -2,6 +2,9 @@
 # The session's last GPU call: the course report's own CUDA code timed on the H200 (built
 # from a carried copy, not part of this repository), the double-precision megakernel's
 # tests, the grader's GPU tests after the sandboxed-build change, and bench --gpu-only rows.
+# .gpu-deps/report/ (git-ignored, carried with the tree) held the course report's public
+# code, its folders cuda_a, cuda_b, cuda_c and common, copied by hand from the report's
+# repository ("Parallel Ray Tracer"); none of it is part of this repository.
 export CPATH=$PWD/.gpu-deps/include
 if ! command -v bwrap >/dev/null; then dpkg -x .gpu-deps/bubblewrap_*.deb /tmp/bw && export PATH=/tmp/bw/usr/bin:$PATH; fi
 make -j16 lab01-ref lab05-ref lab06-ref lab07-ref ${EXTRA_TARGETS:-} > /tmp/build.log 2>&1 || { tail -20 /tmp/build.log; exit 1; }
