@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
-# The session's last GPU call: the course report's own CUDA code timed on the H200 (built
-# from a carried copy, not part of this repository), the double-precision megakernel's
-# tests, the grader's GPU tests after the sandboxed-build change, and bench --gpu-only rows.
+# The session's third GPU call: the course report's own CUDA code timed on the H200 (built
+# from a carried copy, not part of this repository) and the grader's GPU tests after the
+# sandboxed-build change (EXTRA_TARGETS and EXTRA_TESTS were left empty).
 # .gpu-deps/report/ (git-ignored, carried with the tree) held the course report's public
 # code, its folders cuda_a, cuda_b, cuda_c and common, copied by hand from the report's
 # repository ("Parallel Ray Tracer"); none of it is part of this repository.
