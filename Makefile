@@ -24,7 +24,7 @@ SIMD_INCLUDES := -Icommon/simd $(INCLUDES)
 # The library part of common/host (what unit tests link) and the driver every lab binary adds.
 LIB_SRC    := common/host/scene_loader.cpp common/host/json_with_positions.cpp common/host/image.cpp common/host/cli.cpp \
               common/host/progress.cpp common/host/interrupt_cleanup.cpp \
-              common/host/scene_centring.cpp
+              common/host/scene_centring.cpp common/host/scene_report.cpp
 LIB_OBJ    := $(LIB_SRC:%.cpp=$(BUILD)/%.o)
 DRIVER_OBJ := $(BUILD)/common/host/lab_main.o $(BUILD)/common/host/main.o
 COMMON_OBJ := $(LIB_OBJ) $(DRIVER_OBJ)

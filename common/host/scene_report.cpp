@@ -1,0 +1,88 @@
+#include <scene_report.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+
+namespace {
+
+std::string number(double x) {
+    char text[32];
+    std::snprintf(text, sizeof text, "%.3g", x);
+    return text;
+}
+
+std::string plural(int n, const char* one, const char* many) {
+    return std::to_string(n) + " " + (n == 1 ? one : many);
+}
+
+double longest_edge(const Triangle& t) {
+    return std::max({static_cast<double>(length(t.v1 - t.v0)),
+                     static_cast<double>(length(t.v2 - t.v1)),
+                     static_cast<double>(length(t.v0 - t.v2))});
+}
+
+}  // namespace
+
+SceneUse scene_use(const Scene& scene) {
+    SceneUse use;
+    use.spheres = static_cast<int>(scene.spheres.size());
+    use.triangles = static_cast<int>(scene.triangles.size());
+    for (const Material& m : scene.materials) {
+        use.diffuse += m.type == MaterialType::Diffuse;
+        use.mirrors += m.type == MaterialType::Mirror;
+        use.glass += m.type == MaterialType::Glass;
+    }
+    use.light = scene.has_light;
+    use.background = !is_black(scene.background);
+    double smallest = INFINITY;
+    for (const Sphere& s : scene.spheres) {
+        smallest = std::min(smallest, static_cast<double>(s.radius));
+        use.extent = std::max(use.extent, static_cast<double>(sphere_extent(s)));
+    }
+    for (const Triangle& t : scene.triangles) {
+        const double edge = longest_edge(t);
+        if (edge > 0) smallest = std::min(smallest, edge);  // a zero-area triangle shows nothing
+        use.extent = std::max(use.extent, static_cast<double>(t.extent));
+    }
+    use.smallest = std::isfinite(smallest) ? smallest : 0.0;
+    return use;
+}
+
+std::string describe(const SceneUse& use) {
+    std::string materials;
+    const auto add = [&](int n, const char* kind) {
+        if (n) materials += (materials.empty() ? "" : ", ") + std::to_string(n) + " " + kind;
+    };
+    add(use.diffuse, "diffuse");
+    add(use.mirrors, "mirror");
+    add(use.glass, "glass");
+    std::string line = "scene: " + plural(use.spheres, "sphere", "spheres") + ", " +
+                       plural(use.triangles, "triangle", "triangles") + "; materials: " +
+                       (materials.empty() ? "none" : materials) + "; " +
+                       (use.light ? "a point light" : "no light") + "; " +
+                       (use.background ? "a background" : "a black background");
+    if (use.smallest > 0) {
+        line += "; sizes from " + number(use.smallest) + " within coordinates up to " +
+                number(use.extent) + " (1 : " + number(use.extent / use.smallest) + ")";
+    }
+    return line;
+}
+
+std::string scale_warning(const SceneUse& use) {
+    if (use.smallest <= 0 || use.smallest >= use.extent * kResolvedDetail) return "";
+    return "warning: the scene's smallest detail (" + number(use.smallest) + ") is below 1/" +
+           number(1.0 / kResolvedDetail) + " of its extent (" + number(use.extent) +
+           "): rays that cross the scene leave surfaces by offsets close to that size, so it "
+           "will render with visible error; make the detail larger or the scene smaller";
+}
+
+std::string to_json(const SceneUse& use) {
+    return "{\"spheres\": " + std::to_string(use.spheres) + ", \"triangles\": " +
+           std::to_string(use.triangles) + ", \"diffuse\": " + std::to_string(use.diffuse) +
+           ", \"mirrors\": " + std::to_string(use.mirrors) + ", \"glass\": " +
+           std::to_string(use.glass) + ", \"light\": " + (use.light ? "true" : "false") +
+           ", \"background\": " + (use.background ? "true" : "false") + ", \"smallest\": " +
+           number(use.smallest) + ", \"extent\": " + number(use.extent) + ", \"warning\": " +
+           (scale_warning(use).empty() ? "false" : "true") + "}";
+}

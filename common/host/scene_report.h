@@ -1,0 +1,31 @@
+// What a scene uses, told to the person who renders it: the primitive kinds, the material
+// kinds, the light, the background, and the range of sizes against the scene's extent; and a
+// warning, with what to do, when a detail is smaller than the renderer can resolve at the
+// scene's extent. (The loader refuses what cannot render at all: scene_limits.h. This is the
+// softer case: every primitive is fine on its own, but rays that cross a large scene leave
+// surfaces by offsets that grow with the distance travelled, ray.h, and a detail near the
+// size of those offsets is rendered with visible error.)
+#pragma once
+
+#include <string>
+
+#include <scene.h>
+
+struct SceneUse {
+    int spheres = 0, triangles = 0;
+    int diffuse = 0, mirrors = 0, glass = 0;  // the material table's entries by kind
+    bool light = false;
+    bool background = false;  // a background that is not black
+    double smallest = 0;      // the smallest radius or longest triangle edge (0: no primitive)
+    double extent = 0;        // the largest |coordinate| of any primitive, after centring
+};
+
+// A detail is resolved while it spans at least this many ray offsets of a ray that crossed
+// the scene (offsets are 2^-20 of the distance scale, ray.h; a crossing ray's is about 4
+// extents): smallest >= extent * 2^-14.
+constexpr double kResolvedDetail = 1.0 / (1 << 14);
+
+SceneUse scene_use(const Scene& scene);
+std::string describe(const SceneUse& use);       // one line
+std::string scale_warning(const SceneUse& use);  // one line with what to do, or ""
+std::string to_json(const SceneUse& use);        // an object for --json

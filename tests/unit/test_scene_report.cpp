@@ -1,0 +1,68 @@
+// What the driver tells about a scene (scene_report.h): the counts by kind, and the warning for
+// a detail too small for the scene's extent, which must appear exactly past the threshold.
+#include <gtest/gtest.h>
+
+#include "scene_loader.h"
+#include "scene_report.h"
+
+namespace {
+
+Scene scene_with(double detail_radius, double wall) {
+    Scene s;
+    Material diffuse{};
+    diffuse.type = MaterialType::Diffuse;
+    Material glass = diffuse;
+    glass.type = MaterialType::Glass;
+    s.materials = {diffuse, glass};
+    s.material_names = {"wall", "bead"};
+    const float w = static_cast<float>(wall);
+    s.triangles = {make_triangle({-w, 0, -w}, {-w, 0, w}, {w, 0, w}, 0)};
+    Sphere bead{};
+    bead.center = {0.0f, 1.0f, 0.0f};
+    bead.radius = static_cast<float>(detail_radius);
+    bead.material = 1;
+    s.spheres = {bead};
+    s.has_light = true;
+    return s;
+}
+
+}  // namespace
+
+TEST(SceneReport, CountsWhatTheSceneUses) {
+    const SceneUse use = scene_use(scene_with(0.25, 2.0));
+    EXPECT_EQ(use.spheres, 1);
+    EXPECT_EQ(use.triangles, 1);
+    EXPECT_EQ(use.diffuse, 1);
+    EXPECT_EQ(use.glass, 1);
+    EXPECT_EQ(use.mirrors, 0);
+    EXPECT_TRUE(use.light);
+    EXPECT_FALSE(use.background);
+    EXPECT_FLOAT_EQ(static_cast<float>(use.smallest), 0.25f);
+    EXPECT_FLOAT_EQ(static_cast<float>(use.extent), 2.0f);
+    const std::string line = describe(use);
+    EXPECT_NE(line.find("1 sphere, 1 triangle"), std::string::npos) << line;
+    EXPECT_NE(line.find("1 diffuse, 1 glass"), std::string::npos) << line;
+    EXPECT_NE(line.find("1 : 8"), std::string::npos) << line;
+    EXPECT_EQ(scale_warning(use), "");
+}
+
+// The warning starts where a detail spans fewer than 2^14 of the scene's extent.
+TEST(SceneReport, WarnsOfADetailBelowTheResolvedSize) {
+    const double wall = 1000.0;
+    const double limit = wall * kResolvedDetail;  // about 0.061
+    EXPECT_EQ(scale_warning(scene_use(scene_with(limit * 1.5, wall))), "");
+    const std::string warning = scale_warning(scene_use(scene_with(limit * 0.5, wall)));
+    ASSERT_FALSE(warning.empty());
+    EXPECT_EQ(warning.rfind("warning: ", 0), 0u) << warning;
+    EXPECT_NE(warning.find("make the detail larger or the scene smaller"), std::string::npos);
+    EXPECT_NE(to_json(scene_use(scene_with(limit * 0.5, wall))).find("\"warning\": true"),
+              std::string::npos);
+}
+
+TEST(SceneReport, AnEmptySceneHasNoSizes) {
+    Scene s;
+    const SceneUse use = scene_use(s);
+    EXPECT_EQ(use.smallest, 0.0);
+    EXPECT_EQ(scale_warning(use), "");
+    EXPECT_EQ(describe(use).find("sizes"), std::string::npos);
+}
