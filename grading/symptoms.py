@@ -55,24 +55,25 @@ def named(image: np.ndarray, want: np.ndarray) -> str:
     or "" when none is clear."""
     if image is None or want is None or image.shape[:2] != want.shape[:2]:
         return ""
-    found = [s for s in (black_rows(image, want),) if s]
     gray, expected = _gray(image), _gray(want)
-    if not found and np.all(np.isfinite(gray)):
-        base = _distance(gray, expected)
-        candidates = {
-            "the image is upside down (row 0 is the top: check the y index or the file's row "
-            "order)": gray[::-1],
-            "the image is mirrored left to right (check the x index)": gray[:, ::-1],
-            "the image is right with x and y swapped: check the pixel index arithmetic": gray.T
-            if gray.shape[0] == gray.shape[1] else None,
-            f"the PFM looks gamma-encoded (right after raising it to {GAMMA}): a PFM holds linear "
-            "radiance; gamma belongs in the PPM only": np.clip(gray, 0, None) ** GAMMA,
-        }
-        distances = {text: _distance(undone, expected) for text, undone in candidates.items()
-                     if undone is not None}
-        best = min(distances, key=distances.get)
-        if distances[best] < CLEARLY_CLOSER * base:
-            found.append(best)
-        elif factor := _factor(gray, expected):
-            found.append(factor)
-    return "".join(f"; {s}" for s in found)
+    if not np.all(np.isfinite(gray)):
+        return ""  # the checks count NaN and Inf themselves
+    # A transform first: a flipped image also moves the scene's own black rows (a black sky
+    # at the top lands at the bottom), which alone would look like rows never rendered.
+    base = _distance(gray, expected)
+    candidates = {
+        "the image is upside down (row 0 is the top: check the y index or the file's row "
+        "order)": gray[::-1],
+        "the image is mirrored left to right (check the x index)": gray[:, ::-1],
+        "the image is right with x and y swapped: check the pixel index arithmetic": gray.T
+        if gray.shape[0] == gray.shape[1] else None,
+        f"the PFM looks gamma-encoded (right after raising it to {GAMMA}): a PFM holds linear "
+        "radiance; gamma belongs in the PPM only": np.clip(gray, 0, None) ** GAMMA,
+    }
+    distances = {text: _distance(undone, expected) for text, undone in candidates.items()
+                 if undone is not None}
+    best = min(distances, key=distances.get)
+    if distances[best] < CLEARLY_CLOSER * base:
+        return f"; {best}"
+    found = black_rows(image, want) or _factor(gray, expected)
+    return f"; {found}" if found else ""
