@@ -30,7 +30,7 @@ import numpy as np
 
 from grading import scenes, symptoms
 from grading.compare import compare
-from grading.harness import ImageError, golden, run_lab
+from grading.harness import GOLDEN, ImageError, golden, run_lab
 
 
 @dataclasses.dataclass
@@ -74,11 +74,27 @@ def check_golden(binary, scene: str, *, seed: int = 7, spp: int = GOLDEN_TEST_SP
     run = run_lab(binary, g.scene, width=g.meta["width"], height=g.meta["height"], spp=spp,
                   bounces=g.meta["bounces"], seed=seed, launcher=launcher, threads=threads,
                   extra=extra)
+    copied = stored_golden_copied(run.image)
+    if copied:
+        return CheckResult(f"golden image '{scene}'", False,
+                           f"the image is the stored golden image '{copied}' itself, bit for "
+                           f"bit: a copy, not a render (a render at {spp} spp is noisy)")
     heatmap = heatmap_dir / f"{scene}-diff.png" if heatmap_dir else None
     report = compare(run.image, spp, g.mean, g.variance, g.meta["golden_spp"],
                      heatmap_path=heatmap)
     hint = "" if report.passed else symptoms.named(run.image, g.mean)
     return CheckResult(f"golden image '{scene}'", report.passed, report.summary() + hint)
+
+
+def stored_golden_copied(image: np.ndarray) -> str | None:
+    """The name of a stored golden image (reference/golden/) that `image` is, bit for bit, or
+    None. The golden images are public (they ship with the course), so a submission could
+    carry one and print it; no render at a test's spp matches a converged image exactly."""
+    for folder in sorted(p for p in GOLDEN.iterdir() if p.is_dir()):
+        stored = golden(folder.name).mean
+        if stored.shape == image.shape and np.array_equal(stored, image):
+            return folder.name
+    return None
 
 
 # The sphere interior both checks below render: albedo, radius, light intensity.

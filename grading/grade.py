@@ -19,7 +19,7 @@ import sys
 import time
 from typing import Callable
 
-from grading import checks, gpu, hidden, sandbox
+from grading import checks, golden_sums, gpu, hidden, sandbox
 from grading.harness import ROOT, RunPolicy, available_cores, build, policy
 from grading.results import Results, Test
 
@@ -37,6 +37,7 @@ class Item:
     run: Callable  # run(binary, **kwargs) -> checks.CheckResult
     heatmaps: bool = False  # run() takes heatmap_dir=: an image comparison
     requires: tuple[str, ...] = ()  # graded only once the items with these ids have passed
+    visibility: str = "visible"     # Gradescope's, for its results.json test
 
     def __post_init__(self):
         if isinstance(self.requires, str):
@@ -59,7 +60,8 @@ def hidden_scene(**options) -> Item:
     earns nothing."""
     return Item("hidden", "hidden scene", 0,
                 lambda b, secret, **k: hidden.check_hidden(b, LAB01_REFERENCE, secret,
-                                                           **options, **k), heatmaps=True)
+                                                           **options, **k), heatmaps=True,
+                visibility="after_published")
 
 
 def parallel_speedup(points: int, **options) -> Item:
@@ -209,13 +211,18 @@ def grade(lab: str, binary: pathlib.Path, heatmap_dir: pathlib.Path, *, trusted:
     rubric = RUBRICS[lab]
     results = results or Results()
     for item in rubric:
-        results.add(Test(item.id, item.label, item.points))
+        results.add(Test(item.id, item.label, item.points, visibility=item.visibility))
     if not trusted:
         reason = sandbox.probe()
         if reason:
             results.refuse(f"refusing to grade untrusted code without a sandbox: {reason} "
                            f"(pass --trusted to grade your own code without one)")
             return results.as_dict()
+    reason = golden_sums.problem()
+    if reason:  # every image check would compare with the wrong data: the grader's fault
+        results.refuse(f"refusing to grade against golden data that is not as recorded: "
+                       f"{reason}", regrade=True)
+        return results.as_dict()
     on_gpu = gpu.is_gpu_lab(lab)
     # CUDA reserves virtual address space for all of the GPU's memory and the host's (unified
     # addressing), so an address-space limit (RLIMIT_AS) stops every CUDA program at start-up.
@@ -389,7 +396,8 @@ def main(argv=None) -> int:
     a = p.parse_args(argv)
     out = pathlib.Path(a.results)
     results = Results(path=out)
-    results.add_all(Test(i.id, i.label, i.points) for i in RUBRICS[a.lab])
+    results.add_all(Test(i.id, i.label, i.points, visibility=i.visibility)
+                    for i in RUBRICS[a.lab])
 
     def interrupted(signum, _frame):
         raise KeyboardInterrupt(signal.Signals(signum).name)

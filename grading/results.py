@@ -29,6 +29,9 @@ class Test:
     finished: bool = False
     ok: bool = False       # the check passed (a 0-point gate passes without points)
     regrade: bool = False  # the machine could not measure it: points provisional
+    # Gradescope's: "visible", or "after_published" for a hidden test, whose outcome the
+    # top-level output states in one line meanwhile (Results.complete)
+    visibility: str = "visible"
 
     @property
     def passed(self) -> bool:
@@ -44,7 +47,7 @@ class Test:
     def as_dict(self) -> dict:
         return {"name": self.label, "score": self.score, "max_score": self.max_score,
                 "status": "passed" if self.passed else "failed", "output": self.output,
-                "execution_time": round(self.seconds, 3), "visibility": "visible",
+                "execution_time": round(self.seconds, 3), "visibility": self.visibility,
                 "extra_data": {"check": self.id, "regrade": self.regrade}}
 
 
@@ -93,6 +96,10 @@ class Results:
         self.changed()
 
     def complete(self, seconds: float) -> None:
+        for t in self.tests:
+            if t.visibility != "visible" and t.finished:
+                self.notes.append(f"{t.label}: {'passed' if t.passed else 'failed'} (its details "
+                                  f"are shown once the grades are published)")
         regrade = [t.label for t in self.tests if t.regrade]
         if regrade:
             self.notes.append("marked for regrade (the machine was too busy to measure; points "

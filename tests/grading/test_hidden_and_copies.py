@@ -1,0 +1,45 @@
+"""Two things a class should not learn from results.json: the hidden scene's details (Gradescope
+shows that test only once the grades are published; a one-line summary is public at once),
+and the stored golden images (public, so a submission could print one: the golden check
+names the copy)."""
+import sys
+
+from grading.grade import describe, grade, passed_by_check
+from grading.harness import GOLDEN
+
+# Renders as the reference does, except that the golden Cornell view gets the stored golden
+# image itself (a submission that recognises the graded scene and prints what it should be).
+COPIER = """#!{python}
+import shutil, subprocess, sys
+args = sys.argv[1:]
+p = subprocess.run([{reference!r}, *args])
+if p.returncode:
+    sys.exit(p.returncode)
+scene = args[args.index("--scene") + 1] if "--scene" in args else ""
+if scene.endswith("cornell.json") and "--pfm" in args and args[args.index("--width") + 1] == "64":
+    shutil.copyfile({golden!r}, args[args.index("--pfm") + 1])
+"""
+
+
+def test_the_hidden_scene_is_hidden_with_a_public_summary(lab01_ref, tmp_path):
+    results = grade("01", lab01_ref, tmp_path, trusted=True)
+    hidden = next(t for t in results["tests"] if t["extra_data"]["check"] == "hidden")
+    assert hidden["visibility"] == "after_published"
+    assert all(t["visibility"] == "visible" for t in results["tests"] if t is not hidden)
+    assert results["visibility"] == "visible"
+    assert "hidden scene: passed (its details are shown once the grades are published)" in (
+        results["output"]), results["output"]
+
+
+def test_a_printed_golden_image_is_named_a_copy(lab01_ref, tmp_path):
+    copier = tmp_path / "lab"
+    copier.write_text(COPIER.format(python=sys.executable, reference=str(lab01_ref),
+                                    golden=str(GOLDEN / "cornell" / "golden.pfm")))
+    copier.chmod(0o755)
+    results = grade("01", copier, tmp_path, trusted=True)
+    passed = passed_by_check(results)
+    assert passed["hidden"] and not passed["golden-cornell"], describe(results)
+    output = next(t["output"] for t in results["tests"]
+                  if t["extra_data"]["check"] == "golden-cornell")
+    assert "the stored golden image 'cornell' itself" in output and "a copy" in output, output
+    assert results["score"] <= 80, describe(results)
