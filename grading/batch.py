@@ -70,7 +70,12 @@ def write_html(path: pathlib.Path, lab: str, rows: dict[str, dict]) -> None:
             cells.append(f'<td class="{cls}" title="{e(t.get("output", ""))}">'
                          f'{t["score"]}/{t["max_score"]}</td>')
         note = e(r.get("output", "").splitlines()[0]) if r.get("output") else ""
-        body.append(f"<tr><th>{e(student)}</th><td>{r.get('score', 0)}</td>{''.join(cells)}"
+        # Each student's own page (images, heatmaps, what each check saw), where the grader
+        # wrote one: grading/report_html.py.
+        page = path.parent / student / "heatmaps" / "report.html"
+        name = (f'<a href="{e(student)}/heatmaps/report.html">{e(student)}</a>' if page.exists()
+                else e(student))
+        body.append(f"<tr><th>{name}</th><td>{r.get('score', 0)}</td>{''.join(cells)}"
                     f"<td>{note}</td></tr>")
     path.write_text(f"""<!doctype html><meta charset="utf-8"><title>Lab {lab} grades</title>
 <style>body{{font-family:sans-serif}} td,th{{padding:2px 8px;border:1px solid #ccc}}

@@ -28,7 +28,7 @@ import time
 
 import numpy as np
 
-from grading import scenes, symptoms
+from grading import report_html, scenes, symptoms
 from grading.compare import compare
 from grading.harness import GOLDEN, ImageError, golden, run_lab
 
@@ -82,6 +82,8 @@ def check_golden(binary, scene: str, *, seed: int = 7, spp: int = GOLDEN_TEST_SP
     heatmap = heatmap_dir / f"{scene}-diff.png" if heatmap_dir else None
     report = compare(run.image, spp, g.mean, g.variance, g.meta["golden_spp"],
                      heatmap_path=heatmap)
+    if heatmap_dir and run.image is not None:  # for the page (grading/report_html.py)
+        report_html.write_images(heatmap_dir, scene, run.image, g.mean)
     hint = "" if report.passed else symptoms.named(run.image, g.mean)
     return CheckResult(f"golden image '{scene}'", report.passed, report.summary() + hint)
 

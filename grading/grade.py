@@ -19,7 +19,7 @@ import sys
 import time
 from typing import Callable
 
-from grading import checks, golden_sums, gpu, hidden, sandbox
+from grading import checks, golden_sums, gpu, hidden, report_html, sandbox
 from grading.harness import ROOT, RunPolicy, available_cores, build, policy
 from grading.results import Results, Test
 
@@ -443,7 +443,11 @@ def main(argv=None) -> int:
         print_table(a.lab, binary, results.as_dict())
         if not any(heatmaps.iterdir()):
             heatmaps.rmdir()
-        print(f"wrote {out}" + (f"; diff heatmaps in {heatmaps}/" if heatmaps.exists() else ""))
+            print(f"wrote {out}")
+        else:
+            page = report_html.write_report(heatmaps, a.lab, str(a.binary or a.sources or binary),
+                                            results.as_dict())
+            print(f"wrote {out}; the images, diff heatmaps and {page}")
         return 2 if results.refused else 0
     except KeyboardInterrupt as e:
         results.interrupt(f"the grader was interrupted ({e or 'SIGINT'}) before it finished")

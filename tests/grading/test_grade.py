@@ -24,7 +24,9 @@ def test_reference_gets_full_marks(lab01_ref, tmp_path):
     results, table = grade(lab01_ref, tmp_path)
     assert results["score"] == results["max_score"] == 100, table
     assert all({"name", "score", "max_score", "output"} <= t.keys() for t in results["tests"])
-    assert not (tmp_path / "maps").exists()  # no failures, no heatmaps
+    # No failures, no diff heatmaps: the folder holds the page and the images only.
+    assert not list((tmp_path / "maps").glob("*-diff.png"))
+    assert (tmp_path / "maps" / "report.html").exists()
 
 
 def test_skeleton_gets_nothing_and_a_heatmap(lab01_pristine_skeleton, tmp_path):

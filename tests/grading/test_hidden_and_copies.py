@@ -5,7 +5,7 @@ names the copy)."""
 import sys
 
 from grading.grade import describe, grade, passed_by_check
-from grading.harness import GOLDEN
+from grading.harness import GOLDEN, ROOT
 
 # Renders as the reference does, except that the golden Cornell view gets the stored golden
 # image itself (a submission that recognises the graded scene and prints what it should be).
@@ -43,3 +43,27 @@ def test_a_printed_golden_image_is_named_a_copy(lab01_ref, tmp_path):
                   if t["extra_data"]["check"] == "golden-cornell")
     assert "the stored golden image 'cornell' itself" in output and "a copy" in output, output
     assert results["score"] <= 80, describe(results)
+
+
+def test_a_grade_writes_a_page_with_the_images(lab01_ref, tmp_path):
+    """`--heatmaps DIR` gets report.html: the score table, and per golden scene the
+    submission's image, the golden image and (for a failed comparison) the heatmap, as PNGs;
+    a flipped image's page says so."""
+    import subprocess
+    from tests.grading.submissions import altered_reference
+    flipped = altered_reference(tmp_path, "image[::-1]", lab01_ref)
+    for name, binary in (("right", lab01_ref), ("flipped", flipped)):
+        pages = tmp_path / name
+        p = subprocess.run([sys.executable, "-m", "grading.grade", "01", "--trusted", "--binary",
+                            str(binary), "--results", str(tmp_path / f"{name}.json"),
+                            "--heatmaps", str(pages)], cwd=ROOT, capture_output=True, text=True,
+                           timeout=600)
+        assert p.returncode == 0, p.stdout + p.stderr
+        page = (pages / "report.html").read_text()
+        assert "<table>" in page and "what it saw" in page
+        if name == "right":
+            for png in ("cornell-yours.png", "cornell-golden.png", "showcase-yours.png"):
+                assert (pages / png).read_bytes()[:8] == b"\x89PNG\r\n\x1a\n" and png in page
+        else:
+            assert "upside down" in page and "hidden-diff.png" not in page
+            assert (pages / "hidden-diff.png").exists()
