@@ -35,7 +35,8 @@ struct WavefrontConfig {
     static constexpr SceneMemory kSceneMemory = kMemory;
     static constexpr bool kAggregatedPush = kAggregated;  // push, else push_each_atomic
     // Blocks of kStageThreads each kernel must fit on a multiprocessor (__launch_bounds__):
-    // more caps the registers lower, for more warps in flight to hide memory latency.
+    // more caps the registers lower, for more warps in flight. 1 leaves the registers to the
+    // compiler, which on the H200 was faster than 12 or 16 blocks (handouts/06-cuda-split.md).
     static constexpr int kMinBlocksPerSM = kMinBlocks;
 };
 
