@@ -347,7 +347,8 @@ def main(argv=None) -> int:
                 import bench_report_output  # noqa: F401  (checked before minutes of rendering)
             except ImportError:
                 raise BadInput("matplotlib is not installed for this python: run `make deps`")
-            _writable(out)
+            if problem := tradeoff_report.cannot_write(out):
+                raise BadInput(problem)
         machine = machine_dict()
         log(f"bench ({plan.describe()}) on {machine['cpu']}, {machine['cores']} cores"
             + (f", {machine['gpu']}" if machine["gpu"] else "") + f", {machine['date']}")
@@ -380,14 +381,6 @@ def main(argv=None) -> int:
         print(f"bench: error: {str(e).strip().splitlines()[0]}", file=sys.stderr)
         return 2
 
-
-def _writable(out: pathlib.Path) -> None:
-    try:
-        out.mkdir(parents=True, exist_ok=True)
-        (out / ".write-test").touch()
-        (out / ".write-test").unlink()
-    except OSError as e:
-        raise BadInput(f"--out {out}: cannot write there ({e.strerror or e})") from None
 
 
 if __name__ == "__main__":

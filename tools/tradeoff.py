@@ -106,12 +106,8 @@ def main(argv=None) -> int:
         if binary is not None and not binary.is_file():
             raise BadInput(f"--binary {a.binary}: no such file")
         out = pathlib.Path(a.out)
-        try:
-            out.mkdir(parents=True, exist_ok=True)
-            (out / ".write-test").touch()
-            (out / ".write-test").unlink()
-        except OSError as e:
-            raise BadInput(f"--out {a.out}: cannot write there ({e.strerror or e})") from None
+        if problem := tradeoff_report.cannot_write(out):
+            raise BadInput(problem)
         return run(QUICK if a.quick or binary else FULL, out, a.note, binary, a.binary)
     except BadInput as e:
         print(f"error: {e}", file=sys.stderr)

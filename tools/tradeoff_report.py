@@ -19,6 +19,18 @@ import subprocess
 import tradeoff_fit
 
 
+def cannot_write(out: pathlib.Path) -> str | None:
+    """Why a report cannot be written to folder `out` (made if missing), or None: checked
+    before minutes of rendering, not after."""
+    try:
+        out.mkdir(parents=True, exist_ok=True)
+        (out / ".write-test").touch()
+        (out / ".write-test").unlink()
+    except OSError as e:
+        return f"--out {out}: cannot write there ({e.strerror or e})"
+    return None
+
+
 @dataclasses.dataclass
 class Machine:
     cpu: str

@@ -19,22 +19,10 @@ from cuda_env import gpu_name, missing_gpu
 from grading import checks
 from grading.compare import compare
 from grading.harness import ROOT, build, golden, run_lab
+from renderer_checks import CHECKS
 
 LAB = "06-cuda-split"
 
-# The checks every renderer of the course passes (as for lab 05).
-CHECKS = {
-    "sphere-interior": checks.check_sphere_interior,
-    "million-samples": checks.check_million_samples,
-    "lit-plane": checks.check_lit_plane,
-    "glass-pane": checks.check_glass_slab,
-    "golden-cornell": lambda b: checks.check_golden(b, "cornell"),
-    "golden-showcase": lambda b: checks.check_golden(b, "showcase"),
-    "scale": checks.check_scale_invariance,
-    "translation": checks.check_translation_invariance,
-    "large-primitives": checks.check_large_primitives,
-    "reproducible": checks.check_reproducible,
-}
 
 
 def make(*args, **kwargs):

@@ -11,6 +11,7 @@ import pytest
 
 from grading import checks, scenes
 from grading.harness import ROOT, build, run_lab
+from renderer_checks import CHECKS
 
 
 @pytest.fixture(scope="module")
@@ -18,20 +19,6 @@ def lab01_ref_double():
     return build("lab01-ref-double")[0]
 
 
-# Every check of the grader that lab 01's reference passes (tests/labs/test_lab01.py,
-# test_extremes.py), each with its own small renders.
-CHECKS = {
-    "sphere-interior": checks.check_sphere_interior,
-    "million-samples": checks.check_million_samples,
-    "lit-plane": checks.check_lit_plane,
-    "glass-pane": checks.check_glass_slab,
-    "golden-cornell": lambda b: checks.check_golden(b, "cornell"),
-    "golden-showcase": lambda b: checks.check_golden(b, "showcase"),
-    "scale": checks.check_scale_invariance,
-    "translation": checks.check_translation_invariance,
-    "large-primitives": checks.check_large_primitives,
-    "reproducible": checks.check_reproducible,
-}
 
 
 @pytest.mark.parametrize("check", CHECKS.values(), ids=CHECKS.keys())
