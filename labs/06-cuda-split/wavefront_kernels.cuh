@@ -1,12 +1,12 @@
 // The stages of the wavefront path tracer, one kernel each. Between two closest-hit queries a
-// path is the core's PathState, kept in the path pool; the kernels hand paths to each other
-// through queues of pool slots (path_queue.cuh). Per bounce:
+// path is an item on a queue (path_queue.cuh) in the path pool (path_pool.cuh): the kernels
+// hand paths to each other by copying them onto the next stage's queue. Per bounce b:
 //
-//   find_closest_hits   active queue -> each path's Hit                     (the report's CHIT)
-//   shade_hits          active queue -> the core's bounce_step; pushes the paths that go on
-//                       to the next active queue and those that asked for a shadow ray to
-//                       the shadow queue                                     (PROCESS)
-//   trace_shadow_rays   shadow queue -> the light sample's radiance, unless blocked  (AHIT)
+//   find_closest_hits   paths(b) -> each path's Hit, beside it in the queue  (the report's CHIT)
+//   shade_hits          paths(b) -> the core's bounce_step; pushes the paths that go on onto
+//                       paths(b + 1) and the light samples they ask for onto shadows(b)
+//                                                                             (PROCESS)
+//   trace_shadow_rays   shadows(b) -> the light sample's radiance, unless blocked  (AHIT)
 //
 // and per wave generate_camera_paths (GEN) before the first bounce and accumulate_samples
 // (CHECK's job here: the bounce step ends each path, and the finished paths' radiance joins
@@ -22,18 +22,22 @@
 
 #include <path_tracer.h>
 
-#include "packed_hit.cuh"
+#include "path_pool.cuh"
 #include "path_queue.cuh"
 #include "scene_pool.cuh"
 #include "wave.cuh"
 
-template <class PoolT, SceneMemory kMemory, bool kAggregated = true, class MaterialsT = AnyMaterial,
+template <class LayoutT, SceneMemory kMemory, bool kAggregated = true, class MaterialsT = AnyMaterial,
           int kMinBlocks = 1>
 struct WavefrontConfig {
-    using Pool = PoolT;
+    using Layout = LayoutT;  // AosPathPool (lab 06) or SoaPathPool (lab 07)
+    using Pool = PathPool<Layout>;
+    using Paths = Queue<typename Layout::Paths>;
+    using ShadowRays = Queue<typename Layout::ShadowRays>;
+    using Radiance = typename Layout::Radiance;
     using Materials = MaterialsT;  // what shade_hits compiles in: the scene's kinds, or all
     static constexpr SceneMemory kSceneMemory = kMemory;
-    static constexpr bool kAggregatedPush = kAggregated;  // push, else push_each_atomic
+    static constexpr bool kAggregatedPush = kAggregated;  // reserve, else reserve_each
     // Blocks of kStageThreads each kernel must fit on a multiprocessor (__launch_bounds__):
     // more caps the registers lower, for more warps in flight. 1 leaves the registers to the
     // compiler, which on the H200 was faster than 12 or 16 blocks (handouts/06-cuda-split.md).
@@ -60,21 +64,12 @@ constexpr int min_blocks_per_sm(int wanted) {
     return wanted * kStageThreads <= kMaxThreadsPerSM ? wanted : kMaxThreadsPerSM / kStageThreads;
 }
 
-template <class C>
-__device__ inline void enqueue(const PathQueue& queue, int id) {
-    if constexpr (C::kAggregatedPush) {
-        push(queue, id);
-    } else {
-        push_each_atomic(queue, id);
-    }
-}
-
 // GEN: the camera ray of every slot of the wave, as render_pixel makes it (the same jitter
-// numbers), and every path onto the first active queue.
+// numbers), its radiance sum started, and every path onto the first queue.
 template <class C>
 __global__ void __launch_bounds__(kStageThreads, min_blocks_per_sm(C::kMinBlocksPerSM))
-    generate_camera_paths(const WavefrontArgs args, const Wave wave, const typename C::Pool pool,
-                          const PathQueue active) {
+    generate_camera_paths(const WavefrontArgs args, const Wave wave, const typename C::Radiance radiance,
+                          const typename C::Paths paths) {
     const int threads = static_cast<int>(gridDim.x * blockDim.x);
     for (int slot = static_cast<int>(blockIdx.x * blockDim.x + threadIdx.x); slot < wave.paths();
          slot += threads) {
@@ -85,63 +80,64 @@ __global__ void __launch_bounds__(kStageThreads, min_blocks_per_sm(C::kMinBlocks
         const Ray ray = args.camera.ray_through(x + real(rng.at(kDimPixelX)),
                                                 y + real(rng.at(kDimPixelY)));
         const PathState path = start_path(ray, args.settings.bounces);
-        pool.start_path(slot, path);
-        if (path.alive) enqueue<C>(active, slot);
+        radiance.start(slot, path.radiance);
+        if (path.alive) push<C::kAggregatedPush>(paths, QueuedPath{path.ray, path.throughput, slot});
     }
 }
 
-// CHIT: the nearest surface on each active path's ray.
+// CHIT: the nearest surface on each queued path's ray, stored beside the path.
 template <class C>
 __global__ void __launch_bounds__(kStageThreads, min_blocks_per_sm(C::kMinBlocksPerSM))
-    find_closest_hits(const WavefrontArgs args, const typename C::Pool pool, const PathQueue active) {
+    find_closest_hits(const WavefrontArgs args, const typename C::Paths paths) {
     extern __shared__ float4 shared_scene[];  // used when the scene is in shared memory
     const SceneView scene = scene_in<C::kSceneMemory>(args.layout, args.scene_pool, shared_scene);
-    for_each_queued(active, [&](int id) { pool.store_hit(id, closest_hit(scene, pool.load_ray(id))); });
+    for_each_queued(paths, [&](int k) {
+        paths.items.store_hit(k, closest_hit(scene, paths.items.load_ray(k)));
+    });
 }
 
-// PROCESS: the core's bounce step at each active path's hit; every path on `active` is about
-// to make interaction number `bounce`. A path that goes on is stored and pushed to the next
-// bounce's active queue; one whose step asked for a shadow ray, to the shadow queue, with
-// the request in its slot. A path that ends simply is not pushed: its radiance stays in its
-// slot for accumulate_samples. The step starts from zero radiance and whatever it adds (the
-// background, for a path that escapes) joins the slot's radiance afterwards: the same single
+// PROCESS: the core's bounce step at each queued path's hit; every path on `paths` is about
+// to make interaction number `bounce`. A path that goes on is pushed, with its next ray and
+// throughput, onto the next bounce's queue; a light sample its step asked for, onto the
+// shadow queue. A path that ends simply is not pushed: its radiance is already in its slot,
+// for accumulate_samples. The step starts from zero radiance and whatever it adds (the
+// background, for a path that escapes) joins the slot's sum afterwards: the same single
 // addition the core's loop makes, and no radiance read or written for the other paths.
 template <class C>
 __global__ void __launch_bounds__(kStageThreads, min_blocks_per_sm(C::kMinBlocksPerSM))
-    shade_hits(const WavefrontArgs args, const Wave wave, const typename C::Pool pool, int bounce,
-               const PathQueue active, const PathQueue next, const PathQueue shadows) {
+    shade_hits(const WavefrontArgs args, const Wave wave, const typename C::Radiance radiance, int bounce,
+               const typename C::Paths paths, const typename C::Paths next,
+               const typename C::ShadowRays shadows) {
     extern __shared__ float4 shared_scene[];
     const SceneView scene = scene_in<C::kSceneMemory>(args.layout, args.scene_pool, shared_scene);
-    for_each_queued(active, [&](int id) {
-        PathState path = pool.load_path(id, bounce);
+    for_each_queued(paths, [&](int k) {
+        const QueuedPath queued = paths.items.load(k);
+        PathState path{queued.ray, queued.throughput, Vec3(0.0f), bounce, true};
         ShadowRay shadow;
-        const bool wants_shadow_ray = bounce_step<typename C::Materials>(
-            scene, pool.load_hit(id), stream_of(args, wave, id), args.settings.bounces, path, shadow);
+        const bool wants_shadow_ray =
+            bounce_step<typename C::Materials>(scene, paths.items.load_hit(k), stream_of(args, wave, queued.slot),
+                                               args.settings.bounces, path, shadow);
         if (path.radiance.x != 0.0f || path.radiance.y != 0.0f || path.radiance.z != 0.0f) {
-            pool.add_radiance(id, path.radiance);
+            radiance.add(queued.slot, path.radiance);
         }
-        if (wants_shadow_ray) {
-            pool.store_shadow(id, shadow);
-            enqueue<C>(shadows, id);
-        }
-        if (path.alive) {
-            pool.store_path(id, path);
-            enqueue<C>(next, id);
-        }
+        if (wants_shadow_ray) push<C::kAggregatedPush>(shadows, QueuedShadowRay{shadow, queued.slot});
+        if (path.alive) push<C::kAggregatedPush>(next, QueuedPath{path.ray, path.throughput, queued.slot});
     });
 }
 
 // AHIT: each light sample's shadow ray; any blocker will do (occluded stops at the first).
-// Only this kernel writes a queued path's radiance between two shade_hits launches, so the
-// addition needs no atomic.
+// Only this kernel adds to a slot's radiance between two shade_hits launches, and a path asks
+// for one light sample per interaction, so the addition needs no atomic.
 template <class C>
 __global__ void __launch_bounds__(kStageThreads, min_blocks_per_sm(C::kMinBlocksPerSM))
-    trace_shadow_rays(const WavefrontArgs args, const typename C::Pool pool, const PathQueue shadows) {
+    trace_shadow_rays(const WavefrontArgs args, const typename C::Radiance radiance,
+                      const typename C::ShadowRays shadows) {
     extern __shared__ float4 shared_scene[];
     const SceneView scene = scene_in<C::kSceneMemory>(args.layout, args.scene_pool, shared_scene);
-    for_each_queued(shadows, [&](int id) {
-        const ShadowRay shadow = pool.load_shadow(id);
-        if (!occluded(scene, shadow.ray, shadow.t_max)) pool.add_radiance(id, shadow.radiance);
+    for_each_queued(shadows, [&](int k) {
+        const QueuedShadowRay queued = shadows.items.load(k);
+        const ShadowRay& s = queued.shadow;
+        if (!occluded(scene, s.ray, s.t_max)) radiance.add(queued.slot, s.radiance);
     });
 }
 
@@ -151,13 +147,13 @@ __global__ void __launch_bounds__(kStageThreads, min_blocks_per_sm(C::kMinBlocks
 // receives sum.mean(spp). One thread per pixel: no atomics, no order to depend on.
 template <class C>
 __global__ void __launch_bounds__(kStageThreads, min_blocks_per_sm(C::kMinBlocksPerSM))
-    accumulate_samples(const Wave wave, const typename C::Pool pool, SampleSum* sums, Vec3* means,
+    accumulate_samples(const Wave wave, const typename C::Radiance radiance, SampleSum* sums, Vec3* means,
                        int spp) {
     const int threads = static_cast<int>(gridDim.x * blockDim.x);
     for (int p = static_cast<int>(blockIdx.x * blockDim.x + threadIdx.x); p < wave.pixels;
          p += threads) {
         SampleSum sum = sums[p];
-        for (int s = 0; s < wave.samples; ++s) sum.add(pool.load_radiance(p + s * wave.pixels));
+        for (int s = 0; s < wave.samples; ++s) sum.add(radiance.load(p + s * wave.pixels));
         sums[p] = sum;
         if (means) means[p] = sum.mean(spp);
     }

@@ -42,18 +42,13 @@ struct WavefrontStats {
     std::vector<long long> shadow_rays;               // [bounce]: shadow queue's size
     int waves = 0;
     int wave_paths = 0;       // the largest wave
-    size_t bytes_per_path = 0;  // pool and queues, device memory per slot
+    size_t bytes_per_path = 0;  // the pool (its queues and radiance), device memory per slot
 };
 
 // Paths per wave unless memory or RT_LAB06_WAVE_PATHS says fewer: 2^21 (2M) paths, about
-// 0.25 GB of pool and queues. Measured with lab06-bench's wave-size rows on an H200
-// (handouts/06-cuda-split.md): on the baseline 2^21 and 2^22 tie and 2^18 and 2^20 are
-// slower (more launches); at 16 bounces 2^18 is fastest for the SoA pool (it fits the L2).
+// 0.34 GB of pool. Measured with lab06-bench's wave-size rows on an H200
+// (handouts/06-cuda-split.md).
 constexpr long long kDefaultWavePaths = 1 << 21;
-
-// Device memory per pool slot besides the pool itself: two active queues and the shadow
-// queue, one int each.
-constexpr size_t kQueueBytesPerPath = 3 * sizeof(int);
 
 inline long long max_wave_paths(size_t bytes_per_path) {
     size_t free_bytes = 0, total_bytes = 0;
@@ -86,8 +81,7 @@ public:
     using Pool = typename C::Pool;
     struct Memory {
         Pool pool;
-        int* items[3];  // active queues of even and odd bounces, the shadow queue
-        int* sizes;     // [0, bounces]: active queue of each bounce; then the shadow queues
+        int* sizes;  // [0, bounces]: the path queue of each bounce; then the shadow queues
         SampleSum* sums;
         Vec3* means;
     };
@@ -101,42 +95,44 @@ public:
     WaveStages(const WaveStages&) = delete;
     WaveStages& operator=(const WaveStages&) = delete;
 
-    // The queues of bounce b: the paths about to make interaction number b, and the shadow
-    // rays that interaction asks for.
-    PathQueue active(int bounce) const {
-        return {memory_.items[bounce % 2], memory_.sizes + bounce};
+    // The queues of bounce b: the paths about to make interaction number b (the pool's two
+    // path queues take turns), and the shadow rays that interaction asks for.
+    typename C::Paths active(int bounce) const {
+        return {memory_.pool.paths[bounce % 2], memory_.sizes + bounce};
     }
-    PathQueue shadows(int bounce) const {
-        return {memory_.items[2], memory_.sizes + args_.settings.bounces + 1 + bounce};
+    typename C::ShadowRays shadows(int bounce) const {
+        return {memory_.pool.shadow_rays, memory_.sizes + args_.settings.bounces + 1 + bounce};
     }
 
-    void generate_camera_paths(const PathQueue& active) {
+    void generate_camera_paths(const typename C::Paths& active) {
         launch(kGenerate, [&] {
-            ::generate_camera_paths<C><<<grid_[kGenerate], kStageThreads>>>(args_, wave_, memory_.pool, active);
+            ::generate_camera_paths<C><<<grid_[kGenerate], kStageThreads>>>(args_, wave_, memory_.pool.radiance, active);
         });
     }
-    void find_closest_hits(const PathQueue& active) {
+    void find_closest_hits(const typename C::Paths& active) {
         launch(kClosestHit, [&] {
-            ::find_closest_hits<C><<<grid_[kClosestHit], kStageThreads, shared_bytes_>>>(args_, memory_.pool, active);
+            ::find_closest_hits<C><<<grid_[kClosestHit], kStageThreads, shared_bytes_>>>(args_, active);
         });
     }
     // The bounce of the paths on `active` is where its counter lies: active(b)'s is sizes[b].
-    void shade_hits(const PathQueue& active, const PathQueue& next, const PathQueue& shadows) {
+    void shade_hits(const typename C::Paths& active, const typename C::Paths& next,
+                    const typename C::ShadowRays& shadows) {
         const int bounce = static_cast<int>(active.size - memory_.sizes);
         launch(kShade, [&] {
             ::shade_hits<C><<<grid_[kShade], kStageThreads, shared_bytes_>>>(
-                args_, wave_, memory_.pool, bounce, active, next, shadows);
+                args_, wave_, memory_.pool.radiance, bounce, active, next, shadows);
         });
     }
-    void trace_shadow_rays(const PathQueue& shadows) {
+    void trace_shadow_rays(const typename C::ShadowRays& shadows) {
         launch(kShadow, [&] {
-            ::trace_shadow_rays<C><<<grid_[kShadow], kStageThreads, shared_bytes_>>>(args_, memory_.pool, shadows);
+            ::trace_shadow_rays<C><<<grid_[kShadow], kStageThreads, shared_bytes_>>>(
+                args_, memory_.pool.radiance, shadows);
         });
     }
     void accumulate_samples() {
         launch(kAccumulate, [&] {
             ::accumulate_samples<C><<<grid_[kAccumulate], kStageThreads>>>(
-                wave_, memory_.pool, memory_.sums, last_wave_ ? memory_.means : nullptr,
+                wave_, memory_.pool.radiance, memory_.sums, last_wave_ ? memory_.means : nullptr,
                 args_.settings.spp);
         });
     }
@@ -243,21 +239,18 @@ double render_waves(const RenderJob& job, const cudaDeviceProp& prop, const Scen
     const size_t shared_bytes = C::kSceneMemory == SceneMemory::Shared ? layout.bytes() : 0;
     const std::array<unsigned, kStageCount> grid = prepare_stages<C>(prop, shared_bytes, stats);
 
-    const size_t bytes_per_path = Pool::bytes_for(1024) / 1024 + kQueueBytesPerPath;
+    const size_t bytes_per_path = Pool::bytes_for(1024) / 1024;
     const WavePlan plan = plan_waves(settings, max_wave_paths(bytes_per_path));
     const int band_pixels = plan.band_rows * settings.width;
     const int slots = band_pixels * plan.samples_per_wave;
     if (stats) stats->bytes_per_path = bytes_per_path;
 
     DeviceArray<unsigned char> pool_memory(Pool::bytes_for(slots), "allocating the path pool");
-    DeviceArray<int> items(3 * static_cast<size_t>(slots), "allocating the path queues");
     DeviceArray<int> sizes(2 * settings.bounces + 1, "allocating the queue sizes");
     DeviceArray<SampleSum> sums(band_pixels, "allocating the pixel sums");
     DeviceArray<Vec3> means(band_pixels, "allocating the image band");
-    const typename WaveStages<C>::Memory memory{
-        Pool::carve(pool_memory.data(), slots),
-        {items.data(), items.data() + slots, items.data() + 2 * static_cast<size_t>(slots)},
-        sizes.data(), sums.data(), means.data()};
+    const typename WaveStages<C>::Memory memory{Pool::carve(pool_memory.data(), slots), sizes.data(),
+                                                sums.data(), means.data()};
     const WavefrontArgs args{layout, scene_pool, job.camera, settings};
     WaveStages<C> stages(args, memory, shared_bytes, grid, stats);
 
@@ -284,10 +277,10 @@ double render_waves(const RenderJob& job, const cudaDeviceProp& prop, const Scen
     return seconds;
 }
 
-// The whole render() of a wavefront lab, for path-pool layout Pool: the scene in each
+// The whole render() of a wavefront lab, for path-pool layout Layout: the scene in each
 // block's shared memory when it is small, else in global memory (lab 05's rule,
 // choose_scene_memory), and a shading kernel for the scene's material kinds.
-template <class Pool>
+template <class Layout>
 RenderStats render_wavefront(const RenderJob& job, Image& image, WavefrontStats* stats = nullptr) {
     const cudaDeviceProp prop = open_device();
     const SceneLayout layout = layout_of(job.scene);
@@ -300,7 +293,7 @@ RenderStats render_wavefront(const RenderJob& job, Image& image, WavefrontStats*
     using S = std::integral_constant<SceneMemory, SceneMemory::Shared>;
     using G = std::integral_constant<SceneMemory, SceneMemory::Global>;
     const auto render = [&](auto memory, auto materials) {
-        using C = WavefrontConfig<Pool, decltype(memory)::value, true, decltype(materials)>;
+        using C = WavefrontConfig<Layout, decltype(memory)::value, true, decltype(materials)>;
         return render_waves<C>(job, prop, layout, scene_pool.data(), image, stats);
     };
     const double seconds = shared ? (specular ? render(S{}, AnyMaterial{}) : render(S{}, DiffuseOnly{}))

@@ -131,7 +131,7 @@ def test_skeleton_in_sync():
     assert set(expected) == {"path_queue.cuh", "render.cu", "stage_loop.cuh"}
     for name, text in expected.items():
         assert (ROOT / "labs" / LAB / "skeleton" / name).read_text() == text, name
-    assert "atomicAdd(queue.size" not in expected["path_queue.cuh"].split("push_each_atomic")[0]
+    assert "atomicAdd(size" not in expected["path_queue.cuh"].split("reserve_each")[0]
     assert "for (int bounce" not in expected["stage_loop.cuh"]
 
 

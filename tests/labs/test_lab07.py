@@ -42,6 +42,7 @@ def test_skeleton_in_sync():
     for name, text in expected.items():
         assert (ROOT / "labs" / LAB / "skeleton" / name).read_text() == text, name
     assert "Vec3Array" not in expected["path_pool_soa.cuh"]
+    assert "c.take<float>()" not in expected["path_pool_soa.cuh"]
 
 
 def test_no_gpu_is_one_line(lab07_ref, tmp_path):

@@ -1,43 +1,19 @@
 // The path pool as a structure of arrays (SoA): one array per scalar field, so that the
-// threads of a warp, which work on paths of neighbouring slots, read and write neighbouring
-// words, and a kernel that needs only some fields moves only those. The member functions
-// are lab 06's AosPathPool's (path_pool_aos.cuh): the kernels read a field "as one struct"
-// (pool.load_path(i)) whichever layout is behind it, the way pbrt-v4's generated SOA types
-// do, so lab 06's kernels run unchanged on this pool.
+// threads of a warp, which work on neighbouring places of a queue, read and write
+// neighbouring words, and a kernel that needs only some fields moves only those. The member
+// functions are lab 06's (path_pool.cuh lists them; path_pool_aos.cuh implements them as an
+// array of structures): the kernels read an item "as one struct" (paths.load(k)) whichever
+// layout is behind it, the way pbrt-v4's generated SOA types do, so lab 06's kernels run
+// unchanged on this pool.
 //!
-//! Lab 07 students write SoaPathPool (the region between BEGIN/END SOLUTION);
+//! Lab 07 students write the three arrays (the region between BEGIN/END SOLUTION);
 //! tools/skeletons.py turns this file into labs/07-soa/skeleton/path_pool_soa.cuh.
 #pragma once
 
-#include <cstddef>
-#include <cstdint>
-
-#include <path_tracer.h>
-
-#include "packed_hit.cuh"
-
-// Lays arrays out one after another in one allocation, each on a 256-byte boundary (so every
-// warp's access to it starts on a cache line). With a null base it only measures.
-class ArrayCarver {
-public:
-    ArrayCarver(void* base, int slots) : base_(static_cast<char*>(base)), slots_(slots) {}
-    template <class T>
-    T* take() {
-        offset_ = (offset_ + 255) / 256 * 256;
-        T* array = base_ ? reinterpret_cast<T*>(base_ + offset_) : nullptr;
-        offset_ += sizeof(T) * static_cast<size_t>(slots_);
-        return array;
-    }
-    size_t bytes() const { return offset_; }
-
-private:
-    char* base_;
-    int slots_;
-    size_t offset_ = 0;
-};
+#include <path_pool.cuh>
 
 // BEGIN SOLUTION
-// A Vec3 per slot as three float arrays.
+// A Vec3 per place as three float arrays.
 struct Vec3Array {
     float *x, *y, *z;
 
@@ -68,94 +44,104 @@ struct RayArray {
     }
 };
 
-// The fields of AosPathPool::Record, each in its own array: 23 words of 4 bytes per path
-// (the AoS record's 112 bytes hold the same 92 and 20 bytes of padding that keep its rows
-// aligned).
-struct SoaPathPool {
-    RayArray ray;                // PathState, less what the queues say (bounce, alive)
-    Vec3Array throughput, radiance;
-    float* hit_t;                // PackedHit
+// The fields of AosPaths::Record, each in its own array: 12 words of 4 bytes per place.
+struct SoaPaths {
+    RayArray ray;
+    Vec3Array throughput;
+    int* slot;
+    float* hit_t;  // PackedHit
     int* hit_primitive;
-    RayArray shadow_ray;         // ShadowRay
-    float* shadow_t_max;
-    Vec3Array shadow_radiance;
 
-    static constexpr const char* kName = "SoA";
-    // The arrays one after another, in the order above.
-    static SoaPathPool laid_out(ArrayCarver& c) {
-        SoaPathPool p;
-        p.ray.carve(c);
-        p.throughput.carve(c);
-        p.radiance.carve(c);
-        p.hit_t = c.take<float>();
-        p.hit_primitive = c.take<int>();
-        p.shadow_ray.carve(c);
-        p.shadow_t_max = c.take<float>();
-        p.shadow_radiance.carve(c);
-        return p;
+    void carve(ArrayCarver& c) {
+        ray.carve(c);
+        throughput.carve(c);
+        slot = c.take<int>();
+        hit_t = c.take<float>();
+        hit_primitive = c.take<int>();
     }
-    static SoaPathPool carve(void* memory, int slots) {
-        ArrayCarver c(memory, slots);
-        return laid_out(c);
+    // find_closest_hits writes the hit before anyone reads it: store leaves it alone.
+    __device__ void store(int k, const QueuedPath& p) const {
+        ray.store(k, p.ray);
+        throughput.store(k, p.throughput);
+        slot[k] = p.slot;
     }
-    static size_t bytes_for(int slots) {
-        ArrayCarver c(nullptr, slots);
-        laid_out(c);
-        return c.bytes();
-    }
-
-    __device__ void start_path(int i, const PathState& p) const {
-        ray.store(i, p.ray);
-        throughput.store(i, p.throughput);
-        radiance.store(i, p.radiance);
-    }
-    __device__ PathState load_path(int i, int bounce) const {
-        return {ray.load(i), throughput.load(i), Vec3(0.0f), bounce, true};
-    }
-    __device__ void store_path(int i, const PathState& p) const {
-        ray.store(i, p.ray);
-        throughput.store(i, p.throughput);
-    }
-    __device__ Ray load_ray(int i) const { return ray.load(i); }
-    __device__ Hit load_hit(int i) const { return unpack_hit({hit_t[i], hit_primitive[i]}); }
-    __device__ void store_hit(int i, const Hit& h) const {
+    __device__ QueuedPath load(int k) const { return {ray.load(k), throughput.load(k), slot[k]}; }
+    __device__ Ray load_ray(int k) const { return ray.load(k); }
+    __device__ void store_hit(int k, const Hit& h) const {
         const PackedHit packed = pack_hit(h);
-        hit_t[i] = packed.t;
-        hit_primitive[i] = packed.primitive;
+        hit_t[k] = packed.t;
+        hit_primitive[k] = packed.primitive;
     }
-    __device__ ShadowRay load_shadow(int i) const {
-        return {shadow_ray.load(i), shadow_t_max[i], shadow_radiance.load(i)};
+    __device__ Hit load_hit(int k) const { return unpack_hit({hit_t[k], hit_primitive[k]}); }
+};
+
+// The fields of AosShadowRays::Record: 11 words per place.
+struct SoaShadowRays {
+    RayArray ray;
+    float* t_max;
+    Vec3Array radiance;
+    int* slot;
+
+    void carve(ArrayCarver& c) {
+        ray.carve(c);
+        t_max = c.take<float>();
+        radiance.carve(c);
+        slot = c.take<int>();
     }
-    __device__ void store_shadow(int i, const ShadowRay& s) const {
-        shadow_ray.store(i, s.ray);
-        shadow_t_max[i] = s.t_max;
-        shadow_radiance.store(i, s.radiance);
+    __device__ void store(int k, const QueuedShadowRay& q) const {
+        ray.store(k, q.shadow.ray);
+        t_max[k] = q.shadow.t_max;
+        radiance.store(k, q.shadow.radiance);
+        slot[k] = q.slot;
     }
-    __device__ Vec3 load_radiance(int i) const { return radiance.load(i); }
-    __device__ void add_radiance(int i, Vec3 r) const { radiance.store(i, radiance.load(i) + r); }
+    __device__ QueuedShadowRay load(int k) const {
+        return {{ray.load(k), t_max[k], radiance.load(k)}, slot[k]};
+    }
+};
+
+struct SoaRadiance {
+    Vec3Array sum;  // [slot]
+
+    void carve(ArrayCarver& c) { sum.carve(c); }
+    __device__ void start(int slot, Vec3 v) const { sum.store(slot, v); }
+    __device__ void add(int slot, Vec3 v) const { sum.store(slot, sum.load(slot) + v); }
+    __device__ Vec3 load(int slot) const { return sum.load(slot); }
 };
 // SKELETON
-//> // TODO(lab07): the pool as a structure of arrays. Give SoaPathPool one array per scalar
-//> // field of lab 06's AosPathPool::Record (Ray, PackedHit, throughput, radiance, the shadow
-//> // ray's fields; a Vec3 is three float arrays), carved out of the one allocation with
-//> // ArrayCarver (bytes_for measures the same layout with a null base), and the same member
-//> // functions reading and writing them (path_pool_aos.cuh says what each one does).
-//> // Until then: nothing is stored and every load returns a default, a hit included (no hit),
-//> // so no path keeps any radiance: the image is black.
-//> struct SoaPathPool {
-//>     static constexpr const char* kName = "SoA";
-//>     static SoaPathPool carve(void*, int) { return {}; }
-//>     static size_t bytes_for(int slots) { return static_cast<size_t>(slots); }
-//>
-//>     __device__ void start_path(int, const PathState&) const {}
-//>     __device__ PathState load_path(int, int bounce) const { return {Ray{}, Vec3(0.0f), Vec3(0.0f), bounce, true}; }
-//>     __device__ void store_path(int, const PathState&) const {}
+//> // TODO(lab07): the pool as a structure of arrays. Give SoaPaths, SoaShadowRays and
+//> // SoaRadiance one array per scalar field of lab 06's records (path_pool_aos.cuh: a Ray, a
+//> // Vec3 and a slot per queued path, and its PackedHit; the ShadowRay's fields and a slot
+//> // per shadow ray; a Vec3 per slot of radiance; a Vec3 is three float arrays), each taken
+//> // from the pool's one allocation in carve (ArrayCarver::take<T>() gives an array of T
+//> // with one element per slot), and the member functions of path_pool_aos.cuh reading and
+//> // writing them. Until then: nothing is stored and every load returns a default, a hit
+//> // included (no hit), so no path gathers any radiance: the image is black.
+//> struct SoaPaths {
+//>     void carve(ArrayCarver& c) { c.take<char>(); }
+//>     __device__ void store(int, const QueuedPath&) const {}
+//>     __device__ QueuedPath load(int) const { return {Ray{}, Vec3(0.0f), 0}; }
 //>     __device__ Ray load_ray(int) const { return {}; }
-//>     __device__ Hit load_hit(int) const { return {}; }
 //>     __device__ void store_hit(int, const Hit&) const {}
-//>     __device__ ShadowRay load_shadow(int) const { return {}; }
-//>     __device__ void store_shadow(int, const ShadowRay&) const {}
-//>     __device__ Vec3 load_radiance(int) const { return Vec3(0.0f); }
-//>     __device__ void add_radiance(int, Vec3) const {}
+//>     __device__ Hit load_hit(int) const { return {}; }
+//> };
+//>
+//> struct SoaShadowRays {
+//>     void carve(ArrayCarver& c) { c.take<char>(); }
+//>     __device__ void store(int, const QueuedShadowRay&) const {}
+//>     __device__ QueuedShadowRay load(int) const { return {{Ray{}, 0.0f, Vec3(0.0f)}, 0}; }
+//> };
+//>
+//> struct SoaRadiance {
+//>     void carve(ArrayCarver& c) { c.take<char>(); }
+//>     __device__ void start(int, Vec3) const {}
+//>     __device__ void add(int, Vec3) const {}
+//>     __device__ Vec3 load(int) const { return Vec3(0.0f); }
 //> };
 // END SOLUTION
+
+struct SoaPathPool {
+    static constexpr const char* kName = "SoA";
+    using Paths = SoaPaths;
+    using ShadowRays = SoaShadowRays;
+    using Radiance = SoaRadiance;
+};
