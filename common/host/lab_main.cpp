@@ -79,12 +79,13 @@ static int run(int argc, char** argv, const LabHooks& hooks, bool& setup_reporte
         std::printf(
             "{\"lab\": \"%s\", \"scene\": \"%s\", \"width\": %d, \"height\": %d, \"spp\": %d, "
             "\"bounces\": %d, \"seed\": %llu, \"seconds\": %.6f, \"paths_per_second\": %.1f, "
-            "\"device\": \"%s\", \"precision\": \"%s\", \"scene_uses\": %s%s}\n",
+            "\"device\": \"%s\", \"precision\": \"%s\", \"scene_uses\": %s%s%s}\n",
             kLabName, json_escape(options.scene_path).c_str(), settings.width, settings.height,
             settings.spp, settings.bounces, static_cast<unsigned long long>(settings.seed),
             stats.seconds, paths_per_second, json_escape(stats.device).c_str(), kPrecisionName,
             to_json(use).c_str(),
-            stats.timing.empty() ? "" : (", \"timing\": \"" + json_escape(stats.timing) + "\"").c_str());
+            stats.timing.empty() ? "" : (", \"timing\": \"" + json_escape(stats.timing) + "\"").c_str(),
+            stats.layout.empty() ? "" : (", \"layout\": " + stats.layout).c_str());
     } else {
         std::printf("%s: %dx%d, %d spp, %d bounces: %.3f s render, %.2f Mpaths/s on %s\n",
                     kLabName, settings.width, settings.height, settings.spp, settings.bounces,

@@ -11,9 +11,10 @@
 //   ./lab07-bench ...   the same, with lab 07's SoA pool too (bench_pools.cuh)
 //
 // The configurations: "megakernel" (lab 05's render_kernel in its reference shape),
-// "<layout>" (the lab reference: warp-aggregated push, scene in shared memory when small,
-// 2^21 paths a wave, shading compiled for the scene's material kinds), "<layout>-atomic-each"
-// (one atomic per push), "<layout>-global-scene", "<layout>-all-materials" (shading compiled
+// "<layout>" (the lab reference: block-aggregated push, scene in shared memory when small,
+// 2^21 paths a wave, shading compiled for the scene's material kinds), "<layout>-atomic-per-warp"
+// and "<layout>-atomic-each" (one atomic per warp's pushes, per push), "<layout>-prefetch" (each thread loads its next item ahead),
+// "<layout>-grid-stride" (grids that fill the GPU once instead of one thread per place), "<layout>-global-scene", "<layout>-all-materials" (shading compiled
 // for every material kind, on a scene without mirrors or glass) and "<layout>-wave-N" (N
 // paths a wave).
 #include <algorithm>
@@ -107,21 +108,29 @@ static double megakernel(const Setup& s, Image& image) {
 
 template <class Pool, class Materials>
 static void add_pool_configs(const Setup& s, std::vector<Config>& configs) {
-    using Shared = WavefrontConfig<Pool, SceneMemory::Shared, true, Materials>;
-    using SharedEach = WavefrontConfig<Pool, SceneMemory::Shared, false, Materials>;
-    using SharedAny = WavefrontConfig<Pool, SceneMemory::Shared, true, AnyMaterial>;
-    using Global = WavefrontConfig<Pool, SceneMemory::Global, true, Materials>;
-    using Occupancy75 = WavefrontConfig<Pool, SceneMemory::Shared, true, Materials, 12>;
-    using Occupancy100 = WavefrontConfig<Pool, SceneMemory::Shared, true, Materials, 16>;
+    using Shared = WavefrontConfig<Pool, SceneMemory::Shared, Reserve::kPerBlock, Materials>;
+    using SharedEach = WavefrontConfig<Pool, SceneMemory::Shared, Reserve::kPerThread, Materials>;
+    using SharedWarp = WavefrontConfig<Pool, SceneMemory::Shared, Reserve::kPerWarp, Materials>;
+    using SharedAny = WavefrontConfig<Pool, SceneMemory::Shared, Reserve::kPerBlock, AnyMaterial>;
+    using Global = WavefrontConfig<Pool, SceneMemory::Global, Reserve::kPerBlock, Materials>;
+    using Occupancy50 = WavefrontConfig<Pool, SceneMemory::Shared, Reserve::kPerBlock, Materials, 8>;
+    using Occupancy75 = WavefrontConfig<Pool, SceneMemory::Shared, Reserve::kPerBlock, Materials, 12>;
+    using Occupancy100 = WavefrontConfig<Pool, SceneMemory::Shared, Reserve::kPerBlock, Materials, 16>;
+    using Prefetch = WavefrontConfig<Pool, SceneMemory::Shared, Reserve::kPerBlock, Materials, 1, true>;
+    using GridStride = WavefrontConfig<Pool, SceneMemory::Shared, Reserve::kPerBlock, Materials, 1, false, false>;
     const std::string n = Pool::kName;
     if (choose_scene_memory(s.layout) == SceneMemory::Shared) {
         configs.push_back(wavefront<Shared>(s, n, "the lab's reference", kDefaultWavePaths));
+        configs.push_back(wavefront<SharedWarp>(s, n + "-atomic-per-warp", "one atomicAdd per warp's pushes", kDefaultWavePaths));
         configs.push_back(wavefront<SharedEach>(s, n + "-atomic-each", "one atomicAdd per push", kDefaultWavePaths));
+        configs.push_back(wavefront<Prefetch>(s, n + "-prefetch", "each thread loads its next item ahead", kDefaultWavePaths));
+        configs.push_back(wavefront<GridStride>(s, n + "-grid-stride", "grids that fill the GPU once, threads striding over the queue", kDefaultWavePaths));
         configs.push_back(wavefront<Global>(s, n + "-global-scene", "scene in global memory", kDefaultWavePaths));
         if (!std::is_same_v<Materials, AnyMaterial>) {
             configs.push_back(wavefront<SharedAny>(s, n + "-all-materials",
                                                    "shading compiled for every material kind", kDefaultWavePaths));
         }
+        configs.push_back(wavefront<Occupancy50>(s, n + "-occupancy-50", "8 blocks a multiprocessor (at most 64 registers)", kDefaultWavePaths));
         configs.push_back(wavefront<Occupancy75>(s, n + "-occupancy-75", "12 blocks a multiprocessor (at most 40 registers)", kDefaultWavePaths));
         configs.push_back(wavefront<Occupancy100>(s, n + "-occupancy-100", "16 blocks a multiprocessor (at most 32 registers)", kDefaultWavePaths));
         for (long long w : {1LL << 18, 1LL << 19, 1LL << 20, 1LL << 22}) {

@@ -55,6 +55,18 @@ public:
         offset_ += sizeof(T) * static_cast<size_t>(slots_);
         return array;
     }
+    // `count` arrays of T one after another, each on a 256-byte boundary: returns the first
+    // and sets `stride` to the elements from the start of one to the start of the next.
+    template <class T>
+    T* take_arrays(int count, int& stride) {
+        static_assert(256 % sizeof(T) == 0, "arrays on 256-byte boundaries");
+        const size_t array_bytes = (sizeof(T) * static_cast<size_t>(slots_) + 255) / 256 * 256;
+        offset_ = (offset_ + 255) / 256 * 256;
+        T* first = base_ ? reinterpret_cast<T*>(base_ + offset_) : nullptr;
+        offset_ += array_bytes * static_cast<size_t>(count);
+        stride = static_cast<int>(array_bytes / sizeof(T));
+        return first;
+    }
     size_t bytes() const { return offset_; }
 
 private:

@@ -27,8 +27,8 @@
 #include "scene_pool.cuh"
 #include "wave.cuh"
 
-template <class LayoutT, SceneMemory kMemory, bool kAggregated = true, class MaterialsT = AnyMaterial,
-          int kMinBlocks = 1>
+template <class LayoutT, SceneMemory kMemory, Reserve kHow = Reserve::kPerBlock, class MaterialsT = AnyMaterial,
+          int kMinBlocks = 1, bool kPrefetchNext = false, bool kGridPerItem = true>
 struct WavefrontConfig {
     using Layout = LayoutT;  // AosPathPool (lab 06) or SoaPathPool (lab 07)
     using Pool = PathPool<Layout>;
@@ -37,7 +37,15 @@ struct WavefrontConfig {
     using Radiance = typename Layout::Radiance;
     using Materials = MaterialsT;  // what shade_hits compiles in: the scene's kinds, or all
     static constexpr SceneMemory kSceneMemory = kMemory;
-    static constexpr bool kAggregatedPush = kAggregated;  // reserve, else reserve_each
+    static constexpr Reserve kReserve = kHow;  // how pushes reserve their places
+    // for_each_queued loads each thread's next item ahead (find_closest_hits and
+    // trace_shadow_rays): no faster on the H200 (handouts/06-cuda-split.md).
+    static constexpr bool kPrefetch = kPrefetchNext;
+    // The queue kernels' grids cover the largest queue the wave can make (one thread per
+    // place; those past the queue's size return at once), else they fill the GPU once and
+    // their threads stride over the queue. One thread per place was 4% faster on the H200:
+    // no thread is left with one more item than the others at the end of a launch.
+    static constexpr bool kOneItemPerThread = kGridPerItem;
     // Blocks of kStageThreads each kernel must fit on a multiprocessor (__launch_bounds__):
     // more caps the registers lower, for more warps in flight. 1 leaves the registers to the
     // compiler, which on the H200 was faster than 12 or 16 blocks (handouts/06-cuda-split.md).
@@ -70,19 +78,20 @@ template <class C>
 __global__ void __launch_bounds__(kStageThreads, min_blocks_per_sm(C::kMinBlocksPerSM))
     generate_camera_paths(const WavefrontArgs args, const Wave wave, const typename C::Radiance radiance,
                           const typename C::Paths paths) {
-    const int threads = static_cast<int>(gridDim.x * blockDim.x);
-    for (int slot = static_cast<int>(blockIdx.x * blockDim.x + threadIdx.x); slot < wave.paths();
-         slot += threads) {
-        const SampleStream rng = stream_of(args, wave, slot);
-        const uint64_t pixel = wave.pixel_of(slot);
-        const int x = static_cast<int>(pixel % args.settings.width);
-        const int y = static_cast<int>(pixel / args.settings.width);
-        const Ray ray = args.camera.ray_through(x + real(rng.at(kDimPixelX)),
-                                                y + real(rng.at(kDimPixelY)));
-        const PathState path = start_path(ray, args.settings.bounces);
-        radiance.start(slot, path.radiance);
-        if (path.alive) push<C::kAggregatedPush>(paths, QueuedPath{path.ray, path.throughput, slot});
-    }
+    for_each_place(wave.paths(), [&](int slot, bool valid) {
+        PathState path{};
+        if (valid) {
+            const SampleStream rng = stream_of(args, wave, slot);
+            const uint64_t pixel = wave.pixel_of(slot);
+            const int x = static_cast<int>(pixel % args.settings.width);
+            const int y = static_cast<int>(pixel / args.settings.width);
+            const Ray ray = args.camera.ray_through(x + real(rng.at(kDimPixelX)),
+                                                    y + real(rng.at(kDimPixelY)));
+            path = start_path(ray, args.settings.bounces);
+            radiance.start(slot, path.radiance);
+        }
+        push<C::kReserve>(paths, valid && path.alive, QueuedPath{path.ray, path.throughput, slot});
+    });
 }
 
 // CHIT: the nearest surface on each queued path's ray, stored beside the path.
@@ -91,9 +100,9 @@ __global__ void __launch_bounds__(kStageThreads, min_blocks_per_sm(C::kMinBlocks
     find_closest_hits(const WavefrontArgs args, const typename C::Paths paths) {
     extern __shared__ float4 shared_scene[];  // used when the scene is in shared memory
     const SceneView scene = scene_in<C::kSceneMemory>(args.layout, args.scene_pool, shared_scene);
-    for_each_queued(paths, [&](int k) {
-        paths.items.store_hit(k, closest_hit(scene, paths.items.load_ray(k)));
-    });
+    for_each_queued<C::kPrefetch>(
+        paths, [&](int k) { return paths.items.load_ray(k); },
+        [&](int k, const Ray& ray) { paths.items.store_hit(k, closest_hit(scene, ray)); });
 }
 
 // PROCESS: the core's bounce step at each queued path's hit; every path on `paths` is about
@@ -110,18 +119,23 @@ __global__ void __launch_bounds__(kStageThreads, min_blocks_per_sm(C::kMinBlocks
                const typename C::ShadowRays shadows) {
     extern __shared__ float4 shared_scene[];
     const SceneView scene = scene_in<C::kSceneMemory>(args.layout, args.scene_pool, shared_scene);
-    for_each_queued(paths, [&](int k) {
-        const QueuedPath queued = paths.items.load(k);
-        PathState path{queued.ray, queued.throughput, Vec3(0.0f), bounce, true};
-        ShadowRay shadow;
-        const bool wants_shadow_ray =
-            bounce_step<typename C::Materials>(scene, paths.items.load_hit(k), stream_of(args, wave, queued.slot),
-                                               args.settings.bounces, path, shadow);
-        if (path.radiance.x != 0.0f || path.radiance.y != 0.0f || path.radiance.z != 0.0f) {
-            radiance.add(queued.slot, path.radiance);
+    for_each_place(*paths.size, [&](int k, bool valid) {
+        PathState path{};
+        ShadowRay shadow{};
+        bool wants_shadow_ray = false;
+        int slot = 0;
+        if (valid) {
+            const QueuedPath queued = paths.items.load(k);
+            slot = queued.slot;
+            path = {queued.ray, queued.throughput, Vec3(0.0f), bounce, true};
+            wants_shadow_ray = bounce_step<typename C::Materials>(
+                scene, paths.items.load_hit(k), stream_of(args, wave, slot), args.settings.bounces, path, shadow);
+            if (path.radiance.x != 0.0f || path.radiance.y != 0.0f || path.radiance.z != 0.0f) {
+                radiance.add(slot, path.radiance);
+            }
         }
-        if (wants_shadow_ray) push<C::kAggregatedPush>(shadows, QueuedShadowRay{shadow, queued.slot});
-        if (path.alive) push<C::kAggregatedPush>(next, QueuedPath{path.ray, path.throughput, queued.slot});
+        push<C::kReserve>(shadows, wants_shadow_ray, QueuedShadowRay{shadow, slot});
+        push<C::kReserve>(next, valid && path.alive, QueuedPath{path.ray, path.throughput, slot});
     });
 }
 
@@ -134,8 +148,8 @@ __global__ void __launch_bounds__(kStageThreads, min_blocks_per_sm(C::kMinBlocks
                       const typename C::ShadowRays shadows) {
     extern __shared__ float4 shared_scene[];
     const SceneView scene = scene_in<C::kSceneMemory>(args.layout, args.scene_pool, shared_scene);
-    for_each_queued(shadows, [&](int k) {
-        const QueuedShadowRay queued = shadows.items.load(k);
+    for_each_queued<C::kPrefetch>(
+        shadows, [&](int k) { return shadows.items.load(k); }, [&](int, const QueuedShadowRay& queued) {
         const ShadowRay& s = queued.shadow;
         if (!occluded(scene, s.ray, s.t_max)) radiance.add(queued.slot, s.radiance);
     });

@@ -21,6 +21,7 @@
 #include <lab.h>
 
 #include "cuda_check.h"
+#include "layout_probe.cuh"
 #include "stage_loop.cuh"
 #include "wavefront_kernels.cuh"
 
@@ -111,7 +112,7 @@ public:
     }
     void find_closest_hits(const typename C::Paths& active) {
         launch(kClosestHit, [&] {
-            ::find_closest_hits<C><<<grid_[kClosestHit], kStageThreads, shared_bytes_>>>(args_, active);
+            ::find_closest_hits<C><<<queue_grid(kClosestHit), kStageThreads, shared_bytes_>>>(args_, active);
         });
     }
     // The bounce of the paths on `active` is where its counter lies: active(b)'s is sizes[b].
@@ -119,13 +120,13 @@ public:
                     const typename C::ShadowRays& shadows) {
         const int bounce = static_cast<int>(active.size - memory_.sizes);
         launch(kShade, [&] {
-            ::shade_hits<C><<<grid_[kShade], kStageThreads, shared_bytes_>>>(
+            ::shade_hits<C><<<queue_grid(kShade), kStageThreads, shared_bytes_>>>(
                 args_, wave_, memory_.pool.radiance, bounce, active, next, shadows);
         });
     }
     void trace_shadow_rays(const typename C::ShadowRays& shadows) {
         launch(kShadow, [&] {
-            ::trace_shadow_rays<C><<<grid_[kShadow], kStageThreads, shared_bytes_>>>(
+            ::trace_shadow_rays<C><<<queue_grid(kShadow), kStageThreads, shared_bytes_>>>(
                 args_, memory_.pool.radiance, shadows);
         });
     }
@@ -149,6 +150,13 @@ public:
     }
 
 private:
+    // Blocks for a kernel that pops a queue: one thread per path of the wave (no queue holds
+    // more), or with C::kOneItemPerThread false enough to fill the GPU once.
+    unsigned queue_grid(Stage stage) const {
+        const unsigned covering = static_cast<unsigned>((wave_.paths() + kStageThreads - 1) / kStageThreads);
+        return C::kOneItemPerThread ? std::max(grid_[stage], covering) : grid_[stage];
+    }
+
     template <class Launch>
     void launch(Stage stage, Launch&& kernel_launch) {
         if (stats_) {
@@ -293,10 +301,10 @@ RenderStats render_wavefront(const RenderJob& job, Image& image, WavefrontStats*
     using S = std::integral_constant<SceneMemory, SceneMemory::Shared>;
     using G = std::integral_constant<SceneMemory, SceneMemory::Global>;
     const auto render = [&](auto memory, auto materials) {
-        using C = WavefrontConfig<Layout, decltype(memory)::value, true, decltype(materials)>;
+        using C = WavefrontConfig<Layout, decltype(memory)::value, Reserve::kPerBlock, decltype(materials)>;
         return render_waves<C>(job, prop, layout, scene_pool.data(), image, stats);
     };
     const double seconds = shared ? (specular ? render(S{}, AnyMaterial{}) : render(S{}, DiffuseOnly{}))
                                   : (specular ? render(G{}, AnyMaterial{}) : render(G{}, DiffuseOnly{}));
-    return {seconds, describe(prop)};
+    return {seconds, describe(prop), "", describe_layout<Layout>()};
 }

@@ -12,7 +12,7 @@ stand-in.
 On a GPU (tools/gpu_check.sh runs these; elsewhere they skip and say why): each lab's
 reference scores 100 in the sandbox, each pristine skeleton at most 10%, and each classic GPU
 bug (tests/grading/gpu_mutants.py) loses the points it should, with a message naming the
-symptom, and lab 06's reference handed in for lab 07 loses the speed points. Renders are small but for the timed ones (~0.4 s of kernel time each on an H200),
+symptom, and lab 06's reference handed in for lab 07 loses the layout's points. Renders are small but for the timed ones (~0.4 s of kernel time each on an H200),
 so that this part stays within a few minutes there.
 """
 import concurrent.futures
@@ -328,6 +328,39 @@ def test_swapped_x_and_y_are_named(tmp_path):
     assert right.passed and "swapped" not in right.detail, right.detail
 
 
+def reporting_layout(folder: pathlib.Path, layout) -> pathlib.Path:
+    """Lab 01's reference with `layout` added to its --json (left out when None): what a
+    wavefront lab reports about its path pool (labs/06-cuda-split/layout_probe.cuh)."""
+    script = folder / f"layout-{abs(hash(json.dumps(layout)))}"
+    script.write_text(f"""#!{sys.executable}
+import json, subprocess, sys
+p = subprocess.run([{str(build("lab01-ref")[0])!r}, *sys.argv[1:]], capture_output=True, text=True)
+sys.stderr.write(p.stderr)
+out, layout = p.stdout, json.loads({json.dumps(json.dumps(layout))})
+if layout is not None and out.startswith("{{"):
+    out = json.dumps({{**json.loads(out), "layout": layout}}) + "\\n"
+sys.stdout.write(out)
+sys.exit(p.returncode)
+""")
+    script.chmod(0o755)
+    return script
+
+
+@pytest.mark.parametrize("layout, passes, says", [
+    ({"name": "SoA", "bytes_between_neighbours": 4}, True, "4 bytes apart (a structure of arrays)"),
+    ({"name": "AoS", "bytes_between_neighbours": 48}, False, "48 bytes apart"),
+    ({"name": "SoA", "bytes_between_neighbours": -1}, False, "does not store what it is given"),
+    ({"name": "SoA", "bytes_between_neighbours": "4"}, False, "does not report"),
+    (None, False, "does not report its pool's layout"),
+])
+def test_the_layout_check_reads_the_probe(tmp_path, layout, passes, says):
+    """Lab 07's layout check on stand-ins reporting each kind of probe result: only a
+    structure of arrays passes, and a pool that stores nothing, or a program that does not
+    say, fails with a reason."""
+    result = checks.check_structure_of_arrays(reporting_layout(tmp_path, layout))
+    assert result.passed == passes and says in result.detail, result.detail
+
+
 def test_a_timed_render_is_checked_at_the_golden_size():
     """The timed render is the golden view `scale` times larger; box-filtered, a correct one
     is the golden image (here: the golden image itself, upsampled), a transposed one is not."""
@@ -426,13 +459,16 @@ def test_swapped_index_loses_what_shows_position(gpu_builds, tmp_path):
     assert "x and y swapped" in plane["output"], describe(results)
 
 
-def test_lab06_handed_in_for_lab07_loses_only_the_speed(on_gpu, tmp_path):
+def test_lab06_handed_in_for_lab07_loses_the_layout_points(on_gpu, tmp_path):
     """Lab 07's lesson is the pool's layout: lab 06's reference (the AoS pool, the same
-    image) is correct, but on the H200 it takes 1.4x the SoA pool's time (162 against 113 ms
-    on the baseline): 0.70 of the reference's speed, below the 0.75 bar. This is the speed
-    check failing on a GPU."""
+    image) is correct, and on the H200 within 10% of the SoA pool's speed (74 against 68 ms
+    on the baseline), above the 0.75 bar. What it lacks is the layout, which the probe
+    finds: the same field of neighbouring paths a 48-byte record apart."""
     results = grade("07", ROOT / "lab06-ref", tmp_path, trusted=True)
     passed = passed_by_check(results)
-    assert not passed.pop("speed"), describe(results)
+    assert not passed.pop("structure-of-arrays"), describe(results)
     assert all(passed.values()), describe(results)
-    assert results["score"] == 70, describe(results)
+    assert results["score"] == 90, describe(results)
+    layout = next(t["output"] for t in results["tests"]
+                  if t["extra_data"]["check"] == "structure-of-arrays")
+    assert "48 bytes apart" in layout, layout

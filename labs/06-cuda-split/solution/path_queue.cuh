@@ -21,55 +21,114 @@ struct Queue {
     int* size;    // how many items the queue holds: one counter in device memory
 };
 
-// Reserves one place on the queue whose counter is `size` for the calling thread and returns
-// it: one atomic add for all the threads of a warp that push together ("warp-aggregated").
-// The pushing threads find each other (coalesced_threads), the first of them reserves that
-// many places at once, and each takes its own place by its rank among them, so a warp's items
-// also land side by side. A plain atomicAdd per thread is correct too; this turns up to 32
-// atomics on the same counter into one (reserve_each below; lab06-bench measures both).
-__device__ inline int reserve(int* size) {
+// How the threads that push onto a queue reserve their places (lab06-bench measures each).
+enum class Reserve {
+    kPerBlock,   // one atomic add on the counter per block: reserve below
+    kPerWarp,    // one per warp: reserve_per_warp
+    kPerThread,  // one per thread: reserve_per_thread
+};
+
+// Reserves a place on the queue whose counter is `size` for each thread of the block that
+// `wants` one, and returns it (-1 for a thread that wants none). Every thread of the block
+// calls it together: it synchronises the block. The threads first count themselves in
+// shared memory, where atomics are cheap; then one thread reserves that many places with one
+// atomic add on the queue's size, and each takes its place by its rank in the count.
+//
+// Why not one atomic per thread: every thread of the GPU pushing onto the same queue adds to
+// the same counter, and the L2 performs the additions to one address one after another (on
+// the H200 about 1.4 ns each). A warp that waits for its place waits for all the additions
+// queued before its own; with one per block there are 128 times fewer of them.
+__device__ inline int reserve(int* size, bool wants) {
     // BEGIN SOLUTION
-    namespace cg = cooperative_groups;
-    const cg::coalesced_group pushing = cg::coalesced_threads();
-    int first = 0;
-    if (pushing.thread_rank() == 0) first = atomicAdd(size, static_cast<int>(pushing.size()));
-    return pushing.shfl(first, 0) + static_cast<int>(pushing.thread_rank());
+    __shared__ int count, first;
+    if (threadIdx.x == 0) count = 0;
+    __syncthreads();
+    const int rank = wants ? atomicAdd(&count, 1) : -1;
+    __syncthreads();
+    if (threadIdx.x == 0 && count > 0) first = atomicAdd(size, count);
+    __syncthreads();
+    return wants ? first + rank : -1;
     // SKELETON
-    //> // TODO(lab06): reserve the place with an atomic add on *size (one per warp: the
-    //> // threads pushing together are cooperative_groups::coalesced_threads()), and return
-    //> // it. Until then: a plain read and write of the size, which gives two threads the same
-    //> // place whenever they push at once. A warp's threads push together and all read the
-    //> // same size, so nearly every path overwrites another (a race): the image comes out
-    //> // black, or nearly.
+    //> // TODO(lab06): count the block's threads that want a place (an atomic add on a
+    //> // __shared__ counter gives each its rank), let one thread reserve that many places
+    //> // with one atomicAdd on *size, and give each wanting thread the first place plus its
+    //> // rank; __syncthreads() between the steps. Until then: a plain read and write of the
+    //> // size, which gives many threads the same place when they push at once, so nearly
+    //> // every path overwrites another (a race): the image comes out black, or nearly.
+    //> if (!wants) return -1;
     //> const int place = *size;
     //> *size = place + 1;
     //> return place;
     // END SOLUTION
 }
 
-// The same reservation with one atomic per thread: what reserve is measured against.
-__device__ inline int reserve_each(int* size) { return atomicAdd(size, 1); }
+// The same reservation with one atomic add per warp: the pushing threads of the warp find
+// each other (coalesced_threads), the first reserves for all, each takes its place by rank.
+__device__ inline int reserve_per_warp(int* size, bool wants) {
+    if (!wants) return -1;
+    namespace cg = cooperative_groups;
+    const cg::coalesced_group pushing = cg::coalesced_threads();
+    int first = 0;
+    if (pushing.thread_rank() == 0) first = atomicAdd(size, static_cast<int>(pushing.size()));
+    return pushing.shfl(first, 0) + static_cast<int>(pushing.thread_rank());
+}
 
-// Appends `item` (a QueuedPath or a QueuedShadowRay) at a place reserved as kAggregated says.
-template <bool kAggregated = true, class Items, class Item>
-__device__ inline void push(const Queue<Items>& queue, const Item& item) {
-    if constexpr (kAggregated) {
-        queue.items.store(reserve(queue.size), item);
+// And with one atomic add per thread (the compiler may still combine a warp's additions).
+__device__ inline int reserve_per_thread(int* size, bool wants) { return wants ? atomicAdd(size, 1) : -1; }
+
+// Pushes `item` (a QueuedPath or a QueuedShadowRay) for each thread that `wants` to; every
+// thread of the block calls it together (see reserve).
+template <Reserve kHow = Reserve::kPerBlock, class Items, class Item>
+__device__ inline void push(const Queue<Items>& queue, bool wants, const Item& item) {
+    int place;
+    if constexpr (kHow == Reserve::kPerBlock) {
+        place = reserve(queue.size, wants);
+    } else if constexpr (kHow == Reserve::kPerWarp) {
+        place = reserve_per_warp(queue.size, wants);
     } else {
-        queue.items.store(reserve_each(queue.size), item);
+        place = reserve_per_thread(queue.size, wants);
+    }
+    if (wants) queue.items.store(place, item);
+}
+
+// Calls work(k, valid) for the places of a queue of `size` places, block by block: block b
+// takes places b * blockDim.x ... b * blockDim.x + blockDim.x - 1, and if the grid has fewer
+// threads than the queue has places, that plus the grid's threads, and so on. So a warp works
+// on 32 neighbouring places, and the loop is the same for every thread of a block, which lets
+// work push (a push synchronises the block); valid is false for the threads past the end.
+// The host sizes the grid without knowing the queue's size, which only the GPU knows, so
+// that it can launch every stage of a wave without waiting: one thread per place the queue
+// could hold (wavefront_renderer.cuh), most of which find nothing to do on a short queue.
+template <class Work>
+__device__ inline void for_each_place(int size, Work&& work) {
+    const int threads = static_cast<int>(gridDim.x * blockDim.x);
+    for (int first = static_cast<int>(blockIdx.x * blockDim.x); first < size; first += threads) {
+        const int k = first + static_cast<int>(threadIdx.x);
+        work(k, k < size);
     }
 }
 
-// Pops the queue: calls work(k) for every place k in it, the places shared among all the
-// threads of the grid (thread t takes t, t + threads, t + 2 threads, ...), so that a warp
-// works on 32 neighbouring places. The grid is sized to fill the GPU once, not to the queue,
-// whose size only the GPU knows: the host launches every stage of a wave without waiting to
-// read a size back.
-template <class Items, class Work>
-__device__ inline void for_each_queued(const Queue<Items>& queue, Work&& work) {
+// Pops a queue whose kernel pushes nothing: work(k, load(k)) for every place k in it, each
+// thread on its own (t, t + threads, t + 2 threads, ...; one turn with the grid the host
+// launches). With kPrefetch each thread loads its next item before it works on the current
+// one, so that the next item's trip from memory overlaps the current one's work: no faster
+// on the H200, where these kernels wait on arithmetic and atomics more than on loads
+// (handouts/06-cuda-split.md, section 5).
+template <bool kPrefetch = false, class Items, class Load, class Work>
+__device__ inline void for_each_queued(const Queue<Items>& queue, Load&& load, Work&& work) {
     const int size = *queue.size;
     const int threads = static_cast<int>(gridDim.x * blockDim.x);
-    for (int k = static_cast<int>(blockIdx.x * blockDim.x + threadIdx.x); k < size; k += threads) {
-        work(k);
+    int k = static_cast<int>(blockIdx.x * blockDim.x + threadIdx.x);
+    if constexpr (!kPrefetch) {
+        for (; k < size; k += threads) work(k, load(k));
+    } else {
+        if (k >= size) return;
+        auto item = load(k);
+        for (int next = k + threads; next < size; k = next, next += threads) {
+            auto following = load(next);
+            work(k, item);
+            item = following;
+        }
+        work(k, item);
     }
 }

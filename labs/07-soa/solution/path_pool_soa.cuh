@@ -13,99 +13,86 @@
 #include <path_pool.cuh>
 
 // BEGIN SOLUTION
-// A Vec3 per place as three float arrays.
-struct Vec3Array {
-    float *x, *y, *z;
+// The arrays of one kind of item: kFields arrays of 4-byte words, one per scalar field, one
+// after another in the pool's allocation; field f of place k is words[f * stride + k]. One
+// pointer and one stride rather than a pointer per array: a kernel keeps the addresses it
+// uses in registers, and a pointer for each of the 26 arrays that shade_hits touches took
+// it to 126 registers and a quarter of the GPU's threads (handouts/07-soa.md).
+template <int kFields>
+struct FieldArrays {
+    float* words;
+    int stride;
 
-    void carve(ArrayCarver& c) {
-        x = c.take<float>();
-        y = c.take<float>();
-        z = c.take<float>();
+    void carve(ArrayCarver& c) { words = c.take_arrays<float>(kFields, stride); }
+    __device__ float load(int field, int k) const { return words[field * stride + k]; }
+    __device__ void store(int field, int k, float v) const { words[field * stride + k] = v; }
+    __device__ Vec3 load3(int field, int k) const {
+        return Vec3(load(field, k), load(field + 1, k), load(field + 2, k));
     }
-    __device__ Vec3 load(int i) const { return Vec3(x[i], y[i], z[i]); }
-    __device__ void store(int i, Vec3 v) const {
-        x[i] = v.x;
-        y[i] = v.y;
-        z[i] = v.z;
+    __device__ void store3(int field, int k, Vec3 v) const {
+        store(field, k, v.x);
+        store(field + 1, k, v.y);
+        store(field + 2, k, v.z);
     }
-};
-
-struct RayArray {
-    Vec3Array origin, direction;
-
-    void carve(ArrayCarver& c) {
-        origin.carve(c);
-        direction.carve(c);
-    }
-    __device__ Ray load(int i) const { return {origin.load(i), direction.load(i)}; }
-    __device__ void store(int i, const Ray& r) const {
-        origin.store(i, r.origin);
-        direction.store(i, r.direction);
+    __device__ Ray load_ray(int field, int k) const { return {load3(field, k), load3(field + 3, k)}; }
+    __device__ void store_ray(int field, int k, const Ray& r) const {
+        store3(field, k, r.origin);
+        store3(field + 3, k, r.direction);
     }
 };
 
-// The fields of AosPaths::Record, each in its own array: 12 words of 4 bytes per place.
+// The fields of AosPaths::Record, each in its own array: 12 words per place.
 struct SoaPaths {
-    RayArray ray;
-    Vec3Array throughput;
-    int* slot;
-    float* hit_t;  // PackedHit
-    int* hit_primitive;
+    enum Field { kRay = 0, kThroughput = 6, kSlot = 9, kHitT = 10, kHitPrimitive = 11, kFields = 12 };
+    FieldArrays<kFields> a;
 
-    void carve(ArrayCarver& c) {
-        ray.carve(c);
-        throughput.carve(c);
-        slot = c.take<int>();
-        hit_t = c.take<float>();
-        hit_primitive = c.take<int>();
-    }
+    void carve(ArrayCarver& c) { a.carve(c); }
     // find_closest_hits writes the hit before anyone reads it: store leaves it alone.
     __device__ void store(int k, const QueuedPath& p) const {
-        ray.store(k, p.ray);
-        throughput.store(k, p.throughput);
-        slot[k] = p.slot;
+        a.store_ray(kRay, k, p.ray);
+        a.store3(kThroughput, k, p.throughput);
+        a.store(kSlot, k, __int_as_float(p.slot));
     }
-    __device__ QueuedPath load(int k) const { return {ray.load(k), throughput.load(k), slot[k]}; }
-    __device__ Ray load_ray(int k) const { return ray.load(k); }
+    __device__ QueuedPath load(int k) const {
+        return {a.load_ray(kRay, k), a.load3(kThroughput, k), __float_as_int(a.load(kSlot, k))};
+    }
+    __device__ Ray load_ray(int k) const { return a.load_ray(kRay, k); }
     __device__ void store_hit(int k, const Hit& h) const {
         const PackedHit packed = pack_hit(h);
-        hit_t[k] = packed.t;
-        hit_primitive[k] = packed.primitive;
+        a.store(kHitT, k, packed.t);
+        a.store(kHitPrimitive, k, __int_as_float(packed.primitive));
     }
-    __device__ Hit load_hit(int k) const { return unpack_hit({hit_t[k], hit_primitive[k]}); }
+    __device__ Hit load_hit(int k) const {
+        return unpack_hit({a.load(kHitT, k), __float_as_int(a.load(kHitPrimitive, k))});
+    }
 };
 
 // The fields of AosShadowRays::Record: 11 words per place.
 struct SoaShadowRays {
-    RayArray ray;
-    float* t_max;
-    Vec3Array radiance;
-    int* slot;
+    enum Field { kRay = 0, kTMax = 6, kRadiance = 7, kSlot = 10, kFields = 11 };
+    FieldArrays<kFields> a;
 
-    void carve(ArrayCarver& c) {
-        ray.carve(c);
-        t_max = c.take<float>();
-        radiance.carve(c);
-        slot = c.take<int>();
-    }
+    void carve(ArrayCarver& c) { a.carve(c); }
     __device__ void store(int k, const QueuedShadowRay& q) const {
-        ray.store(k, q.shadow.ray);
-        t_max[k] = q.shadow.t_max;
-        radiance.store(k, q.shadow.radiance);
-        slot[k] = q.slot;
+        a.store_ray(kRay, k, q.shadow.ray);
+        a.store(kTMax, k, q.shadow.t_max);
+        a.store3(kRadiance, k, q.shadow.radiance);
+        a.store(kSlot, k, __int_as_float(q.slot));
     }
     __device__ QueuedShadowRay load(int k) const {
-        return {{ray.load(k), t_max[k], radiance.load(k)}, slot[k]};
+        return {{a.load_ray(kRay, k), a.load(kTMax, k), a.load3(kRadiance, k)},
+                __float_as_int(a.load(kSlot, k))};
     }
 };
 
+// Each slot's radiance: three arrays.
 struct SoaRadiance {
-    Vec3Array sum;  // [slot]
+    FieldArrays<3> a;
 
-    void carve(ArrayCarver& c) { sum.carve(c); }
-    __device__ void start(int slot, Vec3 v) const { sum.store(slot, v); }
-    __device__ void add(int slot, Vec3 v) const { sum.store(slot, sum.load(slot) + v); }
-    __device__ Vec3 load(int slot) const { return sum.load(slot); }
+    void carve(ArrayCarver& c) { a.carve(c); }
+    __device__ void start(int slot, Vec3 v) const { a.store3(0, slot, v); }
+    __device__ void add(int slot, Vec3 v) const { a.store3(0, slot, a.load3(0, slot) + v); }
+    __device__ Vec3 load(int slot) const { return a.load3(0, slot); }
 };
 // SKELETON
 //> // TODO(lab07): the pool as a structure of arrays. Give SoaPaths, SoaShadowRays and
