@@ -102,6 +102,18 @@ def test_h200_bar(lab07_ref):
     assert min(soa) < min(aos), (min(soa), min(aos))
 
 
+def test_each_layout_reports_where_neighbours_lie(gpu, lab07_ref, lab07_pristine_skeleton):
+    """The probe in --json (labs/06-cuda-split/layout_probe.cuh), which lab 07's grader reads:
+    the same field of neighbouring queued paths lies 4 bytes apart in the SoA pool, a 48-byte
+    record apart in lab 06's AoS pool, and nowhere in the skeleton's pool, which stores
+    nothing."""
+    def layout(binary):
+        return run_lab(binary, width=4, height=4, spp=1).json["layout"]
+    assert layout(lab07_ref) == {"name": "SoA", "bytes_between_neighbours": 4}
+    assert layout(build("lab06-ref")[0]) == {"name": "AoS", "bytes_between_neighbours": 48}
+    assert layout(lab07_pristine_skeleton)["bytes_between_neighbours"] == -1
+
+
 @pytest.fixture(scope="module")
 def lab07_pristine_skeleton(nvcc, tmp_path_factory):
     return pristine_skeleton(LAB, tmp_path_factory)
