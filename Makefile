@@ -64,7 +64,8 @@ help:
 	@echo "make bench-micro  Google Benchmark of the inner loops (closest hit, shadow ray, path)"
 	@echo "make count-work   instructions per camera path, split by query (needs valgrind)"
 	@echo "make tradeoff     speed against accuracy: error vs time of every lab here, bias vs"
-	@echo "                  bounces, fast math, ray offsets; checked, plotted (QUICK=1: CI size)"
+	@echo "                  bounces, fast math, ray offsets; checked, plotted (QUICK=1: CI size;"
+	@echo "                  PLOTS=0: no matplotlib; tools/tradeoff_gpu.sh: the GPU machine's)"
 	@echo "make lab01-ref-double  lab 01's reference computing in double (lab05-ref-double: GPU)"
 	@echo "make bench-precision  float against double: time and error of lab 01's reference"
 	@echo "make golden       regenerate the golden images in reference/ (minutes)"
@@ -201,11 +202,14 @@ bench-micro: $(BUILD)/intersect_bench
 	$(BUILD)/intersect_bench --benchmark_min_time=0.2
 
 # Speed against accuracy (tools/tradeoff.py): error against time for every renderer here,
-# bias against bounces, fast math and ray offsets; fails when a check does. CSV, Markdown and
-# PNG plots go to REPORTS. QUICK=1 is the CI size (tests/tools/test_tradeoff.py runs it).
+# bias against bounces, fast math and ray offsets; fails when a check does. CSV, Markdown,
+# JSON and PNG plots go to REPORTS. QUICK=1 is the CI size (tests/tools/test_tradeoff.py runs
+# it); PLAN=gpu the GPU machine's (tools/tradeoff_gpu.sh); PLOTS=0 needs no matplotlib and
+# draws nothing (`tools/tradeoff.py --replot DIR` draws the plots later).
 REPORTS ?= $(BUILD)/reports
 tradeoff: lab01-ref
-	$(PYTHON) tools/tradeoff.py --out $(REPORTS) $(if $(filter 1 true yes,$(QUICK)),--quick)
+	$(PYTHON) tools/tradeoff.py --out $(REPORTS) $(if $(filter 1 true yes,$(QUICK)),--quick) \
+	    $(if $(PLAN),--plan $(PLAN)) $(if $(filter 0 false no,$(PLOTS)),--no-plots)
 
 # Float against double: time and error of lab01-ref and lab01-ref-double (tools/bench_precision.py).
 bench-precision: lab01-ref lab01-ref-double

@@ -39,7 +39,7 @@ from grading.harness import (RunError, ImageError, available_cores, cpu_has_avx2
 
 import bench_report_data as report  # noqa: E402
 import tradeoff_report  # noqa: E402  (Machine: CPU model, cores, date, load)
-import tradeoff_series  # noqa: E402  (make, gpu_missing; also sets Open MPI's root switches)
+import tradeoff_series  # noqa: E402  (make, gpu_missing, gpu_info; also sets Open MPI's root switches)
 
 FORMAT = "bench-report rows v1"  # the JSON's "format": --merge refuses anything else
 
@@ -135,19 +135,6 @@ def plan_from(quick: bool, scale: int | None, repeat: int | None) -> Plan:
 
 
 # ---- which implementations run here ----------------------------------------------------------
-
-def gpu_info() -> str | None:
-    """'NAME, driver X' for each GPU nvidia-smi lists, or None."""
-    if shutil.which("nvidia-smi") is None:
-        return None
-    p = subprocess.run(["nvidia-smi", "--query-gpu=name,driver_version",
-                        "--format=csv,noheader"], capture_output=True, text=True)
-    lines = [l.strip() for l in p.stdout.splitlines() if l.strip()] if p.returncode == 0 else []
-    if not lines:
-        return None
-    return "; ".join(f"{l.split(',')[0].strip()}, driver {l.split(',')[-1].strip()}"
-                     for l in lines)
-
 
 def why_not(impl: Impl, bin_dir: pathlib.Path | None) -> str | None:
     """Why `impl` cannot run here, or None (then its binary is ready)."""
@@ -249,7 +236,7 @@ def measure(plan: Plan, impls: list[Impl], bin_dir: pathlib.Path, log) -> tuple[
 def machine_dict() -> dict:
     m = tradeoff_report.Machine.here()
     return {"cpu": m.cpu, "cores": m.cores, "date": m.date, "load_before": m.load_before,
-            "gpu": gpu_info()}
+            "gpu": tradeoff_series.gpu_info()}
 
 
 # ---- the JSON a report is made from (and --gpu-only writes) -----------------------------------

@@ -4,6 +4,7 @@ Files: tradeoff.csv (every render of the spp sweeps), tradeoff-fits.csv (one slo
 sweep), tradeoff-bias.csv (the bounce sweep), tradeoff.md (the page: machine, verdicts,
 tables, plots), tradeoff-error-time-<scene>.png (log-log error against render time, one line
 per renderer) and tradeoff-bias.png (missing energy against bounces, closed form drawn in).
+tradeoff.json, what all of them are made from, is tools/tradeoff_record.py's.
 """
 from __future__ import annotations
 
@@ -38,6 +39,7 @@ class Machine:
     date: str
     load_before: str
     load_after: str = ""
+    gpu: str = ""  # 'NAME, driver X' where the run measured a GPU (tradeoff_series.gpu_info)
 
     @staticmethod
     def here() -> "Machine":
@@ -53,7 +55,8 @@ class Machine:
                        load())
 
     def line(self) -> str:
-        return (f"{self.cpu}, {self.cores} cores, {self.date}; load average "
+        gpu = f", {self.gpu}" if self.gpu else ""
+        return (f"{self.cpu}, {self.cores} cores{gpu}, {self.date}; load average "
                 f"{self.load_before} at the start, {self.load_after} at the end")
 
 
@@ -164,6 +167,9 @@ def markdown(*, machine: Machine, mode: str, note: str, sweeps, references: dict
     L += ["", f"Mode: {mode}. Time is each binary's own `seconds` from `--json` (render only: "
           "no scene loading, no file writing; GPU: kernel time). MSE is RMSE^2 less the "
           "reference's own noise (mean sigma^2 / N); efficiency = 1 / (MSE x seconds).", ""]
+    if not plots:
+        L += ["Plots: not drawn by this run (--no-plots, or no matplotlib where it ran); "
+              "`tools/tradeoff.py --replot DIR` draws them from DIR/tradeoff.json.", ""]
     L.append("**Verdict: " + ("PASS**" if not failures else "FAIL**"))
     L += [f"- {f}" for f in failures] or ["- every checked slope within -0.5 +- 0.05, no "
                                           "plateau; the bias matches its closed form at every "
@@ -201,7 +207,7 @@ def markdown(*, machine: Machine, mode: str, note: str, sweeps, references: dict
                          f"{'pass' if p.z_pass else 'FAIL'} | {p.efficiency:.4g} |")
         L += ["", "</details>", ""]
     if unavailable:
-        L += ["## Not measured here", ""] + [f"- {s.name}: {s.unavailable}" for s in unavailable]
+        L += ["## Not measured here", ""] + [f"- {name}: {why}" for name, why in unavailable]
         L.append("")
     L += ["## Bias against bounces", "", bias_setup, "",
           "| renderer | bounces | measured bias +- SE | closed form | (measured - closed) / SE |"

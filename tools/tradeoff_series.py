@@ -2,7 +2,8 @@
 unavailable with the reason (which the report prints).
 
 - the CPU references this host can build and run (lab01-ref ... lab04-simd-ref);
-- the GPU reference (lab05-ref) where nvidia-smi lists a GPU and it builds;
+- the GPU reference (lab05-ref) and its double build (lab05-ref-double, shown like a
+  variant) where nvidia-smi lists a GPU, they build and they render a pixel there;
 - variants of the lab-01 reference built by `make variant` (grading/variants.py): fast math,
   and a fixed world-space epsilon instead of the scale-aware ray offset of common/core/ray.h.
   A variant is one entry of VARIANTS: a name, what it changes, and either the files it
@@ -62,11 +63,13 @@ def first_words(text: str) -> str:
 
 
 def make(target: str) -> str | None:
-    """Builds `target`; returns None, or the last line of what make said when it failed."""
+    """Builds `target`; returns None, or the last line of what make said when it failed that
+    is not make's own "make: *** [...] Error 1" (which names no reason)."""
     p = subprocess.run(["make", "-s", "-C", str(ROOT), target], capture_output=True, text=True)
     if p.returncode == 0:
         return None
-    lines = (p.stderr or p.stdout).strip().splitlines()
+    lines = [line for line in (p.stderr or p.stdout).strip().splitlines()
+             if not re.match(r"make(\[\d+\])?: \*\*\*", line)]
     return f"does not build here: {lines[-1] if lines else 'make failed'}"
 
 
@@ -97,12 +100,53 @@ def gpu_missing() -> str | None:
     return None
 
 
+def gpu_info() -> str | None:
+    """'NAME, driver X' for each GPU nvidia-smi lists, or None (for the report's machine)."""
+    if shutil.which("nvidia-smi") is None:
+        return None
+    p = subprocess.run(["nvidia-smi", "--query-gpu=name,driver_version",
+                        "--format=csv,noheader"], capture_output=True, text=True)
+    lines = [l.strip() for l in p.stdout.splitlines() if l.strip()] if p.returncode == 0 else []
+    if not lines:
+        return None
+    return "; ".join(f"{l.split(',')[0].strip()}, driver {l.split(',')[-1].strip()}"
+                     for l in lines)
+
+
+def does_not_run(binary: pathlib.Path) -> str | None:
+    """Why `binary` cannot render one pixel here, or None. A GPU build can compile where the
+    GPU cannot be used (no driver, too old a driver, a GPU another job holds); finding out with
+    a 1x1 render costs a CUDA start-up (0.31 s on the H200: reference/gpu/h200-2026-12-02-final/
+    report-cuda.txt), finding out after minutes of reference renders costs those minutes."""
+    try:
+        p = subprocess.run([str(binary), "--quiet", "--width", "1", "--height", "1", "--spp",
+                            "1"], capture_output=True, text=True, timeout=120)
+    except (OSError, subprocess.TimeoutExpired) as e:
+        return f"does not run here: {e}"
+    if p.returncode == 0:
+        return None
+    return f"does not run here: {first_words(p.stderr).removeprefix('error: ')}"
+
+
+# name, make target (= binary), what it is, checked. The double build is shown, not checked,
+# as lab 01's is (VARIANTS below): what double costs on a GPU is the point.
+GPU_REFERENCES = [
+    ("lab05-ref", "lab05-ref", "CUDA megakernel (GPU)", True),
+    ("lab05 double", "lab05-ref-double", "lab05-ref in double precision (-DRT_DOUBLE, GPU)",
+     False),
+]
+
+
 def gpu_references() -> list[Series]:
-    s = Series("lab05-ref", "CUDA megakernel (GPU)")
-    s.unavailable = gpu_missing() or make("lab05-ref")
-    if s.unavailable is None:
-        s.binary = ROOT / "lab05-ref"
-    return [s]
+    missing = gpu_missing()
+    out = []
+    for name, target, what, checked in GPU_REFERENCES:
+        s = Series(name, what, checked=checked)
+        s.unavailable = missing or make(target) or does_not_run(ROOT / target)
+        if s.unavailable is None:
+            s.binary = ROOT / target
+        out.append(s)
+    return out
 
 
 # ---- variants of the lab-01 reference -------------------------------------------------------
@@ -173,5 +217,6 @@ def build_variant(v: Variant, log=print) -> Series:
     return s
 
 
-def variants(log=print) -> list[Series]:
-    return [build_variant(v, log) for v in VARIANTS]
+def variants(names=None, log=print) -> list[Series]:
+    """The VARIANTS called `names` (None: all), each built or marked unavailable."""
+    return [build_variant(v, log) for v in VARIANTS if names is None or v.name in names]

@@ -3,11 +3,20 @@ can fail: made-up error series with the wrong slope or a plateau, a renderer who
 are all the same path (correlated seeds: the error stops falling) and one that stops a
 bounce early (the bias check's closed form catches it).
 
+Measuring without matplotlib (PLOTS=0, the GPU machine) and drawing later (--replot): the
+quick run is made with matplotlib blocked, then replotted; tradeoff.json reads back exactly.
+The GPU machine's plan (--plan gpu, tools/tradeoff_gpu.sh) stops in one line where no GPU
+can run it, shown here with a stand-in nvidia-smi (skipped where a real GPU is present).
+
 CI cost, measured on a busy two-core machine: about a minute (the quick run, two mutants
-built by `make variant` and run through the quick checks)."""
+built by `make variant` and run through the quick checks); the tests added with --replot
+and --plan gpu take a few seconds more (16 s for the whole file on an idle two-core VM with
+everything built and the references cached)."""
 import csv
+import dataclasses
 import importlib.util
 import math
+import os
 import random
 import subprocess
 import sys
@@ -18,10 +27,13 @@ from grading import scenes
 from grading.harness import ROOT, build
 
 sys.path.insert(0, str(ROOT / "tools"))
+import tradeoff  # noqa: E402
 import tradeoff_bias  # noqa: E402
 import tradeoff_fit  # noqa: E402
+import tradeoff_record  # noqa: E402
+import tradeoff_report  # noqa: E402
 import tradeoff_series  # noqa: E402
-from tradeoff_sweep import Sweep  # noqa: E402
+from tradeoff_sweep import Point, Sweep  # noqa: E402
 
 SPP = [1 << k for k in range(11)]
 
@@ -89,9 +101,9 @@ def test_fixed_epsilon_variant_changes_only_the_offset():
     assert double.target == "lab01-ref-double" and double.not_built is None
 
 
-def run_tool(*args):
+def run_tool(*args, env=None):
     return subprocess.run([sys.executable, str(ROOT / "tools" / "tradeoff.py"), *map(str, args)],
-                          capture_output=True, text=True, timeout=900)
+                          capture_output=True, text=True, timeout=900, env=env)
 
 
 def read_csv(path):
@@ -99,22 +111,180 @@ def read_csv(path):
         return list(csv.DictReader(f))
 
 
-def test_quick_mode_passes(tmp_path):
-    p = subprocess.run(["make", "-s", "-C", str(ROOT), "tradeoff", "QUICK=1",
-                        f"REPORTS={tmp_path}"], capture_output=True, text=True, timeout=900)
+def without_matplotlib(tmp_path):
+    """An environment whose python cannot import matplotlib, as on the GPU machine."""
+    blocker = tmp_path / "no-matplotlib" / "matplotlib"
+    blocker.mkdir(parents=True)
+    (blocker / "__init__.py").write_text("raise ImportError('matplotlib blocked by the test')\n")
+    return {**os.environ, "PYTHONPATH": str(blocker.parent)}
+
+
+def test_quick_mode_passes_without_matplotlib_and_replots(tmp_path):
+    """`make tradeoff QUICK=1 PLOTS=0` measures where matplotlib cannot be imported (the GPU
+    machine) and writes no PNG; --replot then draws the plots from tradeoff.json and the
+    Markdown differs only by them."""
+    out = tmp_path / "report"
+    p = subprocess.run(["make", "-s", "-C", str(ROOT), "tradeoff", "QUICK=1", "PLOTS=0",
+                        f"REPORTS={out}"], capture_output=True, text=True, timeout=900,
+                       env=without_matplotlib(tmp_path))
     assert p.returncode == 0, p.stdout[-3000:] + p.stderr[-2000:]
     assert p.stdout.strip().splitlines()[-1].startswith("tradeoff: PASS")
-    fits = read_csv(tmp_path / "tradeoff-fits.csv")
+    fits = read_csv(out / "tradeoff-fits.csv")
     assert [r["series"] for r in fits] == ["lab01-ref"]
     assert abs(float(fits[0]["slope"]) + 0.5) <= 0.05 and not fits[0]["plateau_spp"]
-    bias = read_csv(tmp_path / "tradeoff-bias.csv")
+    bias = read_csv(out / "tradeoff-bias.csv")
     assert [int(r["bounces"]) for r in bias] == list(range(1, 9))
     assert all(r["pass"] == "pass" for r in bias)
-    report = (tmp_path / "tradeoff.md").read_text()
-    assert "lab01 double: variants are not in the quick plan" in report and "Verdict: PASS" in report
-    for png in ("tradeoff-error-time-cornell.png", "tradeoff-bias.png"):
-        assert (tmp_path / png).read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+    measured = (out / "tradeoff.md").read_text()
+    assert "lab01 double: not in the quick plan" in measured and "Verdict: PASS" in measured
+    assert "--replot" in measured and not list(out.glob("*.png")) and ".png" not in measured
+    record = (out / "tradeoff.json").read_text()
+
+    p = run_tool("--replot", out)
+    assert p.returncode == 0, p.stdout[-3000:] + p.stderr[-2000:]
+    report = (out / "tradeoff.md").read_text()
+    pngs = ("tradeoff-error-time-cornell.png", "tradeoff-bias.png")
+    for png in pngs:
+        assert (out / png).read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
         assert f"]({png})" in report
+    assert (out / "tradeoff.json").read_text() == record
+    drop = lambda text, *words: [l for l in text.splitlines()  # noqa: E731
+                                 if l and not any(w in l for w in words)]
+    assert drop(report, *pngs) == drop(measured, "--replot")
+
+
+def test_plots_without_matplotlib_are_refused_at_once(tmp_path):
+    p = run_tool("--quick", "--out", tmp_path, env=without_matplotlib(tmp_path))
+    assert p.returncode == 2 and p.stdout == "", (p.stdout, p.stderr)
+    lines = p.stderr.strip().splitlines()
+    assert len(lines) == 1 and "matplotlib" in lines[0] and "--no-plots" in lines[0], lines
+
+
+def fake_record():
+    """A record with what real runs produce at the edges: NaN efficiency, infinite SE."""
+    point = Point("lab05-ref", "cornell", 1, 2e-5, 0.4, 0.04, 0.07, -2e-4, 5e-4, 0, 0, True,
+                  1.6e-3, math.nan)
+    sweep = Sweep("lab05-ref", "cornell", True, [point, dataclasses.replace(point, spp=2)],
+                  fit=tradeoff_fit.Fit(-0.5, -3.2, 0.001, 2), plateau=None)
+    bias = tradeoff_bias.BiasPoint("lab01-ref", 1, 256, -0.76, math.inf, -0.76, math.inf,
+                                   0.01, 0)
+    machine = tradeoff_report.Machine("a CPU", 16, "2026-12-02 06:00 UTC", "0.1 0.2 0.3",
+                                      "0.4 0.5 0.6", "NVIDIA H200, driver 580")
+    return tradeoff_record.Record(machine, "gpu", "a note", [sweep], {"cornell": "golden"},
+                                  [("lab02-ref", "not in the gpu plan")], [bias], "setup", 32,
+                                  {"albedo": 0.8, "radius": 2.0, "intensity": 3.0}, [])
+
+
+def test_record_round_trips_exactly(tmp_path):
+    """What --replot reads back is what the run measured: the same JSON bytes when saved
+    again, the same Markdown, non-finite values included (written as strings: strict JSON)."""
+    record = fake_record()
+    path = tmp_path / "tradeoff.json"
+    tradeoff_record.save(path, record)
+    text = path.read_text()
+    assert "NaN" not in text and "Infinity" not in text and '"nan"' in text and '"inf"' in text
+    back = tradeoff_record.load(path)
+    assert math.isnan(back.sweeps[0].points[0].efficiency) and back.bias_points[0].ok
+    assert back.sweeps[0].fit == record.sweeps[0].fit and back.machine == record.machine
+    tradeoff_record.save(tmp_path / "again.json", back)
+    assert (tmp_path / "again.json").read_text() == text
+    page = dict(bias_setup="setup", plots={}, failures=[])
+    assert (tradeoff_report.markdown(machine=back.machine, mode=back.mode, note=back.note,
+                                     sweeps=back.sweeps, references=back.references,
+                                     unavailable=back.unavailable,
+                                     bias_points=back.bias_points, **page)
+            == tradeoff_report.markdown(machine=record.machine, mode=record.mode,
+                                        note=record.note, sweeps=record.sweeps,
+                                        references=record.references,
+                                        unavailable=record.unavailable,
+                                        bias_points=record.bias_points, **page))
+    assert "NVIDIA H200, driver 580" in tradeoff_report.markdown(
+        machine=back.machine, mode="gpu", note="", sweeps=[], references={}, unavailable=[],
+        bias_points=[], **page)
+
+
+def test_replot_refuses_what_is_not_a_record(tmp_path):
+    (tmp_path / "tradeoff.json").write_text('{"format": "bench-report rows v1"}')
+    p = run_tool("--replot", tmp_path)
+    assert p.returncode == 2 and p.stdout == ""
+    lines = p.stderr.strip().splitlines()
+    assert len(lines) == 1 and "not a record written by tools/tradeoff.py" in lines[0], lines
+
+
+def test_gpu_plan_leaves_out_what_it_says():
+    plan = tradeoff.PLANS["gpu"]
+    left_out = dict(tradeoff.not_in_plan(plan))
+    assert set(left_out) == {"lab02a-ref", "lab02-ref", "lab04-ref", "lab04-simd-ref",
+                             "lab01 fast-math", "lab01 fixed-epsilon"}
+    assert all(why == "not in the gpu plan" for why in left_out.values())
+    assert plan.gpu and plan.needs_gpu and plan.max_spp == tradeoff.FULL.max_spp
+    assert [name for name, *_ in tradeoff_series.GPU_REFERENCES] == ["lab05-ref", "lab05 double"]
+    assert "lab05-ref" in tradeoff.EXTREME_CHECKED
+
+
+def fake_nvidia_smi(folder, gpu_listed):
+    """An nvidia-smi on PATH that lists an H200 (compute capability 9.0), or no GPU."""
+    folder.mkdir(parents=True, exist_ok=True)
+    answer = ('case "$*" in *compute_cap*) echo 9.0;; *driver_version*) echo "NVIDIA H200, '
+              '580.00";; *) echo "NVIDIA H200";; esac' if gpu_listed else "exit 0")
+    (folder / "nvidia-smi").write_text(f"#!/bin/sh\n{answer}\n")
+    (folder / "nvidia-smi").chmod(0o755)
+    return {**os.environ, "PATH": f"{folder}:{os.environ['PATH']}"}
+
+
+@pytest.mark.skipif(tradeoff_series.gpu_missing() is None, reason="a real GPU is present")
+@pytest.mark.parametrize("gpu_listed, says", [
+    (False, "no NVIDIA GPU here (nvidia-smi lists none)"),
+    (True, "lab05-ref: does not build here: lab05-ref: needs the CUDA toolkit"),
+])
+def test_gpu_plan_without_a_usable_gpu_is_one_line(tmp_path, gpu_listed, says):
+    """--plan gpu stops before rendering when lab05-ref cannot run (here: no GPU listed, or
+    no nvcc), with one line saying why."""
+    build("lab01-ref")
+    env = fake_nvidia_smi(tmp_path / "bin", gpu_listed)
+    env["NVCC"] = "/no/such/nvcc"  # make's `NVCC ?= nvcc` takes it: lab05-ref cannot build
+    p = run_tool("--plan", "gpu", "--no-plots", "--out", tmp_path / "report", env=env)
+    assert p.returncode == 2, (p.stdout, p.stderr)
+    lines = p.stderr.strip().splitlines()
+    assert len(lines) == 1 and lines[0].startswith("error: the gpu plan needs "), lines
+    assert says in lines[0], lines
+    assert not (tmp_path / "report" / "tradeoff.md").exists()
+
+
+def test_a_gpu_build_without_a_gpu_does_not_run(tmp_path):
+    """What lab05-ref says where the driver is missing is the reason the report gives."""
+    fake = tmp_path / "lab05-ref"
+    fake.write_text("#!/bin/sh\necho 'error: GPU: no usable CUDA GPU: no NVIDIA driver "
+                    "(cudaErrorInsufficientDriver)' >&2\nexit 3\n")
+    fake.chmod(0o755)
+    assert tradeoff_series.does_not_run(fake) == (
+        "does not run here: GPU: no usable CUDA GPU: no NVIDIA driver "
+        "(cudaErrorInsufficientDriver)")
+    assert tradeoff_series.does_not_run(build("lab01-ref")[0]) is None
+
+
+def run_gpu_script(out, env):
+    return subprocess.run(["bash", str(ROOT / "tools" / "tradeoff_gpu.sh"), str(out)],
+                          capture_output=True, text=True, timeout=300,
+                          env={**env, "TRADEOFF_GPU_DRY_RUN": "1"})
+
+
+@pytest.mark.skipif(tradeoff_series.gpu_missing() is None, reason="a real GPU is present")
+def test_gpu_script_builds_for_the_gpu_present_and_runs_the_gpu_plan(tmp_path):
+    """tools/tradeoff_gpu.sh, dry: with an H200 listed it compiles CUDA code for sm_90 only
+    and runs the gpu plan without plots into DIR/tradeoff; with none listed it stops at once."""
+    p = run_gpu_script(tmp_path / "none", fake_nvidia_smi(tmp_path / "none-bin", False))
+    assert p.returncode == 2 and "no NVIDIA GPU here" in p.stdout, p.stdout + p.stderr
+    assert "would run" not in p.stdout
+
+    out = tmp_path / "h200"
+    p = run_gpu_script(out, fake_nvidia_smi(tmp_path / "h200-bin", True))
+    assert p.returncode == 0, p.stdout + p.stderr
+    assert "CUDA code for: -gencode arch=compute_90,code=sm_90 \n" in p.stdout, p.stdout
+    make_line = next(l for l in p.stdout.splitlines() if "would run: make" in l)
+    assert {"lab01-ref", "lab05-ref", "lab05-ref-double"} <= set(make_line.split()), make_line
+    assert f"tools/tradeoff.py --plan gpu --no-plots --out {out}/tradeoff" in p.stdout
+    assert {f.name for f in out.iterdir()} == {"log.txt", "machine.txt", "tradeoff"}
 
 
 def lab01_mutant(name, workdir):
@@ -157,6 +327,10 @@ def test_one_bounce_too_few_fails_the_bias_check(tmp_path):
     (["--binary", "/nonexistent/lab"], "no such file"),
     (["--quick", "--out", "/proc/no-such-folder"], "cannot write there"),
     (["--bounces", "3"], "unrecognized arguments"),
+    (["--quick", "--plan", "gpu"], "choose one"),
+    (["--plan", "gpus"], "invalid choice"),
+    (["--replot", "/nonexistent/report"], "cannot read it"),
+    (["--replot", "/nonexistent/report", "--quick"], "give it nothing else"),
 ])
 def test_bad_input_is_one_line_and_exit_2(args, says):
     p = run_tool(*args)
