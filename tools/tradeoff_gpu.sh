@@ -85,7 +85,7 @@ run() {  # run COMMAND...: shown in the log; only shown when TRADEOFF_GPU_DRY_RU
 say "CUDA code for: $(make -s print-cuda-build-command | grep -o -- '-gencode [^ ]*' | tr '\n' ' ')"
 # Every binary the plan may run (a full plan's variants are built by the tool itself). -k:
 # what builds is built; the tool says in its report which renderer did not.
-targets=(lab01-ref lab03-ref lab03-simd-ref lab01-ref-double lab05-ref lab05-ref-double)
+targets=(lab01-ref lab03-ref lab03-simd-ref lab01-ref-double lab05-ref lab05-ref-double lab06-ref lab07-ref)
 [ "$plan" = full ] && targets+=(lab02a-ref lab02-ref lab04-ref lab04-simd-ref)
 run make -k -j"$(nproc)" "${targets[@]}" >> "$log" 2>&1 || say "make: some targets failed (the report says which)"
 say "build done at $(elapsed) s"

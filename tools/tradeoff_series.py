@@ -134,6 +134,8 @@ GPU_REFERENCES = [
     ("lab05-ref", "lab05-ref", "CUDA megakernel (GPU)", True),
     ("lab05 double", "lab05-ref-double", "lab05-ref in double precision (-DRT_DOUBLE, GPU)",
      False),
+    ("lab06-ref", "lab06-ref", "CUDA wavefront, array-of-structures path pool (GPU)", True),
+    ("lab07-ref", "lab07-ref", "CUDA wavefront, structure-of-arrays path pool (GPU)", True),
 ]
 
 
