@@ -16,7 +16,7 @@
 // The arrays of one kind of item: kFields arrays of 4-byte words, one per scalar field, one
 // after another in the pool's allocation; field f of place k is words[f * stride + k]. One
 // pointer and one stride rather than a pointer per array: a kernel keeps the addresses it
-// uses in registers, and a pointer for each of the 26 arrays that shade_hits touches took
+// uses in registers, and a pointer for each of the 38 arrays in shade_hits' arguments took
 // it to 126 registers and a quarter of the GPU's threads (handouts/07-soa.md).
 template <int kFields>
 struct FieldArrays {
@@ -100,9 +100,11 @@ struct SoaRadiance {
 //> // Vec3 and a slot per queued path, and its PackedHit; the ShadowRay's fields and a slot
 //> // per shadow ray; a Vec3 per slot of radiance; a Vec3 is three float arrays), each taken
 //> // from the pool's one allocation in carve (ArrayCarver::take<T>() gives an array of T
-//> // with one element per slot), and the member functions of path_pool_aos.cuh reading and
-//> // writing them. Until then: nothing is stored and every load returns a default, a hit
-//> // included (no hit), so no path gathers any radiance: the image is black.
+//> // with one element per place; take_arrays<T>(n, stride) n of them at a fixed stride
+//> // from one pointer, which keeps the kernels' registers down: handouts/07-soa.md), and the
+//> // member functions of path_pool_aos.cuh reading and writing them. Until then: nothing is
+//> // stored and every load returns a default, a hit included (no hit), so no path gathers
+//> // any radiance: the image is black.
 //> struct SoaPaths {
 //>     void carve(ArrayCarver& c) { c.take<char>(); }
 //>     __device__ void store(int, const QueuedPath&) const {}
