@@ -275,8 +275,11 @@ def merge(out: pathlib.Path, gpu_json: pathlib.Path) -> dict:
     names = {r["binary"] for r in extra["rows"]}
     base["rows"] = [r for r in base["rows"] if r["binary"] not in names] + extra["rows"]
     base["skipped"] = {k: v for k, v in base.get("skipped", {}).items() if k not in names}
-    base.setdefault("merged", []).append({"machine": extra["machine"],
-                                          "binaries": sorted(names)})
+    # An earlier merge's note keeps only the binaries whose rows are still its own.
+    earlier = [{**m, "binaries": [b for b in m["binaries"] if b not in names]}
+               for m in base.get("merged", [])]
+    base["merged"] = [m for m in earlier if m["binaries"]] + [
+        {"machine": extra["machine"], "binaries": sorted(names)}]
     return base
 
 

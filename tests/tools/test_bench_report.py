@@ -103,6 +103,9 @@ def test_merge_adds_gpu_rows_with_speedups_over_this_reports_serial(quick, tmp_p
     assert tool("--merge", gpu, "--out", out).returncode == 0
     rows = [r for r in csv.DictReader(open(out / "bench.csv")) if r["binary"] == "lab05-ref"]
     assert len(rows) == SETTINGS and float(rows[0]["speedup"]) == pytest.approx(20.0, rel=1e-3)
+    # ... and its note: the machine line of the first merge no longer names these rows.
+    merged = json.loads((out / "bench.json").read_text())["merged"]
+    assert len(merged) == 1 and merged[0]["binaries"] == ["lab05-ref"], merged
 
 
 def test_merge_refuses_rows_measured_at_other_settings(quick, tmp_path):
