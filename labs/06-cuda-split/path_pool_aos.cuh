@@ -26,14 +26,18 @@
 
 #include "path_pool.cuh"
 
-struct AosPaths {
+// One record of kRows 16-byte rows per place, taken from the pool's allocation.
+template <int kRows>
+struct RowRecords {
     struct alignas(16) Record {
-        float4 row[3];
+        float4 row[kRows];
     };
     Record* records;
 
     void carve(ArrayCarver& c) { records = c.take<Record>(); }
+};
 
+struct AosPaths : RowRecords<3> {
     // The whole record: the hit's place gets "nothing hit", find_closest_hits fills it in.
     __device__ void store(int k, const QueuedPath& p) const {
         const Ray& r = p.ray;
@@ -61,14 +65,7 @@ struct AosPaths {
     }
 };
 
-struct AosShadowRays {
-    struct alignas(16) Record {
-        float4 row[3];
-    };
-    Record* records;
-
-    void carve(ArrayCarver& c) { records = c.take<Record>(); }
-
+struct AosShadowRays : RowRecords<3> {
     __device__ void store(int k, const QueuedShadowRay& q) const {
         const Ray& r = q.shadow.ray;
         const Vec3& l = q.shadow.radiance;
@@ -83,15 +80,11 @@ struct AosShadowRays {
     }
 };
 
-struct AosRadiance {
-    float4* rows;  // one per slot
-
-    void carve(ArrayCarver& c) { rows = c.take<float4>(); }
-
-    __device__ void start(int slot, Vec3 v) const { rows[slot] = make_float4(v.x, v.y, v.z, 0.0f); }
+struct AosRadiance : RowRecords<1> {
+    __device__ void start(int slot, Vec3 v) const { records[slot].row[0] = make_float4(v.x, v.y, v.z, 0.0f); }
     __device__ void add(int slot, Vec3 v) const { start(slot, load(slot) + v); }
     __device__ Vec3 load(int slot) const {
-        const float4 v = rows[slot];
+        const float4 v = records[slot].row[0];
         return Vec3(v.x, v.y, v.z);
     }
 };
