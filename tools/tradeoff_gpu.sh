@@ -8,8 +8,8 @@
 #      asks nvidia-smi for its compute capability: one architecture, not the six of its
 #      fallback);
 #   4. tools/tradeoff.py --plan gpu --no-plots: lab01-ref (the efficiency baseline), lab03-ref
-#      and lab03-simd-ref (OpenMP on every core), lab05-ref and lab05-ref-double, and lab 01's
-#      double build, spp 1..4096 on the Cornell box and the extreme scene, the bias sweep;
+#      and lab03-simd-ref (OpenMP on every core), lab05-ref, its double and --use_fast_math
+#      builds, lab06-ref and lab07-ref, and lab 01's double build, spp 1..4096 on the Cornell box and the extreme scene, the bias sweep;
 #      CSV, Markdown and tradeoff.json, no PNGs; stopped at the time budget;
 #   5. a short summary: the tables of the report.
 #
@@ -85,7 +85,8 @@ run() {  # run COMMAND...: shown in the log; only shown when TRADEOFF_GPU_DRY_RU
 say "CUDA code for: $(make -s print-cuda-build-command | grep -o -- '-gencode [^ ]*' | tr '\n' ' ')"
 # Every binary the plan may run (a full plan's variants are built by the tool itself). -k:
 # what builds is built; the tool says in its report which renderer did not.
-targets=(lab01-ref lab03-ref lab03-simd-ref lab01-ref-double lab05-ref lab05-ref-double lab06-ref lab07-ref)
+targets=(lab01-ref lab03-ref lab03-simd-ref lab01-ref-double lab05-ref lab05-ref-double lab05-ref-fast-math
+         lab06-ref lab07-ref)
 [ "$plan" = full ] && targets+=(lab02a-ref lab02-ref lab04-ref lab04-simd-ref)
 run make -k -j"$(nproc)" "${targets[@]}" >> "$log" 2>&1 || say "make: some targets failed (the report says which)"
 say "build done at $(elapsed) s"

@@ -134,6 +134,7 @@ GPU_REFERENCES = [
     ("lab05-ref", "lab05-ref", "CUDA megakernel (GPU)", True),
     ("lab05 double", "lab05-ref-double", "lab05-ref in double precision (-DRT_DOUBLE, GPU)",
      False),
+    ("lab05 fast-math", "lab05-ref-fast-math", "lab05-ref built with --use_fast_math (GPU)", False),
     ("lab06-ref", "lab06-ref", "CUDA wavefront, array-of-structures path pool (GPU)", True),
     ("lab07-ref", "lab07-ref", "CUDA wavefront, structure-of-arrays path pool (GPU)", True),
 ]
