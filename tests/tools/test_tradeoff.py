@@ -218,7 +218,12 @@ def test_gpu_plan_leaves_out_what_it_says():
                              "lab01 fast-math", "lab01 fixed-epsilon"}
     assert all(why == "not in the gpu plan" for why in left_out.values())
     assert plan.gpu and plan.needs_gpu and plan.max_spp == tradeoff.FULL.max_spp
-    assert [name for name, *_ in tradeoff_series.GPU_REFERENCES] == ["lab05-ref", "lab05 double"]
+    # Every GPU reference, and lab 05's double and fast-math builds as variants beside it.
+    assert [name for name, *_ in tradeoff_series.GPU_REFERENCES] == [
+        "lab05-ref", "lab05 double", "lab05 fast-math", "lab06-ref", "lab07-ref"]
+    targets = {target for _, target, *_ in tradeoff_series.GPU_REFERENCES}
+    script = (ROOT / "tools" / "tradeoff_gpu.sh").read_text()
+    assert all(t in script for t in targets), "tools/tradeoff_gpu.sh builds every GPU reference"
     assert "lab05-ref" in tradeoff.EXTREME_CHECKED
 
 
