@@ -11,12 +11,14 @@
 //   ./lab07-bench ...   the same, with lab 07's SoA pool too (bench_pools.cuh)
 //
 // The configurations: "megakernel" (lab 05's render_kernel in its reference shape),
-// "<layout>" (the lab reference: block-aggregated push, scene in shared memory when small,
-// 2^21 paths a wave, shading compiled for the scene's material kinds), "<layout>-atomic-per-warp"
-// and "<layout>-atomic-each" (one atomic per warp's pushes, per push), "<layout>-prefetch" (each thread loads its next item ahead),
-// "<layout>-grid-stride" (grids that fill the GPU once instead of one thread per place), "<layout>-global-scene", "<layout>-all-materials" (shading compiled
-// for every material kind, on a scene without mirrors or glass) and "<layout>-wave-N" (N
-// paths a wave).
+// "<layout>" (the lab reference: pushes reserved once per block, one thread per queue place,
+// scene in shared memory when small, 2^21 paths a wave, shading compiled for the scene's
+// material kinds), "<layout>-atomic-per-warp" and "<layout>-atomic-each" (pushes reserved
+// once per warp, once per thread), "<layout>-prefetch" (each thread loads its next item
+// ahead), "<layout>-grid-stride" (grids that fill the GPU once, threads striding over the
+// queue), "<layout>-global-scene", "<layout>-all-materials" (shading compiled for every
+// material kind, on a scene without mirrors or glass), "<layout>-occupancy-N" (registers
+// capped for N% occupancy) and "<layout>-wave-N" (N paths a wave).
 #include <algorithm>
 #include <cmath>
 #include <cstdio>

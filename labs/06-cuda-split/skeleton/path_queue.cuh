@@ -101,7 +101,7 @@ __device__ inline void for_each_place(int size, Work&& work) {
 // launches). With kPrefetch each thread loads its next item before it works on the current
 // one, so that the next item's trip from memory overlaps the current one's work: no faster
 // on the H200, where these kernels wait on arithmetic and atomics more than on loads
-// (handouts/06-cuda-split.md, section 5).
+// (handouts/06-cuda-split.md, section 2).
 template <bool kPrefetch = false, class Items, class Load, class Work>
 __device__ inline void for_each_queued(const Queue<Items>& queue, Load&& load, Work&& work) {
     const int size = *queue.size;
