@@ -9,7 +9,8 @@
     tools/tradeoff.py --quick --binary PATH   the quick checks on any lab-01-compatible build
     tools/tradeoff.py --plan gpu --no-plots   on a GPU machine without matplotlib
                              (tools/tradeoff_gpu.sh): lab01-ref as the baseline, OpenMP on
-                             every core, lab05-ref and its double build; no PNGs
+                             every core, the GPU labs' references, lab 05's double and fast-
+                             math builds; no PNGs
     tools/tradeoff.py --replot DIR            here, afterwards: the plots and Markdown of the
                              report in DIR, drawn from its tradeoff.json
 
@@ -69,8 +70,8 @@ QUICK = Plan("quick (CI size)", ("lab01-ref",), 1024, False, (), False,
 FULL = Plan("full", None, 4096, True, None, True, 32, 1024, tuple(range(1, 17)), 64)
 # The GPU machine's plan (tools/tradeoff_gpu.sh): FULL's sweeps for the GPU references, with
 # lab01-ref as the efficiency baseline, OpenMP on every core as the CPU's best, and lab 01's
-# double build beside lab 05's. Estimated at 1.5-2 minutes there (16 cores), from the
-# 2-core VM's committed times and 0.3-0.4 s of CUDA start-up per GPU render; not yet measured.
+# double build beside lab 05's. 124 s on the H200 machine's 16 cores
+# (reference/reports/tradeoff-h200-2026-12-02/).
 GPU = Plan("gpu", ("lab01-ref", "lab03-ref", "lab03-simd-ref"), 4096, True, ("lab01 double",),
            True, 32, 1024, tuple(range(1, 17)), 64, needs_gpu=True)
 PLANS = {plan.name.split()[0]: plan for plan in (FULL, QUICK, GPU)}

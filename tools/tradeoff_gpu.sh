@@ -19,8 +19,8 @@
 #   TRADEOFF_GPU_BUDGET=S   seconds for the whole script (default 270: a 5-minute call's
 #                           limit less start-up and copying); the tool gets what the build
 #                           leaves, less 15 s for the summary
-#   TRADEOFF_PLAN=full      another plan of tools/tradeoff.py (full: estimated at 3-4 minutes
-#                           there, close to the budget; the gpu plan at 1.5-2 minutes)
+#   TRADEOFF_PLAN=full      another plan of tools/tradeoff.py (full: not run there; the gpu
+#                           plan took 124 s in all on the H200 machine, build included)
 #
 # DIR then holds tradeoff/ (tradeoff.md, tradeoff.csv, tradeoff-fits.csv, tradeoff-bias.csv,
 # tradeoff.json), log.txt and machine.txt: 7 files. Back here, with matplotlib:
