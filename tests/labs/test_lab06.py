@@ -125,7 +125,7 @@ def test_targets_build_with_nvcc(lab06_ref):
 
 def test_skeleton_in_sync():
     """The committed skeleton is exactly what tools/skeletons.py makes from the solution:
-    the push and the stage loop are what students write."""
+    the queue's reserve and the stage loop are what students write."""
     from grading.variants import pristine_skeleton_sources
     expected = pristine_skeleton_sources(LAB)
     assert set(expected) == {"path_queue.cuh", "render.cu", "stage_loop.cuh"}
@@ -227,8 +227,8 @@ def lab06_pristine_skeleton(nvcc, tmp_path_factory):
 
 
 def test_skeleton_is_visibly_incomplete(gpu, lab06_pristine_skeleton):
-    """Until students write the push and the stage loop, the skeleton builds and renders, but
-    not the right image: its racy push loses nearly every path (measured on an H200: a black
+    """Until students write the reserve and the stage loop, the skeleton builds and renders, but
+    not the right image: its racy reserve loses nearly every path (measured on an H200: a black
     32x32 image), and only the first interaction runs."""
     skeleton = lab06_pristine_skeleton
     assert not checks.check_golden(skeleton, "cornell").passed
