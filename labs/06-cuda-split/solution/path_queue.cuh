@@ -113,8 +113,7 @@ __device__ inline void for_each_place(int size, Work&& work) {
 // thread on its own (t, t + threads, t + 2 threads, ...; one turn with the grid the host
 // launches). With kPrefetch each thread loads its next item before it works on the current
 // one, so that the next item's trip from memory overlaps the current one's work: no faster
-// on the H200, where these kernels wait on arithmetic and atomics more than on loads
-// (handouts/06-cuda-split.md, section 2).
+// on the H200 (handouts/06-cuda-split.md, section 2), so off by default.
 template <bool kPrefetch = false, class Items, class Load, class Work>
 __device__ inline void for_each_queued(const Queue<Items>& queue, Load&& load, Work&& work) {
     const int size = *queue.size;
