@@ -79,9 +79,9 @@ def test_speed_is_measured_against_the_labs_own_reference(lab, monkeypatch):
     assert seen["binary"] == "student-binary"
     assert seen["baseline"] == seen["overhead_reference"] == ROOT / f"lab{lab}-ref"
     assert seen["scale"] == GPU_TIMED_SCALE >= 8 and 0 < seen["bar"] < 1
-    # At least 2e8 paths: ~0.37 s of kernel time for the slowest reference (lab 06) on the
-    # H200, more for the faster ones, whose spp is higher (grading/grade.py).
-    assert seen["spp"] * (64 * seen["scale"]) ** 2 >= 2e8
+    # At least 8e8 paths: 0.3-0.4 s of each reference's kernel time on the H200 (lab 06, the
+    # slowest, renders 2.5 Gpaths/s there; grading/grade.py), far above the ~0.3 s start-up.
+    assert seen["spp"] * (64 * seen["scale"]) ** 2 >= 8e8
 
 
 # ---- host side: the mutants still are what they say -------------------------------------------
