@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# make tradeoff's GPU rows (issue 12), measured on a GPU machine that has python3 with numpy
+# make tradeoff's GPU rows, measured on a GPU machine that has python3 with numpy
 # but no matplotlib and no package registry (the course's H200 machine):
 #   1. the machine: GPU, driver, nvcc, compilers, cores, load;
 #   2. the JSON library from the carried .gpu-deps/ where the compiler has none (as
