@@ -58,7 +58,7 @@ help:
 	@echo "make lab05-bench  the lab-05 kernel shapes the handout measures (needs a GPU)"
 	@echo "make test         build everything and run every test"
 	@echo "make bench        the report's Tables 4-7 here: every lab, baseline + 3 sweeps, with"
-	@echo "                  plots (QUICK=1: CI size; SCALE=K: sides / K; full: ~25 min a round on 2 quiet cores)"
+	@echo "                  plots (QUICK=1: CI size; SCALE=K: sides / K; full: ~25 min a round, 2 cores)"
 	@echo "make bench-serial time the lab-01 reference on the Cornell baseline (minutes)"
 	@echo "make bench-cpu    the CPU labs side by side (the report's Table 4 for this machine)"
 	@echo "make bench-micro  Google Benchmark of the inner loops (closest hit, shadow ray, path)"
