@@ -156,15 +156,19 @@ struct ShadowRay {
 RT_HD inline bool sample_light(const SceneView& scene, Vec3 position, Vec3 origin,
                                Vec3 facing_normal, Vec3 albedo, ShadowRay& shadow) {
     // BEGIN SOLUTION
+    // Every test is written so that NaN fails it: a light exactly at the surface point (a
+    // camera ray that lands on it) has distance 0, no direction (0/0) and no finite radiance.
     const Vec3 to_light = scene.light.position - position;
     const real distance2 = length_squared(to_light);
     const real distance = sqrt_real(distance2);
     const Vec3 wi = to_light * (real(1) / distance);
     const real cos_theta = dot(facing_normal, wi);
-    if (cos_theta <= 0.0f) return false;  // light behind the surface
+    const real falloff = cos_theta / (kPi * distance2);
+    // Light behind the surface, or at the point itself (NaN, or a falloff past the range).
+    if (!(cos_theta > 0.0f) || !(falloff < kRealMax)) return false;
     shadow.ray = {origin, wi};
     shadow.t_max = distance - dot(origin - position, wi);
-    shadow.radiance = albedo * scene.light.intensity * (cos_theta / (kPi * distance2));
+    shadow.radiance = albedo * scene.light.intensity * falloff;
     return true;
     // SKELETON
     //> // TODO(lab01): the light sample. From `position`: the direction wi and distance d to
@@ -220,19 +224,30 @@ RT_HD RT_FORCE_INLINE bool bounce_step(const SceneView& scene, const Hit& hit, c
     }
     if constexpr (Materials::kSpecular) {
         if (!path.alive) return false;
+        // A specular path may bounce 64 times inside a closed mirror or glass room, and must
+        // stay inside: its origin also steps off any edge of a triangle it lies on
+        // (step_off_edges, triangle.h), and a reflected direction is renormalised. Unnormalised,
+        // its length drifts by ~1e-7 a bounce; the sphere test assumes a unit direction, and
+        // after ~10 bounces its hits overshoot the ray offset (the paths escaped a closed mirror
+        // sphere). refract() normalises already.
+        const Vec3 off_edges =
+            hit.triangle >= 0
+                ? step_off_edges(scene.triangles[hit.triangle], surface.position,
+                                 ray_offset(surface.position, hit.t, surface.extent))
+                : Vec3(0.0f);
         if (!Materials::kGlass || (Materials::kMirror && material.type == MaterialType::Mirror)) {
             path.throughput *= material.albedo;
-            path.ray = {above, reflect(incoming, facing)};
+            path.ray = {above + off_edges, normalize(reflect(incoming, facing))};
         } else {  // glass: reflect or refract, chosen with the Fresnel reflectance
             const real eta = entering ? real(1) / material.ior : material.ior;
             real cos_t;
             const real reflectance = fresnel_dielectric(-dot(incoming, facing), eta, cos_t);
             if (rng.at(bounce_dimension(bounce, 0)) < reflectance) {
-                path.ray = {above, reflect(incoming, facing)};
+                path.ray = {above + off_edges, normalize(reflect(incoming, facing))};
             } else {
                 const Vec3 below =
                     offset_ray_origin(surface.position, -facing, hit.t, surface.extent);
-                path.ray = {below, refract(incoming, facing, eta, cos_t)};
+                path.ray = {below + off_edges, refract(incoming, facing, eta, cos_t)};
             }
         }
     }

@@ -54,6 +54,30 @@ inline Triangle make_triangle(Vec3 v0, Vec3 v1, Vec3 v2, int material) {
     return tri;
 }
 
+// A point of a triangle that lies on one of its edges (or within rounding of it) lies on the
+// neighbouring face's plane too: at a closed room's corner, the face across the edge. A ray
+// offset along this triangle's normal alone (ray.h) leaves this plane but not that one, so the
+// next ray may start just behind the neighbour, pass through it, and leave the room (a closed
+// mirror cube lost one path in 368,640 that way at 64 bounces). step_off_edges is the step,
+// within the triangle's plane, that also takes p `margin` inside every edge nearer than that:
+// for each such edge, `margin` along its inward perpendicular. With the normal offset, the
+// origin then lies in front of every face that meets this one at an edge at more than 45
+// degrees, as a room's walls do. Zero for a point farther than `margin` from every edge.
+RT_HD inline void step_off_edge(Vec3 normal, Vec3 from, Vec3 to, Vec3 p, real margin,
+                                Vec3& step) {
+    const Vec3 inward = cross(normal, to - from);  // in the plane, toward the inside
+    const real inward_length = length(inward);     // the edge's length
+    const real depth = dot(p - from, inward);      // distance inside the edge x inward_length
+    if (!(depth >= margin * inward_length)) step += inward * (margin / inward_length);
+}
+RT_HD inline Vec3 step_off_edges(const Triangle& tri, Vec3 p, real margin) {
+    Vec3 step(0.0f);
+    step_off_edge(tri.normal, tri.v0, tri.v1, p, margin, step);
+    step_off_edge(tri.normal, tri.v1, tri.v2, p, margin, step);
+    step_off_edge(tri.normal, tri.v2, tri.v0, p, margin, step);
+    return step;
+}
+
 // Per-ray constants of the watertight test: the axis permutation that makes the ray's
 // dominant axis z, and the shear that maps the ray onto +z.
 struct RayShear {
