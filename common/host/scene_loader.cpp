@@ -59,13 +59,18 @@ public:
         return obj.at(key);
     }
 
-    real number(const json& v, const std::string& pointer) const {
+    // The number as the file writes it (a double), within the range `real` holds.
+    double written_number(const json& v, const std::string& pointer) const {
         if (!v.is_number()) fail(pointer, "expected a number, found " + type_of(v));
         const double d = v.get<double>();
         if (!std::isfinite(d) || std::fabs(d) > kMaxNumber)
             fail(pointer, std::string("expected a finite number within ") + kPrecisionName +
                               " range");
-        return static_cast<real>(d);
+        return d;
+    }
+
+    real number(const json& v, const std::string& pointer) const {
+        return static_cast<real>(written_number(v, pointer));
     }
 
     Vec3 vec3(const json& v, const std::string& pointer) const {
@@ -116,26 +121,33 @@ private:
     const std::map<std::string, size_t>& offsets_;
 };
 
-// A point of the scene, within what the renderer's arithmetic handles (scene_limits.h).
-Vec3 read_position(const SceneReader& r, const json& v, const std::string& pointer) {
+// A point of the scene, within what the renderer's arithmetic handles (scene_limits.h), and
+// the same point as the file writes it, in double.
+Vec3 read_position(const SceneReader& r, const json& v, const std::string& pointer,
+                   WrittenPoint& written) {
     const Vec3 p = r.vec3(v, pointer);
+    double c[3];
     for (int axis = 0; axis < 3; ++axis) {
-        const std::string problem = coordinate_problem(p[axis]);
+        c[axis] = r.written_number(v[axis], pointer + "/" + std::to_string(axis));
+        const std::string problem = coordinate_problem(c[axis]);
         if (!problem.empty()) r.fail(pointer + "/" + std::to_string(axis), problem);
     }
+    written = {c[0], c[1], c[2]};
     return p;
 }
 
 // The triangle of vertices a, b, c of a primitive's "vertices", refused if it would not
 // render (scene_limits.h).
 Triangle read_triangle(const SceneReader& r, const json& obj, const std::string& p,
-                       const std::vector<Vec3>& v, int a, int b, int c, int material) {
+                       const std::vector<Vec3>& v, int a, int b, int c, int material,
+                       Scene& scene) {
     const Triangle tri = make_triangle(v[a], v[b], v[c], material);
     double written[3][3];
     const int corners[3] = {a, b, c};
     for (int k = 0; k < 3; ++k) {
         for (int axis = 0; axis < 3; ++axis)
             written[k][axis] = obj["vertices"][corners[k]][axis].get<double>();
+        scene.written.triangle_vertices.push_back({written[k][0], written[k][1], written[k][2]});
     }
     const std::string problem = triangle_problem(written, tri);
     if (!problem.empty()) r.fail(p + "/vertices", problem);
@@ -144,21 +156,41 @@ Triangle read_triangle(const SceneReader& r, const json& obj, const std::string&
 
 // The parts of a scene file, one reader each, in the order of the format's description.
 
-void read_camera(const SceneReader& r, const json& root, CameraSpec& camera) {
+// The view's direction and its checks are the file's numbers, in double: in float, a look_at
+// 1e-23 away (or a whole scene at scale 1e-25) has a squared distance that underflows to 0,
+// and the camera was refused as looking at itself.
+void read_camera(const SceneReader& r, const json& root, Scene& scene) {
+    CameraSpec& camera = scene.camera;
+    WrittenPoint& from = scene.written.camera_position;
+    WrittenPoint& to = scene.written.camera_look_at;
     const json& cam = r.require(root, "", "camera");
     r.check_keys(cam, "/camera", {"position", "look_at", "up", "vfov"});
-    camera.position = read_position(r, r.require(cam, "/camera", "position"), "/camera/position");
-    camera.look_at = read_position(r, r.require(cam, "/camera", "look_at"), "/camera/look_at");
+    camera.position =
+        read_position(r, r.require(cam, "/camera", "position"), "/camera/position", from);
+    camera.look_at =
+        read_position(r, r.require(cam, "/camera", "look_at"), "/camera/look_at", to);
     if (cam.contains("up")) camera.up = r.vec3(cam["up"], "/camera/up");
     if (cam.contains("vfov")) {
         camera.vfov_degrees = r.number(cam["vfov"], "/camera/vfov");
         if (!(camera.vfov_degrees > 0.0f && camera.vfov_degrees < 180.0f))
             r.fail("/camera/vfov", "expected a field of view in degrees, in (0, 180)");
     }
-    const Vec3 forward = camera.look_at - camera.position;
-    if (length_squared(forward) == 0.0f)
+    const double forward[3] = {to.x - from.x, to.y - from.y, to.z - from.z};
+    if (forward[0] == 0.0 && forward[1] == 0.0 && forward[2] == 0.0)
         r.fail("/camera/look_at", "expected a point different from the camera position");
-    if (length_squared(cross(forward, camera.up)) == 0.0f)
+    for (int axis = 0; axis < 3; ++axis) camera.forward[axis] = forward[axis];
+    // Parallel or not, on unit vectors: a cross product of raw ones can underflow.
+    const double f_length = std::hypot(forward[0], forward[1], forward[2]);
+    const double up[3] = {camera.up.x, camera.up.y, camera.up.z};
+    const double up_length = std::hypot(up[0], up[1], up[2]);
+    double f[3], u[3];
+    for (int axis = 0; axis < 3; ++axis) {
+        f[axis] = forward[axis] / f_length;
+        u[axis] = up[axis] / up_length;
+    }
+    const double right[3] = {f[1] * u[2] - f[2] * u[1], f[2] * u[0] - f[0] * u[2],
+                             f[0] * u[1] - f[1] * u[0]};
+    if (!(up_length > 0.0) || std::hypot(right[0], right[1], right[2]) < 1e-30)
         r.fail("/camera/up", "expected an up vector not parallel to the viewing direction");
 }
 
@@ -167,8 +199,8 @@ void read_light(const SceneReader& r, const json& root, Scene& scene) {
     const json& light = root["light"];
     r.check_keys(light, "/light", {"position", "intensity"});
     scene.has_light = true;
-    scene.light.position =
-        read_position(r, r.require(light, "/light", "position"), "/light/position");
+    scene.light.position = read_position(r, r.require(light, "/light", "position"),
+                                         "/light/position", scene.written.light_position);
     scene.light.intensity =
         r.non_negative_vec3(r.require(light, "/light", "intensity"), "/light/intensity");
 }
@@ -238,13 +270,15 @@ public:
     }
 
     std::vector<Vec3> vertices(const json& obj, const std::string& p, size_t count) const {
+        WrittenPoint unused;  // read_triangle reads the written vertices itself
         const json& v = r_.require(obj, p, "vertices");
         if (!v.is_array() || v.size() != count)
             r_.fail(p + "/vertices", "expected an array of " + std::to_string(count) +
                                          " points, found " + SceneReader::type_of(v));
         std::vector<Vec3> points;
         for (size_t k = 0; k < count; ++k)
-            points.push_back(read_position(r_, v[k], p + "/vertices/" + std::to_string(k)));
+            points.push_back(
+                read_position(r_, v[k], p + "/vertices/" + std::to_string(k), unused));
         return points;
     }
 
@@ -260,13 +294,15 @@ void read_spheres(const SceneReader& r, const PrimitiveReader& prims, Scene& sce
         const std::string p = "/spheres/" + std::to_string(i);
         r.check_keys(spheres[i], p, {"center", "radius", "material"});
         Sphere s{};
-        s.center = read_position(r, r.require(spheres[i], p, "center"), p + "/center");
+        WrittenPoint centre;
+        s.center = read_position(r, r.require(spheres[i], p, "center"), p + "/center", centre);
         s.radius = r.number(r.require(spheres[i], p, "radius"), p + "/radius");
         if (!(s.radius > 0.0f)) r.fail(p + "/radius", "expected a radius > 0");
         const std::string problem = sphere_problem(s);
         if (!problem.empty()) r.fail(p + "/radius", problem);
         s.material = prims.material(spheres[i], p);
         scene.spheres.push_back(s);
+        scene.written.sphere_centres.push_back(centre);
     }
 }
 
@@ -278,7 +314,7 @@ void read_triangles(const SceneReader& r, const PrimitiveReader& prims, Scene& s
         r.check_keys(triangles[i], p, {"vertices", "material"});
         const auto v = prims.vertices(triangles[i], p, 3);
         scene.triangles.push_back(
-            read_triangle(r, triangles[i], p, v, 0, 1, 2, prims.material(triangles[i], p)));
+            read_triangle(r, triangles[i], p, v, 0, 1, 2, prims.material(triangles[i], p), scene));
     }
     const json& quads = prims.list("quads");
     for (size_t i = 0; i < quads.size(); ++i) {
@@ -286,8 +322,8 @@ void read_triangles(const SceneReader& r, const PrimitiveReader& prims, Scene& s
         r.check_keys(quads[i], p, {"vertices", "material"});
         const auto v = prims.vertices(quads[i], p, 4);
         const int m = prims.material(quads[i], p);
-        scene.triangles.push_back(read_triangle(r, quads[i], p, v, 0, 1, 2, m));
-        scene.triangles.push_back(read_triangle(r, quads[i], p, v, 0, 2, 3, m));
+        scene.triangles.push_back(read_triangle(r, quads[i], p, v, 0, 1, 2, m, scene));
+        scene.triangles.push_back(read_triangle(r, quads[i], p, v, 0, 2, 3, m, scene));
     }
 }
 
@@ -318,7 +354,8 @@ Scene parse_scene(const std::string& text, const std::string& name) {
 
     Scene scene;
     scene.name = name;
-    read_camera(r, root, scene.camera);
+    scene.written.present = true;
+    read_camera(r, root, scene);
     if (root.contains("background"))
         scene.background = r.non_negative_vec3(root["background"], "/background");
     read_light(r, root, scene);
