@@ -15,39 +15,52 @@ constexpr long kMaxBounces = 64;
 // JSON reader (and a double) holds exactly.
 constexpr long long kMaxSeed = (1LL << 53) - 1;
 
+// A point as the scene file writes it: the JSON numbers as doubles, before rounding to `real`.
+struct WrittenPoint {
+    double x = 0.0, y = 0.0, z = 0.0;
+
+    // Whether this point, rounded, is `p`: whether p still stands for it.
+    bool rounds_to(Vec3 p) const {
+        return static_cast<real>(x) == p.x && static_cast<real>(y) == p.y &&
+               static_cast<real>(z) == p.z;
+    }
+};
+
 // The camera as the file states it; the Camera proper depends on the image size.
 struct CameraSpec {
     Vec3 position{0.5f, 0.5f, 1.0f};
     Vec3 look_at{0.5f, 0.5f, 0.0f};
     Vec3 up{0.0f, 1.0f, 0.0f};
     real vfov_degrees = 55.0f;
-    // look_at - position as the file writes them, in double (the loader sets it): the view's
-    // direction, which rounding the two points to `real` first could turn by degrees when
-    // they lie close together far from the origin. Zero: look_at - position is used.
-    double forward[3] = {0.0, 0.0, 0.0};
+    // position and look_at as the file writes them (the loader sets them, centre_scene moves
+    // them): the view's direction is their difference in double. Rounding the two points
+    // first could turn it by degrees when they lie close together far from the origin. Used
+    // while position and look_at are still these points rounded.
+    bool written = false;
+    WrittenPoint written_position, written_look_at;
 
     Camera for_image(int width, int height) const {
-        if (forward[0] == 0.0 && forward[1] == 0.0 && forward[2] == 0.0)
+        if (!(written && written_position.rounds_to(position) &&
+              written_look_at.rounds_to(look_at)))
             return Camera::look_at(position, look_at, up, vfov_degrees, width, height);
+        const double forward[3] = {written_look_at.x - written_position.x,
+                                   written_look_at.y - written_position.y,
+                                   written_look_at.z - written_position.z};
         return Camera::looking_along(position, forward, up, vfov_degrees, width, height);
     }
-};
-
-// A point as the scene file writes it: the JSON numbers as doubles, before rounding to `real`.
-struct WrittenPoint {
-    double x = 0.0, y = 0.0, z = 0.0;
 };
 
 // The scene's points as the file writes them, parallel to the Scene's own rounded ones.
 // centre_scene (scene_centring.h) moves the scene by differences of these and rounds once,
 // after the move: rounded first, every point of a scene moved 1e4 of its sizes away kept an
 // error of ulp(1e4) ~ 1e-3 of its size through the move (a lamp 1e-2 above a floor rendered it
-// 4.9% too bright). A scene built in code has none (`present` false) and is moved by its own.
+// 4.9% too bright). A point the scene no longer holds (changed after loading, or a scene built
+// in code) is moved from the scene's own.
 struct WrittenCoordinates {
     bool present = false;
-    WrittenPoint camera_position, camera_look_at, light_position;
-    std::vector<WrittenPoint> sphere_centres;          // parallel to Scene::spheres
-    std::vector<WrittenPoint> triangle_vertices;       // 3 per entry of Scene::triangles
+    WrittenPoint light_position;
+    std::vector<WrittenPoint> sphere_centres;     // parallel to Scene::spheres
+    std::vector<WrittenPoint> triangle_vertices;  // 3 per entry of Scene::triangles
 };
 
 struct Scene {

@@ -23,32 +23,42 @@ struct BoundsD {
 };
 
 WrittenPoint exact(Vec3 p) { return {p.x, p.y, p.z}; }
+Vec3 rounded(WrittenPoint p) {
+    return {static_cast<real>(p.x), static_cast<real>(p.y), static_cast<real>(p.z)};
+}
 
-// The scene's points in double: as the file writes them, or, for a scene built in code (or
-// one whose arrays were changed after loading), its own.
+// The written point while `own` still stands for it, else `own`.
+WrittenPoint pick(bool have, const WrittenPoint& written, Vec3 own) {
+    return have && written.rounds_to(own) ? written : exact(own);
+}
+
+// The scene's points in double: as the file writes them where the scene still holds them
+// (the written point rounds to the scene's own), else the scene's own: a scene built in
+// code, or a point changed after loading.
 struct ExactPoints {
     const Scene& scene;
-    bool written() const {
+    bool sized() const {
         return scene.written.present &&
                scene.written.sphere_centres.size() == scene.spheres.size() &&
                scene.written.triangle_vertices.size() == 3 * scene.triangles.size();
     }
     WrittenPoint sphere(size_t i) const {
-        return written() ? scene.written.sphere_centres[i] : exact(scene.spheres[i].center);
+        return pick(sized(), sized() ? scene.written.sphere_centres[i] : WrittenPoint{},
+                    scene.spheres[i].center);
     }
     WrittenPoint vertex(size_t i, int k) const {
-        if (written()) return scene.written.triangle_vertices[3 * i + k];
         const Triangle& t = scene.triangles[i];
-        return exact(k == 0 ? t.v0 : (k == 1 ? t.v1 : t.v2));
+        return pick(sized(), sized() ? scene.written.triangle_vertices[3 * i + k] : WrittenPoint{},
+                    k == 0 ? t.v0 : (k == 1 ? t.v1 : t.v2));
     }
     WrittenPoint camera_position() const {
-        return written() ? scene.written.camera_position : exact(scene.camera.position);
+        return pick(scene.camera.written, scene.camera.written_position, scene.camera.position);
     }
     WrittenPoint camera_look_at() const {
-        return written() ? scene.written.camera_look_at : exact(scene.camera.look_at);
+        return pick(scene.camera.written, scene.camera.written_look_at, scene.camera.look_at);
     }
     WrittenPoint light() const {
-        return written() ? scene.written.light_position : exact(scene.light.position);
+        return pick(scene.written.present, scene.written.light_position, scene.light.position);
     }
 };
 
@@ -68,10 +78,6 @@ void centre_of_bounds(const Scene& scene, double centre[3]) {
 WrittenPoint minus(WrittenPoint p, const double centre[3]) {
     return {p.x - centre[0], p.y - centre[1], p.z - centre[2]};
 }
-Vec3 rounded(WrittenPoint p) {
-    return {static_cast<real>(p.x), static_cast<real>(p.y), static_cast<real>(p.z)};
-}
-
 }  // namespace
 
 Vec3 centring_offset(const Scene& scene) {
@@ -95,8 +101,8 @@ Scene centre_scene(Scene scene) {
         for (int k = 0; k < 3; ++k)
             moved.triangle_vertices.push_back(minus(points.vertex(i, k), centre));
     }
-    moved.camera_position = minus(points.camera_position(), centre);
-    moved.camera_look_at = minus(points.camera_look_at(), centre);
+    const WrittenPoint camera_position = minus(points.camera_position(), centre);
+    const WrittenPoint camera_look_at = minus(points.camera_look_at(), centre);
     moved.light_position = minus(points.light(), centre);
 
     for (size_t i = 0; i < scene.spheres.size(); ++i)
@@ -106,9 +112,12 @@ Scene centre_scene(Scene scene) {
         scene.triangles[i] = make_triangle(rounded(v[0]), rounded(v[1]), rounded(v[2]),
                                            scene.triangles[i].material);
     }
-    scene.camera.position = rounded(moved.camera_position);
-    scene.camera.look_at = rounded(moved.camera_look_at);
+    scene.camera.position = rounded(camera_position);
+    scene.camera.look_at = rounded(camera_look_at);
+    scene.camera.written = true;
+    scene.camera.written_position = camera_position;
+    scene.camera.written_look_at = camera_look_at;
     scene.light.position = rounded(moved.light_position);
-    scene.written = moved;  // the camera's forward is a difference: the move keeps it
+    scene.written = moved;
     return scene;
 }

@@ -16,6 +16,12 @@
 //  - A triangle with an area as written must keep one when its vertices are rounded to
 //    float (else its normal is zero and it is never hit). One that has no area as written is
 //    kept: it has nothing to show.
+//  - In the float build, no size below 2^-20 of the whole scene's extent (its largest
+//    |coordinate| once centred, common/host/scene_centring.h): float's spacing there is
+//    2^-23 of it and a ray that crossed the scene leaves a surface by 2^-20 of it (ray.h),
+//    so such a detail is not placed, or not lit, where it is (a sphere of radius 1e-4 on a
+//    floor of half-size 1e4 rendered the floor 10% too dark). Details down to 2^-14 of the
+//    extent render with a warning (scene_report.h). The double build holds them; it says so.
 // Each function returns what is wrong, or an empty string.
 #pragma once
 
@@ -39,6 +45,7 @@ constexpr const char* kMinSizeText = "1e-9";
 constexpr double kMaxNumber = 3.0e38;  // within float range
 #endif
 constexpr double kMinRelativeSize = 1.0 / (1 << 18);
+constexpr double kMinSceneRelativeSize = 1.0 / (1 << 20);
 
 inline std::string format_number(double x) {
     char text[32];
@@ -94,4 +101,18 @@ inline std::string triangle_problem(const double (&written)[3][3], const Triangl
         return std::string("the triangle collapses to a line when its vertices are rounded to ") +
                kPrecisionName + ": make it larger or move it nearer the origin";
     return "";
+}
+
+// A size against the whole scene's centred extent (see above); the float build's limit only.
+inline std::string scene_scale_problem(const char* what, double size, double scene_extent) {
+#if defined(RT_DOUBLE)
+    (void)what, (void)size, (void)scene_extent;
+    return "";
+#else
+    if (!(size < kMinSceneRelativeSize * scene_extent)) return "";
+    return std::string(what) + " of " + format_number(size) + " is below 2^-20 of the scene's " +
+           "extent (" + format_number(scene_extent) + " from its centre), finer than float " +
+           "arithmetic places it there: render the scene with the double build (make " +
+           "lab01-ref-double), or make the detail larger or the scene smaller";
+#endif
 }

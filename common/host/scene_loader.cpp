@@ -11,6 +11,7 @@
 
 #include <errors.h>
 #include <json_with_positions.h>
+#include <scene_centring.h>
 #include <scene_limits.h>
 
 using nlohmann::json;
@@ -161,8 +162,9 @@ Triangle read_triangle(const SceneReader& r, const json& obj, const std::string&
 // and the camera was refused as looking at itself.
 void read_camera(const SceneReader& r, const json& root, Scene& scene) {
     CameraSpec& camera = scene.camera;
-    WrittenPoint& from = scene.written.camera_position;
-    WrittenPoint& to = scene.written.camera_look_at;
+    WrittenPoint& from = camera.written_position;
+    WrittenPoint& to = camera.written_look_at;
+    camera.written = true;
     const json& cam = r.require(root, "", "camera");
     r.check_keys(cam, "/camera", {"position", "look_at", "up", "vfov"});
     camera.position =
@@ -177,8 +179,9 @@ void read_camera(const SceneReader& r, const json& root, Scene& scene) {
     }
     const double forward[3] = {to.x - from.x, to.y - from.y, to.z - from.z};
     if (forward[0] == 0.0 && forward[1] == 0.0 && forward[2] == 0.0)
-        r.fail("/camera/look_at", "expected a point different from the camera position");
-    for (int axis = 0; axis < 3; ++axis) camera.forward[axis] = forward[axis];
+        r.fail("/camera/look_at",
+               "expected a point different from the camera position (as doubles, they are "
+               "equal)");
     // Parallel or not, on unit vectors: a cross product of raw ones can underflow.
     const double f_length = std::hypot(forward[0], forward[1], forward[2]);
     const double up[3] = {camera.up.x, camera.up.y, camera.up.z};
@@ -341,6 +344,48 @@ void read_render_settings(const SceneReader& r, const json& root, RenderSettings
     if (rs.contains("seed")) s.seed = static_cast<uint64_t>(read("seed", 0, kMaxSeed));
 }
 
+// The float build's limit on mixed scales (scene_limits.h): each primitive's size against the
+// largest |coordinate| of the scene once centred, both from the file's numbers.
+void check_scene_scale(const SceneReader& r, const json& root, const Scene& scene) {
+    const Vec3 offset = centring_offset(scene);
+    const double centre[3] = {-double(offset.x), -double(offset.y), -double(offset.z)};
+    const auto from_centre = [&](const WrittenPoint& p) {
+        return std::fmax(std::fabs(p.x - centre[0]),
+                         std::fmax(std::fabs(p.y - centre[1]), std::fabs(p.z - centre[2])));
+    };
+    double extent = 0.0;
+    for (size_t i = 0; i < scene.spheres.size(); ++i)
+        extent = std::fmax(extent, from_centre(scene.written.sphere_centres[i]) +
+                                       scene.spheres[i].radius);
+    for (const WrittenPoint& v : scene.written.triangle_vertices)
+        extent = std::fmax(extent, from_centre(v));
+    for (size_t i = 0; i < scene.spheres.size(); ++i) {
+        const std::string problem =
+            scene_scale_problem("a radius", scene.spheres[i].radius, extent);
+        if (!problem.empty()) r.fail("/spheres/" + std::to_string(i) + "/radius", problem);
+    }
+    const size_t listed = root.contains("triangles") ? root["triangles"].size() : 0;
+    for (size_t i = 0; i < scene.triangles.size(); ++i) {
+        const WrittenPoint* v = &scene.written.triangle_vertices[3 * i];
+        const auto edge = [&](int a, int b) {
+            return std::hypot(v[a].x - v[b].x, v[a].y - v[b].y, v[a].z - v[b].z);
+        };
+        const double e1[3] = {v[1].x - v[0].x, v[1].y - v[0].y, v[1].z - v[0].z};
+        const double e2[3] = {v[2].x - v[0].x, v[2].y - v[0].y, v[2].z - v[0].z};
+        if (e1[1] * e2[2] == e1[2] * e2[1] && e1[2] * e2[0] == e1[0] * e2[2] &&
+            e1[0] * e2[1] == e1[1] * e2[0])
+            continue;  // no area as written: nothing to show (triangle_problem)
+        const double longest = std::fmax(edge(0, 1), std::fmax(edge(1, 2), edge(2, 0)));
+        const std::string problem =
+            scene_scale_problem("a triangle with a longest edge", longest, extent);
+        if (!problem.empty()) {
+            r.fail(i < listed ? "/triangles/" + std::to_string(i) + "/vertices"
+                              : "/quads/" + std::to_string((i - listed) / 2) + "/vertices",
+                   problem);
+        }
+    }
+}
+
 }  // namespace
 
 Scene parse_scene(const std::string& text, const std::string& name) {
@@ -363,6 +408,7 @@ Scene parse_scene(const std::string& text, const std::string& name) {
     read_spheres(r, prims, scene);
     read_triangles(r, prims, scene);
     read_render_settings(r, root, scene.render);
+    check_scene_scale(r, root, scene);
     return scene;
 }
 
