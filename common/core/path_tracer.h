@@ -156,16 +156,21 @@ struct ShadowRay {
 RT_HD inline bool sample_light(const SceneView& scene, Vec3 position, Vec3 origin,
                                Vec3 facing_normal, Vec3 albedo, ShadowRay& shadow) {
     // BEGIN SOLUTION
-    // Every test is written so that NaN fails it: a light exactly at the surface point (a
-    // camera ray that lands on it) has distance 0, no direction (0/0) and no finite radiance.
+    // Every test is written so that NaN fails it. A light placed on a surface is met by hit
+    // points that land on it to the last bit (distance 0: no direction, 0/0), or lie off it
+    // by the rounding of their own coordinates only, which then sets the direction to it (a
+    // light in a floor's plane lit the floor 1e13 times too bright, where the double build
+    // sees ~0). So a light nearer than 2 ulps of the point's largest coordinate, which `real`
+    // cannot tell from the point, gives no sample.
     const Vec3 to_light = scene.light.position - position;
     const real distance2 = length_squared(to_light);
+    const real resolved = real(2) * kRealEpsilon * max_component(abs(position));
     const real distance = sqrt_real(distance2);
     const Vec3 wi = to_light * (real(1) / distance);
     const real cos_theta = dot(facing_normal, wi);
     const real falloff = cos_theta / (kPi * distance2);
-    // Light behind the surface, or at the point itself (NaN, or a falloff past the range).
-    if (!(cos_theta > 0.0f) || !(falloff < kRealMax)) return false;
+    // Light behind the surface, not resolved from it, or a falloff past the range.
+    if (!(cos_theta > 0.0f) || !(distance > resolved) || !(falloff < kRealMax)) return false;
     shadow.ray = {origin, wi};
     shadow.t_max = distance - dot(origin - position, wi);
     shadow.radiance = albedo * scene.light.intensity * falloff;

@@ -18,10 +18,12 @@
 #if defined(RT_DOUBLE)
 using real = double;
 constexpr real kRealMax = DBL_MAX;
+constexpr real kRealEpsilon = DBL_EPSILON;  // the spacing of reals at 1
 constexpr const char* kPrecisionName = "double";
 #else
 using real = float;
 constexpr real kRealMax = FLT_MAX;
+constexpr real kRealEpsilon = FLT_EPSILON;
 constexpr const char* kPrecisionName = "float";
 #endif
 

@@ -349,12 +349,15 @@ inline Mask8 sample_light(const SceneView& scene, const Vec3x8& position, const 
                           ShadowPacket& shadow) {
     const Vec3x8 to_light = Vec3x8(scene.light.position) - position;
     const Float8 distance2 = length_squared(to_light);
+    const Float8 resolved = Float8(2.0f * FLT_EPSILON) * max_component(abs(position));
     const Float8 distance = sqrt(distance2);
     const Vec3x8 wi = to_light * (Float8(1.0f) / distance);
     const Float8 cos_theta = dot(facing, wi);
     const Float8 falloff = cos_theta / (Float8(kPi) * distance2);
-    // Light in front of the surface; NaN fails both tests, as in the scalar code.
-    const Mask8 lit = mask & (cos_theta > 0.0f) & (falloff < Float8(FLT_MAX));
+    // Light in front of the surface and resolved from it; NaN fails every test, as in the
+    // scalar code.
+    const Mask8 lit =
+        mask & (cos_theta > 0.0f) & (distance > resolved) & (falloff < Float8(FLT_MAX));
     if (none(lit)) return lit;
     shadow.ray = {origin, wi};
     shadow.t_max = distance - dot(origin - position, wi);
