@@ -92,7 +92,7 @@ def glass_sphere():
     """A camera inside a glass sphere, 0.8 radii from its centre, looking across it: every ray
     meets the surface beyond the critical angle, and the angle is the same at every bounce
     (a chord of a sphere), so total internal reflection keeps each path inside."""
-    r = 1.9
+    r = 1.0
     cam = [0.8 * r, 0.1 * r, 0.05 * r]
     return {"camera": {"position": cam, "look_at": [cam[0], cam[1], cam[2] - 1.0],
                        "up": [0, 1, 0], "vfov": 30},
