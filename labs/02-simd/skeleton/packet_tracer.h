@@ -247,6 +247,42 @@ inline SurfacePacket surface_at(const SceneView& scene, const RayPacket& ray,
     return s;
 }
 
+// ---- specular exits, lane by lane (path_tracer.h's bounce_step, triangle.h's step_off_edges)
+// A specular lane's next origin also steps off the edges of the triangle it hit; a sphere
+// lane's step is zero, as the scalar code adds none.
+inline Vec3x8 cross_lanes(const Vec3x8& a, const Vec3x8& b) {  // cross (vec3.h)
+    return {a.y * b.z - a.z * b.y, a.z * b.x - a.x * b.z, a.x * b.y - a.y * b.x};
+}
+inline void step_off_edge(const Vec3x8& normal, const Vec3x8& from, const Vec3x8& to,
+                          const Vec3x8& p, Float8 margin, Vec3x8& step) {
+    const Vec3x8 inward = cross_lanes(normal, to - from);
+    const Float8 inward_length = sqrt(dot(inward, inward));
+    const Float8 depth = dot(p - from, inward);
+    const Mask8 near{_mm256_cmp_ps(depth.v, (margin * inward_length).v, _CMP_NGE_UQ)};
+    step = select(near, step + inward * (margin / inward_length), step);
+}
+inline Vec3x8 specular_edge_step(const SceneView& scene, const HitPacket& hit,
+                                 const SurfacePacket& surface, Mask8 specular) {
+    const Mask8 on_triangle = and_not(specular, hit.triangle == -1);
+    Vec3x8 step(Vec3(0.0f));
+    if (none(on_triangle)) return step;
+    constexpr int kT = stride_of<Triangle>();
+    const Triangle& t0 = scene.triangles[0];
+    const auto vertex = [&](const Vec3& v) {
+        return Vec3x8(gather(v.x, kT, hit.triangle, on_triangle),
+                      gather(v.y, kT, hit.triangle, on_triangle),
+                      gather(v.z, kT, hit.triangle, on_triangle));
+    };
+    const Vec3x8 v0 = vertex(t0.v0), v1 = vertex(t0.v1), v2 = vertex(t0.v2);
+    // ray_offset (ray.h), lane by lane
+    const Float8 margin = (max_component(abs(surface.position)) + hit.t + surface.extent) *
+                          Float8(1.0f / (1 << 20));
+    step_off_edge(surface.normal, v0, v1, surface.position, margin, step);
+    step_off_edge(surface.normal, v1, v2, surface.position, margin, step);
+    step_off_edge(surface.normal, v2, v0, surface.position, margin, step);
+    return select(on_triangle, step, Vec3x8(Vec3(0.0f)));
+}
+
 // PathState (path_tracer.h) for the 8 paths of a packet. All lanes are at the same bounce:
 // they start together, and a lane whose path ends stays out of `alive`.
 struct PathPacket {
@@ -271,15 +307,19 @@ inline Mask8 sample_light(const SceneView& scene, const Vec3x8& position, const 
                           ShadowPacket& shadow) {
     const Vec3x8 to_light = Vec3x8(scene.light.position) - position;
     const Float8 distance2 = length_squared(to_light);
+    const Float8 resolved = Float8(2.0f * FLT_EPSILON) * max_component(abs(position));
     const Float8 distance = sqrt(distance2);
     const Vec3x8 wi = to_light * (Float8(1.0f) / distance);
     const Float8 cos_theta = dot(facing, wi);
-    const Mask8 lit = and_not(mask, cos_theta <= 0.0f);  // light in front of the surface
+    const Float8 falloff = cos_theta / (Float8(kPi) * distance2);
+    // Light in front of the surface and resolved from it; NaN fails every test, as in the
+    // scalar code.
+    const Mask8 lit =
+        mask & (cos_theta > 0.0f) & (distance > resolved) & (falloff < Float8(FLT_MAX));
     if (none(lit)) return lit;
     shadow.ray = {origin, wi};
     shadow.t_max = distance - dot(origin - position, wi);
-    shadow.radiance =
-        albedo * Vec3x8(scene.light.intensity) * (cos_theta / (Float8(kPi) * distance2));
+    shadow.radiance = albedo * Vec3x8(scene.light.intensity) * falloff;
     return lit;
 }
 
@@ -330,10 +370,14 @@ inline __attribute__((always_inline)) Mask8 bounce_step(const SceneView& scene, 
         next.origin = select(diffuse, above, next.origin);
         next.direction = select(diffuse, d, next.direction);
     }
+    // Specular lanes, as the scalar bounce step: the origin steps off triangle edges, and a
+    // reflected direction is renormalised.
+    Vec3x8 off_edges(Vec3(0.0f));
+    if (any(mirror | glass)) off_edges = specular_edge_step(scene, hit, surface, mirror | glass);
     if (any(mirror)) {
         path.throughput = select(mirror, path.throughput * albedo, path.throughput);
-        next.origin = select(mirror, above, next.origin);
-        next.direction = select(mirror, reflect(ray.direction, facing), next.direction);
+        next.origin = select(mirror, above + off_edges, next.origin);
+        next.direction = select(mirror, normalize(reflect(ray.direction, facing)), next.direction);
     }
     if (any(glass)) {  // reflect or refract, chosen with the Fresnel reflectance
         const Float8 ior = gather(m0.ior, kM, surface.material, glass);
@@ -342,10 +386,10 @@ inline __attribute__((always_inline)) Mask8 bounce_step(const SceneView& scene, 
         const Float8 reflectance = fresnel_dielectric(-dot(ray.direction, facing), eta, cos_t);
         const Mask8 reflects = rng.at(bounce_dimension(bounce, 0)) < reflectance;
         const Vec3x8 below = offset_ray_origin(surface.position, -facing, hit.t, surface.extent);
-        next.origin = select(glass, select(reflects, above, below), next.origin);
+        next.origin = select(glass, select(reflects, above, below) + off_edges, next.origin);
         next.direction =
             select(glass,
-                   select(reflects, reflect(ray.direction, facing),
+                   select(reflects, normalize(reflect(ray.direction, facing)),
                           refract(ray.direction, facing, eta, cos_t)),
                    next.direction);
     }
