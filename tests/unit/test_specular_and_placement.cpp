@@ -42,21 +42,31 @@ std::string parse_error(const std::string& text) {
 }  // namespace
 
 // A reflection of a unit direction rounds to a length 1 +- a few ulps; the bounce step
-// renormalises it, so 64 reflections in a row leave it unit to an ulp or two instead of
-// drifting (which is what let paths out of a closed mirror sphere).
+// renormalises it, so 64 reflections inside a mirror sphere leave it unit to an ulp or two,
+// and every one of them finds the sphere again. Unnormalised, the length drifted and the path
+// left the sphere (the sphere test assumes a unit direction).
 TEST(SpecularBounce, ReflectedDirectionsStayUnitLength) {
-    const Scene scene = mirror_floor();
+    Scene scene;
+    Material m{};
+    m.type = MaterialType::Mirror;
+    m.albedo = Vec3(1.0f);
+    scene.materials.push_back(m);
+    scene.material_names.push_back("mirror");
+    scene.spheres.push_back({Vec3(0.13f, -0.07f, 0.05f), 1.37f, 0});
     const SceneView v = scene.view();
-    PathState path = start_path({{0.1f, 1.0f, 0.2f}, normalize(Vec3(0.31f, -1.0f, 0.17f))}, 64);
-    for (int i = 0; i < 64 && path.alive; ++i) {
-        // The floor again and again: turn the ray back down as a mirror ceiling would.
-        Hit hit = closest_hit(v, path.ray);
-        ASSERT_TRUE(hit.found());
-        ShadowRay shadow;
-        bounce_step(v, hit, kRng, 64, path, shadow);
-        EXPECT_NEAR(length(path.ray.direction), 1.0f, 2.5e-7f) << "bounce " << i;
-        path.ray = {Vec3(path.ray.origin.x * 0.5f, 1.0f, path.ray.origin.z * 0.5f),
-                    Vec3(path.ray.direction.x, -path.ray.direction.y, path.ray.direction.z)};
+    for (int k = 0; k < 50; ++k) {
+        const Vec3 d = normalize(Vec3(0.31f + 0.05f * k, -1.0f + 0.03f * k, 0.17f - 0.02f * k));
+        PathState path = start_path({{0.41f, -0.27f, 0.19f}, d}, 64);
+        int bounces = 0;
+        while (path.alive) {
+            const Hit hit = closest_hit(v, path.ray);
+            ASSERT_TRUE(hit.found()) << "ray " << k << " escaped after " << bounces << " bounces";
+            ShadowRay shadow;
+            bounce_step(v, hit, kRng, 64, path, shadow);
+            ++bounces;
+            if (path.alive) ASSERT_NEAR(length(path.ray.direction), 1.0f, 2.5e-7f) << bounces;
+        }
+        EXPECT_EQ(bounces, 64);
     }
 }
 
@@ -87,12 +97,13 @@ TEST(StepOffEdges, AMirrorHitOnARoomsEdgeStartsInFrontOfBothFaces) {
     // A wall x = 1 facing -x, meeting the floor at the edge x = 1, y = 0.
     scene.triangles.push_back(make_triangle({1, 0, -1}, {1, 0, 1}, {1, 1, 1}, 0));
     const SceneView v = scene.view();
-    const Vec3 edge_point(1.0f, 0.0f, 0.25f);
-    const Vec3 d = normalize(Vec3(0.6f, -0.8f, 0.0f));
-    const Ray ray{edge_point - d * 0.5f, d};
+    // 0.4f + 0.6f and 0.8f - 0.8f round to 1 and 0: the hit lies exactly on the edge.
+    const Ray ray{{0.4f, 0.8f, 0.25f}, {0.6f, -0.8f, 0.0f}};
     Hit hit;
-    hit.t = 0.5f;
+    hit.t = 1.0f;
     hit.triangle = 1;  // the floor's second triangle holds the edge x = 1
+    ASSERT_EQ(ray.at(hit.t).x, 1.0f);
+    ASSERT_EQ(ray.at(hit.t).y, 0.0f);
     PathState path = start_path(ray, 4);
     ShadowRay shadow;
     bounce_step(v, hit, kRng, 4, path, shadow);
