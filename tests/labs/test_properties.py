@@ -14,7 +14,8 @@ tested on scenes drawn to break them rather than on the shipped ones:
 
 Each runs on the float and the double build of lab 01's reference; lab 02's packet tracer
 (its edge steps and renormalised reflections, common/simd/packet_tracer.h) must keep lab 01's
-bits on them; lab 05's fast-math build runs the NaN cases where a GPU is.
+bits on them; the GPU references (lab 05, its fast-math build, labs 06 and 07) run the
+enclosures and the lights where a GPU is.
 """
 import json
 import math
@@ -341,11 +342,24 @@ def test_a_light_on_a_surface_in_lab02(tmp_path):
     assert_finite_on_degenerate_lights(build("lab02-ref")[0], tmp_path)
 
 
-def test_a_light_on_a_surface_with_fast_math(tmp_path):
-    """Lab 05's --use_fast_math build: the guards are written so that NaN fails them."""
+GPU_REFERENCES = ["lab05-ref", "lab05-ref-fast-math", "lab06-ref", "lab07-ref"]
+
+
+@pytest.mark.parametrize("target", GPU_REFERENCES)
+def test_gpu_references_trap_every_path_and_never_give_nan(tmp_path, target):
+    """The GPU labs' kernels call the core's bounce step: the enclosures trap every path at 64
+    bounces and the lights on surfaces give no NaN or Inf, --use_fast_math included (its
+    guards are written so that NaN fails them)."""
     if reason := missing_gpu():
         pytest.skip(reason)
-    assert_finite_on_degenerate_lights(build("lab05-ref-fast-math")[0], tmp_path)
+    binary = build(target)[0]
+    for name, make in ENCLOSURES.items():
+        scene = make()
+        image = enclosure_image(binary, scene, tmp_path, 64)
+        if name == "glass-sphere":
+            image = image[beyond_critical_angle(scene, image.shape[1], image.shape[0])]
+        assert not image.any(), f"{name}: {float((image > 0).mean()):.2%} of values lit"
+    assert_finite_on_degenerate_lights(binary, tmp_path)
 
 
 # ---- refusals give the true reason ------------------------------------------------------------
