@@ -168,12 +168,13 @@ RT_HD inline bool sample_light(const SceneView& scene, Vec3 position, Vec3 origi
     const real distance = sqrt_real(distance2);
     const Vec3 wi = to_light * (real(1) / distance);
     const real cos_theta = dot(facing_normal, wi);
-    const real falloff = cos_theta / (kPi * distance2);
-    // Light behind the surface, not resolved from it, or a falloff past the range.
-    if (!(cos_theta > 0.0f) || !(distance > resolved) || !(falloff < kRealMax)) return false;
+    // Light behind the surface, not resolved from it, or a falloff cos/(pi d^2) past the range.
+    if (!(cos_theta > 0.0f) || !(distance > resolved) ||
+        !(cos_theta < kRealMax * (kPi * distance2)))
+        return false;
     shadow.ray = {origin, wi};
     shadow.t_max = distance - dot(origin - position, wi);
-    shadow.radiance = albedo * scene.light.intensity * falloff;
+    shadow.radiance = albedo * scene.light.intensity * (cos_theta / (kPi * distance2));
     return true;
     // SKELETON
     //> // TODO(lab01): the light sample. From `position`: the direction wi and distance d to

@@ -24,12 +24,14 @@ struct Ray {
 // 2^-20 of their sum is 8 to 16 ulps. Measured over random rays leaving triangles and spheres
 // of sizes 1e-3..1e5 placed up to 1e4 from the origin, grazing ones included: no self-hit
 // down to 2^-22, some at 2^-23; 2^-20 keeps a margin of 4 (tests/unit/test_offset.cpp).
-// ray_offset is that distance, offset_ray_origin the point moved by it along n.
-RT_HD inline real ray_offset(Vec3 p, real distance_travelled, real extent) {
+RT_HD inline Vec3 offset_ray_origin(Vec3 p, Vec3 n, real distance_travelled, real extent) {
     constexpr real kRelativeOffset = real(1) / (1 << 20);
     const real scale = max_component(abs(p)) + distance_travelled + extent;
-    return scale * kRelativeOffset;
+    return p + n * (scale * kRelativeOffset);
 }
-RT_HD inline Vec3 offset_ray_origin(Vec3 p, Vec3 n, real distance_travelled, real extent) {
-    return p + n * ray_offset(p, distance_travelled, extent);
+// How far offset_ray_origin moves p: the same arithmetic, for steps of the same size in
+// other directions (step_off_edges, triangle.h).
+RT_HD inline real ray_offset(Vec3 p, real distance_travelled, real extent) {
+    constexpr real kRelativeOffset = real(1) / (1 << 20);
+    return (max_component(abs(p)) + distance_travelled + extent) * kRelativeOffset;
 }

@@ -64,7 +64,9 @@ TEST(SpecularBounce, ReflectedDirectionsStayUnitLength) {
             ShadowRay shadow;
             bounce_step(v, hit, kRng, 64, path, shadow);
             ++bounces;
-            if (path.alive) ASSERT_NEAR(length(path.ray.direction), 1.0f, 2.5e-7f) << bounces;
+            if (path.alive) {
+                ASSERT_NEAR(length(path.ray.direction), 1.0f, 2.5e-7f) << bounces;
+            }
         }
         EXPECT_EQ(bounces, 64);
     }
