@@ -311,15 +311,15 @@ inline Mask8 sample_light(const SceneView& scene, const Vec3x8& position, const 
     const Float8 distance = sqrt(distance2);
     const Vec3x8 wi = to_light * (Float8(1.0f) / distance);
     const Float8 cos_theta = dot(facing, wi);
-    const Float8 falloff = cos_theta / (Float8(kPi) * distance2);
-    // Light in front of the surface and resolved from it; NaN fails every test, as in the
-    // scalar code.
-    const Mask8 lit =
-        mask & (cos_theta > 0.0f) & (distance > resolved) & (falloff < Float8(FLT_MAX));
+    // Light in front of the surface and resolved from it, a finite falloff; NaN fails every
+    // test, as in the scalar code.
+    const Mask8 lit = mask & (cos_theta > 0.0f) & (distance > resolved) &
+                      (cos_theta < Float8(FLT_MAX) * (Float8(kPi) * distance2));
     if (none(lit)) return lit;
     shadow.ray = {origin, wi};
     shadow.t_max = distance - dot(origin - position, wi);
-    shadow.radiance = albedo * Vec3x8(scene.light.intensity) * falloff;
+    shadow.radiance =
+        albedo * Vec3x8(scene.light.intensity) * (cos_theta / (Float8(kPi) * distance2));
     return lit;
 }
 
