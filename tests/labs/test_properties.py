@@ -14,8 +14,8 @@ tested on scenes drawn to break them rather than on the shipped ones:
 
 Each runs on the float and the double build of lab 01's reference; lab 02's packet tracer
 (its edge steps and renormalised reflections, common/simd/packet_tracer.h) must keep lab 01's
-bits on them; the GPU references (lab 05, its fast-math build, labs 06 and 07) run the
-enclosures and the lights where a GPU is.
+bits on them; lab 01 built with -ffast-math, and the GPU references (lab 05, its fast-math
+build, labs 06 and 07) where a GPU is, run the enclosures and the lights.
 """
 import json
 import math
@@ -27,7 +27,8 @@ import pytest
 from cuda_env import missing_gpu
 from grading import scenes
 from grading.compare import compare
-from grading.harness import build, cpu_has_avx2, golden, run_lab
+from grading.harness import ROOT, build, cpu_has_avx2, golden, run_lab
+from grading.variants import build_sources, lab_sources
 
 
 @pytest.fixture(scope="module", params=["lab01-ref", "lab01-ref-double"])
@@ -342,6 +343,25 @@ def test_a_light_on_a_surface_in_lab02(tmp_path):
     assert_finite_on_degenerate_lights(build("lab02-ref")[0], tmp_path)
 
 
+def test_cpu_fast_math_build_traps_every_path_and_never_gives_nan(tmp_path):
+    """Lab 01's reference compiled with -ffast-math (make variant, as make tradeoff builds it),
+    which lets the compiler assume no NaN: the guards still hold and the enclosures trap."""
+    binary = build_sources("01-serial", ROOT / "build" / "properties" / "fast-math",
+                           lab_sources("01-serial"),
+                           make_args=("VARIANT_FLAGS_01-serial=-ffast-math",))
+    assert_traps_and_finite(binary, tmp_path)
+
+
+def assert_traps_and_finite(binary, tmp_path):
+    for name, make in ENCLOSURES.items():
+        scene = make()
+        image = enclosure_image(binary, scene, tmp_path, 64)
+        if name == "glass-sphere":
+            image = image[beyond_critical_angle(scene, image.shape[1], image.shape[0])]
+        assert not image.any(), f"{name}: {float((image > 0).mean()):.2%} of values lit"
+    assert_finite_on_degenerate_lights(binary, tmp_path)
+
+
 GPU_REFERENCES = ["lab05-ref", "lab05-ref-fast-math", "lab06-ref", "lab07-ref"]
 
 
@@ -352,14 +372,7 @@ def test_gpu_references_trap_every_path_and_never_give_nan(tmp_path, target):
     guards are written so that NaN fails them)."""
     if reason := missing_gpu():
         pytest.skip(reason)
-    binary = build(target)[0]
-    for name, make in ENCLOSURES.items():
-        scene = make()
-        image = enclosure_image(binary, scene, tmp_path, 64)
-        if name == "glass-sphere":
-            image = image[beyond_critical_angle(scene, image.shape[1], image.shape[0])]
-        assert not image.any(), f"{name}: {float((image > 0).mean()):.2%} of values lit"
-    assert_finite_on_degenerate_lights(binary, tmp_path)
+    assert_traps_and_finite(build(target)[0], tmp_path)
 
 
 # ---- refusals give the true reason ------------------------------------------------------------
