@@ -169,9 +169,10 @@ RT_HD inline bool sample_light(const SceneView& scene, Vec3 position, Vec3 origi
     const Vec3 wi = to_light * (real(1) / distance);
     const real cos_theta = dot(facing_normal, wi);
     // Light behind the surface, not resolved from it, or a falloff cos/(pi d^2) past the range.
-    if (!(cos_theta > 0.0f) || !(distance > resolved) ||
-        !(cos_theta < kRealMax * (kPi * distance2)))
-        return false;
+    // One branch: & rather than || (each ordered comparison is false for NaN).
+    const bool in_front = (cos_theta > 0.0f) & (distance > resolved) &
+                          (cos_theta < kRealMax * (kPi * distance2));
+    if (!in_front) return false;
     shadow.ray = {origin, wi};
     shadow.t_max = distance - dot(origin - position, wi);
     shadow.radiance = albedo * scene.light.intensity * (cos_theta / (kPi * distance2));
