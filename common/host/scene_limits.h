@@ -93,8 +93,12 @@ inline std::string triangle_problem(const double (&written)[3][3], const Triangl
     const double cy = e1[2] * e2[0] - e1[0] * e2[2];
     const double cz = e1[0] * e2[1] - e1[1] * e2[0];
     if (cx == 0.0 && cy == 0.0 && cz == 0.0) return "";  // no area as written: nothing to show
-    const double longest = std::fmax(length(tri.v1 - tri.v0),
-                                     std::fmax(length(tri.v2 - tri.v1), length(tri.v0 - tri.v2)));
+    // The edges as written, in double: in float, a squared edge below 1e-19 underflows.
+    const auto edge = [&](int a, int b) {
+        return std::hypot(written[a][0] - written[b][0], written[a][1] - written[b][1],
+                          written[a][2] - written[b][2]);
+    };
+    const double longest = std::fmax(edge(0, 1), std::fmax(edge(1, 2), edge(2, 0)));
     const std::string size = size_problem("a triangle with a longest edge", longest, tri.extent);
     if (!size.empty()) return size;
     if (is_black(tri.normal))

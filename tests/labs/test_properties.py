@@ -386,13 +386,19 @@ def refusal(binary, scene, tmp_path):
     return p.returncode, lines
 
 
+@pytest.mark.parametrize("spheres", [True, False], ids=["with-sphere", "triangles-only"])
 @pytest.mark.parametrize("factor", [1e-25, 1e-15, 1e15])
-def test_a_scene_too_small_or_large_is_refused_for_its_size(lab01_ref, tmp_path, factor):
-    """The Cornell box scaled far beyond float's bounds: refused for a size or a coordinate,
-    never as a camera looking at itself."""
-    code, lines = refusal(lab01_ref, scenes.scaled(scenes.load("cornell"), factor), tmp_path)
+def test_a_scene_too_small_or_large_is_refused_for_its_size(lab01_ref, tmp_path, factor,
+                                                            spheres):
+    """The Cornell box scaled far beyond float's bounds: refused for a size (as large as it
+    is, not 0) or a coordinate, never as a camera looking at itself."""
+    scene = scenes.scaled(scenes.load("cornell"), factor)
+    if not spheres:
+        scene.pop("spheres")
+    code, lines = refusal(lab01_ref, scene, tmp_path)
     assert code == 2 and len(lines) == 1, lines
     assert "camera position" not in lines[0] and ("1e-9" in lines[0] or "1e9" in lines[0]), lines
+    assert " of 0 " not in lines[0], lines
 
 
 def test_a_look_at_very_close_to_the_camera_is_a_view(tmp_path):
