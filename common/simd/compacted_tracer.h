@@ -25,6 +25,7 @@
 
 #include <cstdint>
 
+#include <lane_use.h>
 #include <packet_tracer.h>
 
 // Paths per group: a few thousand rays' worth of work per bounce, 16 full packets of 16
@@ -79,14 +80,15 @@ struct PathGroup {
 };
 
 // Traces every path of `group` to its end, bounce by bounce, and leaves each path's radiance
-// in out[channel][its slot].
+// in out[channel][its slot]. Counts the packets and paths of each bounce in `use`, if given.
 template <class F>
 inline void trace_group(const SceneView& scene, int max_bounces, PathGroup<F>& group,
-                        float (&out)[3][kGroupPaths]) {
+                        float (&out)[3][kGroupPaths], LaneUse* use = nullptr) {
     constexpr int kLanes = F::kLanes;
     using I = IntOf<F>;
     if (max_bounces <= 0) group.count = 0;  // trace_path: no interaction, no light
     for (int bounce = 0; group.count > 0; ++bounce) {
+        if (use != nullptr) use->add(bounce, (group.count + kLanes - 1) / kLanes, group.count);
         int kept = 0;
         for (int i = 0; i < group.count; i += kLanes) {
             const auto active = MaskOf<F>::first(group.count - i);
@@ -127,7 +129,7 @@ inline void trace_group(const SceneView& scene, int max_bounces, PathGroup<F>& g
 template <class F>
 inline void render_pixels_compacted(const SceneView& scene, const Camera& camera,
                                     const RenderSettings& settings, long first_pixel,
-                                    int pixel_count, Vec3* out) {
+                                    int pixel_count, Vec3* out, LaneUse* use = nullptr) {
     constexpr int kLanes = F::kLanes;
     using Stream = SampleStreamN<F>;
     const int spp = settings.spp;
@@ -186,7 +188,7 @@ inline void render_pixels_compacted(const SceneView& scene, const Camera& camera
         for (int c = 0; c < 3; ++c) {
             for (int i = 0; i < n; ++i) radiance[c][i] = 0.0f;  // a path of no bounce
         }
-        trace_group(scene, settings.bounces, group, radiance);
+        trace_group(scene, settings.bounces, group, radiance, use);
         for (int i = 0; i < n; ++i) {
             sum.add(Vec3(radiance[0][i], radiance[1][i], radiance[2][i]));
             if (++summed == spp) {

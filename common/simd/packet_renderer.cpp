@@ -13,6 +13,10 @@ void render_pixels_avx512(const SceneView&, const Camera&, const RenderSettings&
                           Vec3*);
 void render_pixels_avx512_compacted(const SceneView&, const Camera&, const RenderSettings&, long,
                                     int, Vec3*);
+void count_lanes_avx2(const SceneView&, const Camera&, const RenderSettings&, long, int, bool,
+                      LaneUse&);
+void count_lanes_avx512(const SceneView&, const Camera&, const RenderSettings&, long, int, bool,
+                        LaneUse&);
 
 std::string PacketRenderer::describe() const {
     return std::string(lanes == 16 ? "AVX-512" : "AVX2") + ", " + std::to_string(lanes) +
@@ -22,7 +26,8 @@ std::string PacketRenderer::describe() const {
 PacketRenderer packet_renderer(int lanes, bool compacted) {
     if (lanes == 8) {
         require_avx2("8-lane packets (AVX2)", cpu_model_name());
-        return {compacted ? render_pixels_avx2_compacted : render_pixels_avx2, 8, compacted};
+        return {compacted ? render_pixels_avx2_compacted : render_pixels_avx2, count_lanes_avx2, 8,
+                compacted};
     }
     if (lanes != 16) {
         throw InputError("packets have 8 (AVX2) or 16 (AVX-512) lanes, not " +
@@ -34,7 +39,8 @@ PacketRenderer packet_renderer(int lanes, bool compacted) {
                                 (forced_off("RT_FORCE_NO_AVX512") ? " (RT_FORCE_NO_AVX512 is set)"
                                                                  : ""));
     }
-    return {compacted ? render_pixels_avx512_compacted : render_pixels_avx512, 16, compacted};
+    return {compacted ? render_pixels_avx512_compacted : render_pixels_avx512, count_lanes_avx512,
+            16, compacted};
 }
 
 PacketRenderer widest_packet_renderer() {

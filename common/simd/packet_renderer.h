@@ -14,6 +14,7 @@
 #include <string>
 
 #include <camera.h>
+#include <lane_use.h>
 #include <scene_view.h>
 
 // Renders pixel_count consecutive pixels from pixel index first_pixel (y * width + x) into
@@ -22,9 +23,15 @@ using RenderPixels = void (*)(const SceneView& scene, const Camera& camera,
                               const RenderSettings& settings, long first_pixel, int pixel_count,
                               Vec3* out);
 
+// Traces the same paths as RenderPixels, tallying each bounce's packets and paths in `use`.
+using CountLanes = void (*)(const SceneView& scene, const Camera& camera,
+                            const RenderSettings& settings, long first_pixel, int pixel_count,
+                            bool compacted, LaneUse& use);
+
 // One way of rendering with packets.
 struct PacketRenderer {
     RenderPixels render;  // the function
+    CountLanes count;     // its lane use, measured (lab02-bench)
     int lanes;            // paths per packet: 8 (AVX2) or 16 (AVX-512)
     bool compacted;       // survivors repacked after every bounce (compacted_tracer.h)
 

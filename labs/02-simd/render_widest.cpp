@@ -9,7 +9,10 @@
 // to this.
 //
 // Built with -DRT_PACKETS_FROM_ENV (./lab02-bench), it renders with the width and method that
-// RT_SIMD_LANES (8 or 16) and RT_SIMD_COMPACT (0 or 1) name, for the handout's table.
+// RT_SIMD_LANES (8 or 16) and RT_SIMD_COMPACT (0 or 1) name, for the handout's table, and with
+// RT_SIMD_LANE_USE=1 it then traces the image's paths again, untimed, counting how full the
+// packets were at each bounce, and prints that on stderr.
+#include <cstdio>
 #include <cstdlib>
 #include <string>
 
@@ -40,8 +43,21 @@ PacketRenderer chosen_renderer() {
     return packet_renderer(environment_int("RT_SIMD_LANES", widest.lanes),
                            environment_int("RT_SIMD_COMPACT", 1) != 0);
 }
+
+void report_lane_use(const PacketRenderer& packets, const RenderJob& job) {
+    if (environment_int("RT_SIMD_LANE_USE", 0) == 0) return;
+    LaneUse use;
+    const long pixels = static_cast<long>(job.settings.width) * job.settings.height;
+    for (long first = 0; first < pixels; first += job.settings.width) {
+        packets.count(job.scene, job.camera, job.settings, first, job.settings.width,
+                      packets.compacted, use);
+    }
+    std::fprintf(stderr, "%s\n", packets.describe().c_str());
+    use.print(stderr, packets.lanes);
+}
 #else
 PacketRenderer chosen_renderer() { return widest_packet_renderer(); }
+void report_lane_use(const PacketRenderer&, const RenderJob&) {}
 #endif
 
 }  // namespace
@@ -58,5 +74,7 @@ RenderStats render(const RenderJob& job, Image& image) {
                        settings.width, &image.at(0, y));
         job.progress.rows_done();
     }
-    return {timer.seconds(), cpu_model_name() + ", 1 thread, " + packets.describe()};
+    const double seconds = timer.seconds();
+    report_lane_use(packets, job);
+    return {seconds, cpu_model_name() + ", 1 thread, " + packets.describe()};
 }
