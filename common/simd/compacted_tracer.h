@@ -17,7 +17,7 @@
 // packets as full, but mixes rays of every bounce in one packet. Camera rays of neighbouring
 // samples are coherent (they pass the same triangles' plane cull); scattered late bounces are
 // not, and a packet pays the full triangle test when any lane needs it. Compaction packs
-// rays of one bounce together (the handout measures both).
+// rays of one bounce together (handouts/02-simd.md, section 8).
 //
 // Memory per group is bounded: kGroupPaths paths of 15 words, plus one packet of slack, on
 // the stack (about 17 KB with 16 lanes), whatever the image or spp.
@@ -28,9 +28,9 @@
 #include <lane_use.h>
 #include <packet_tracer.h>
 
-// Paths per group: a few thousand rays' worth of work per bounce, 16 full packets of 16
-// lanes, and small enough for the group to stay in the L1 cache (measured: 256 is as fast as
-// 512 and 1024, and 64 loses 6% on the Cornell box with 16 lanes).
+// Paths per group: 16 full packets of 16 lanes at bounce 0, so that the survivors of later
+// bounces still fill most packets, and few enough (15 KB) for the group to stay in the L1
+// data cache.
 constexpr int kGroupPaths = 256;
 
 // The paths of a group in structure-of-arrays form: entries [0, count) are alive, in any
