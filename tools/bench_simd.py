@@ -11,12 +11,15 @@
 Every binary runs pinned to one CPU (taskset; --cpu picks which), interleaved (one of each,
 round after round), and each row reports its best round: a machine that slows down or speeds
 up during the run affects every row alike. Speedup is the ratio of best render times (render
-only, as each binary reports it). Every image is compared byte for byte with lab01-ref's of
-the same round. Prints a table and the load average before and after; asserts nothing.
-Report only what it printed.
+only, as each binary reports it). With --cpu-time, each row's seconds are instead the CPU time
+of its process (user + system, as the kernel counts it for the child): on a machine shared
+with other jobs, a run that had to wait for the CPU is then not charged for the wait. Every
+image is compared byte for byte with lab01-ref's of the same round. Prints a table and the
+load average before and after; asserts nothing. Report only what it printed.
 """
 import argparse
 import os
+import resource
 import pathlib
 import shutil
 import sys
@@ -61,9 +64,15 @@ def has_avx512() -> bool:
     return all(f in flags for f in ("avx512f", "avx512dq", "avx512vl", "avx512bw"))
 
 
-def time_table(variants, scene, size, spp, bounces, repeat, cpu):
-    """Best render of each variant over `repeat` interleaved rounds; whether each image was
-    lab01-ref's (the first variant's) of the same round in every round."""
+def children_cpu_seconds() -> float:
+    usage = resource.getrusage(resource.RUSAGE_CHILDREN)
+    return usage.ru_utime + usage.ru_stime
+
+
+def time_table(variants, scene, size, spp, bounces, repeat, cpu, cpu_time=False):
+    """Best render of each variant over `repeat` interleaved rounds (render seconds, or the
+    process's CPU seconds with cpu_time); whether each image was lab01-ref's (the first
+    variant's) of the same round in every round."""
     settings = dict(scene=ROOT / "common" / "scenes" / f"{scene}.json", width=size,
                     height=size, spp=spp, bounces=bounces)
     best, identical = {}, {name: True for name, *_ in variants}
@@ -73,7 +82,12 @@ def time_table(variants, scene, size, spp, bounces, repeat, cpu):
             launcher = ["taskset", "-c", str(cpu)] if shutil.which("taskset") else []
             if env:
                 launcher += ["env", *(f"{k}={v}" for k, v in env.items())]
+            before = children_cpu_seconds()
             run = run_lab(ROOT / binary, launcher=launcher, timeout=3600, **settings)
+            if cpu_time:
+                spent = children_cpu_seconds() - before
+                run.json["paths_per_second"] *= run.json["seconds"] / spent
+                run.json["seconds"] = spent
             if base_image is None:
                 base_image = run.image.tobytes()
             identical[name] &= run.image.tobytes() == base_image
@@ -109,6 +123,8 @@ def main() -> int:
     p.add_argument("--cpu", type=int, default=None, help="the CPU to pin to (default: the "
                    "last this process may use)")
     p.add_argument("--only", action="append", help="variant(s) to time besides lab01-ref")
+    p.add_argument("--cpu-time", action="store_true",
+                   help="time each process's CPU seconds, not its reported render seconds")
     a = p.parse_args()
     cpu = a.cpu if a.cpu is not None else max(os.sched_getaffinity(0))
     load_before = os.getloadavg()
@@ -119,10 +135,12 @@ def main() -> int:
         repeat = a.repeat or 5
         scenes = [(a.scene, a.size or 400, a.spp or 64, a.bounces or 4)] if a.size else PACKET_SCENES
         for scene, size, spp, bounces in scenes:
-            best, identical = time_table(variants, scene, size, spp, bounces, repeat, cpu)
+            best, identical = time_table(variants, scene, size, spp, bounces, repeat, cpu,
+                                         a.cpu_time)
             print_table(variants, best, identical,
                         f"'{scene}' {size}x{size}, {spp} spp, {bounces} bounces, CPU {cpu} only, "
-                        f"best of {repeat} interleaved rounds")
+                        f"best of {repeat} interleaved rounds"
+                        f"{', process CPU seconds' if a.cpu_time else ''}")
             target = TARGETS.get(scene)
             if target:
                 widest = "16 compacted" if has_avx512() else "8 compacted"
@@ -144,10 +162,12 @@ def main() -> int:
         build(*(binary for _, binary, _, _ in variants))
         repeat = a.repeat or 3
         spp, bounces = a.spp or 512, a.bounces or 4
-        best, identical = time_table(variants, a.scene, size, spp, bounces, repeat, cpu)
+        best, identical = time_table(variants, a.scene, size, spp, bounces, repeat, cpu,
+                                     a.cpu_time)
         print_table(variants, best, identical,
                     f"'{a.scene}' {size}x{size}, {spp} spp, {bounces} bounces, CPU {cpu} only, "
-                    f"best of {repeat} interleaved rounds")
+                    f"best of {repeat} interleaved rounds"
+                    f"{', process CPU seconds' if a.cpu_time else ''}")
     load_after = os.getloadavg()
     device = best["lab01-ref"]["device"].split(",")[0]
     print(f"CPU: {device}, {os.cpu_count()} logical cores, AVX-512: "
