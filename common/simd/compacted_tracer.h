@@ -140,6 +140,8 @@ inline void render_pixels_compacted(const SceneView& scene, const Camera& camera
     // The next path to start: sample `sample` of pixel first_pixel + pixel.
     int pixel = 0, sample = 0;
     uint64_t pixel_key = Stream::pixel_key(settings.seed, static_cast<uint64_t>(first_pixel));
+    int x = static_cast<int>(first_pixel % settings.width);  // its column and row
+    int y = static_cast<int>(first_pixel / settings.width);
     // The next pixel to sum: its sum so far and its samples so far.
     int sum_pixel = 0, summed = 0;
     SampleSum sum;
@@ -157,15 +159,18 @@ inline void render_pixels_compacted(const SceneView& scene, const Camera& camera
                 py[i] = py[n - 1];
                 continue;
             }
-            const long p = first_pixel + pixel;
             const uint64_t key = Stream::path_key(pixel_key, static_cast<uint64_t>(sample));
             group.slot[i] = i;
             group.key_low[i] = static_cast<uint32_t>(key);
             group.key_high[i] = static_cast<uint32_t>(key >> 32);
-            px[i] = static_cast<float>(p % settings.width);
-            py[i] = static_cast<float>(p / settings.width);
+            px[i] = static_cast<float>(x);
+            py[i] = static_cast<float>(y);
             if (++sample == spp) {
                 sample = 0;
+                if (++x == settings.width) {
+                    x = 0;
+                    ++y;
+                }
                 if (++pixel < pixel_count) {
                     pixel_key = Stream::pixel_key(settings.seed,
                                                   static_cast<uint64_t>(first_pixel + pixel));
