@@ -19,6 +19,7 @@ renderer.
 """
 import os
 import pathlib
+import shutil
 import subprocess
 
 import pytest
@@ -230,6 +231,22 @@ def test_16_lanes_without_avx512_is_one_clear_line(lab02_bench, tmp_path):
     lines = p.stderr.strip().splitlines()
     assert len(lines) == 1 and "AVX-512" in lines[0] and lines[0].startswith("error:"), p.stderr
     assert list(tmp_path.iterdir()) == []
+
+
+@pytest.mark.skipif(shutil.which("nm") is None, reason="no nm (binutils) to list the symbols")
+def test_avx512_object_defines_only_its_own_code(lab02_ref):
+    """The one object built with AVX-512 (packets_avx512.o) defines no function that another
+    object could also define: every global or weak symbol in it is an instantiation for
+    Float16 or one of its entry points. So the linker never has to choose between an AVX-512
+    copy of an inline function and another (the Makefile's link order is the second line of
+    defence), and a CPU without AVX-512 never runs one."""
+    obj = ROOT / "build" / "common" / "simd" / "packets_avx512.o"
+    listing = subprocess.run(["nm", "-C", "--defined-only", str(obj)], capture_output=True,
+                             text=True, check=True).stdout
+    shared = [line for line in listing.splitlines()
+              if line.split()[1:2] and line.split()[1] in ("T", "W", "V", "u", "D", "B", "R")
+              and "Float16" not in line and "_avx512" not in line]
+    assert not shared, "symbols another object may define too:\n" + "\n".join(shared)
 
 
 def peak_memory_kib(command) -> int:
