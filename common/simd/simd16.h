@@ -10,7 +10,7 @@
 
 #if !defined(__AVX512F__) || !defined(__AVX512DQ__) || !defined(__AVX512VL__) || \
     !defined(__AVX512BW__) || !defined(__FMA__)
-#error "simd16.h needs AVX-512 (F, DQ, VL, BW): compile this file with the Makefile's SIMD_AVX512_FLAGS"
+#error "simd16.h needs AVX-512 (F, DQ, VL, BW): build this object with SIMD_AVX512_FLAGS"
 #endif
 
 // GCC 12 warns, wrongly, that the AVX-512 intrinsics' _mm512_undefined_ps() "may be used
@@ -193,8 +193,11 @@ struct U64x16 {
 
     static U64x16 load(const uint32_t* low, const uint32_t* high) {
         const auto half = [](const uint32_t* l, const uint32_t* h) {
-            const __m512i lo32 = _mm512_cvtepu32_epi64(_mm256_loadu_si256(reinterpret_cast<const __m256i*>(l)));
-            const __m512i hi32 = _mm512_cvtepu32_epi64(_mm256_loadu_si256(reinterpret_cast<const __m256i*>(h)));
+            const auto words = [](const uint32_t* w) {
+                return _mm512_cvtepu32_epi64(_mm256_loadu_si256(reinterpret_cast<const __m256i*>(w)));
+            };
+            const __m512i lo32 = words(l);
+            const __m512i hi32 = words(h);
             return _mm512_or_si512(lo32, _mm512_slli_epi64(hi32, 32));
         };
         return {half(low, high), half(low + 8, high + 8)};
@@ -202,7 +205,8 @@ struct U64x16 {
     static U64x16 sequence(uint64_t first) {
         const __m512i s = _mm512_set1_epi64(static_cast<long long>(first));
         const __m512i lane = _mm512_setr_epi64(0, 1, 2, 3, 4, 5, 6, 7);
-        return {_mm512_add_epi64(s, lane), _mm512_add_epi64(s, _mm512_add_epi64(lane, _mm512_set1_epi64(8)))};
+        const __m512i lane_8 = _mm512_add_epi64(lane, _mm512_set1_epi64(8));
+        return {_mm512_add_epi64(s, lane), _mm512_add_epi64(s, lane_8)};
     }
 };
 

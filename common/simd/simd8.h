@@ -219,8 +219,11 @@ struct U64x8 {
     // Lane i: low | high << 32, from two arrays of 8 words.
     static U64x8 load(const uint32_t* low, const uint32_t* high) {
         const auto half = [](const uint32_t* l, const uint32_t* h) {
-            const __m256i lo32 = _mm256_cvtepu32_epi64(_mm_loadu_si128(reinterpret_cast<const __m128i*>(l)));
-            const __m256i hi32 = _mm256_cvtepu32_epi64(_mm_loadu_si128(reinterpret_cast<const __m128i*>(h)));
+            const auto words = [](const uint32_t* w) {
+                return _mm256_cvtepu32_epi64(_mm_loadu_si128(reinterpret_cast<const __m128i*>(w)));
+            };
+            const __m256i lo32 = words(l);
+            const __m256i hi32 = words(h);
             return _mm256_or_si256(lo32, _mm256_slli_epi64(hi32, 32));
         };
         return {half(low, high), half(low + 4, high + 4)};

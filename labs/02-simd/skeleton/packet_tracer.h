@@ -16,7 +16,7 @@
 // register, their y in another, their z in a third.
 //
 // Per lane the arithmetic is lab 01's, operation for operation (sin and cos included: both
-// use the same polynomial, material.h and simd8.h), so every hit and every shading result has
+// use the same polynomial, material.h and lane_math.h), so every hit and every shading result has
 // lab 01's bits and lab 02's image is lab 01's, bit for bit (tests/labs/test_lab02.py).
 #pragma once
 
@@ -27,7 +27,6 @@
 #include <sample_sum.h>
 #include <scene_view.h>
 #include <simd8.h>  // and lane_math.h; a 16-lane build includes simd16.h first
-
 
 // N rays, one per lane.
 template <class F>
@@ -109,7 +108,7 @@ RT_PACKET_INLINE F intersect_sphere(const RayPacket<F>& ray, const Sphere& s, F 
 // (0, t_max), or t_max for a miss. Watertight in every lane, as the scalar test.
 template <class F>
 RT_PACKET_INLINE F intersect_triangle(const RayPacket<F>& ray, const RayShearN<F>& shear,
-                            const Triangle& tri, F t_max) {
+                                      const Triangle& tri, F t_max) {
     using Mask = MaskOf<F>;
     // The plane cull, as in the scalar test; it only rejects. The negated predicates are
     // true for NaN, as !(x <= 0) is in the scalar code.
