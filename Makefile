@@ -20,6 +20,20 @@ CXXFLAGS := -std=c++17 $(OPT) $(WARN) -DRT_SOURCE_DIR='"$(CURDIR)"' -MMD -MP
 # skeleton, a variant, a test's mutant) stands in for any of them.
 INCLUDES      := -Icommon/core -Icommon/host
 SIMD_INCLUDES := -Icommon/simd $(INCLUDES)
+# The SIMD library (x86-64 only; labs 02-04's lab.mk use it): its 8-lane object is built with
+# AVX2, its 16-lane one with AVX-512, and the choice between them (packet_renderer.o) with
+# neither, so a binary runs on any CPU with AVX2 and uses AVX-512 where the CPU has it
+# (common/simd/packet_renderer.h). SIMD_OBJ goes last on a link line, the AVX-512 object
+# last of all: where that object and another both define an inline function out of line
+# (std::string's, say), the linker keeps the first definition, so code that runs on an
+# AVX2-only CPU never calls a copy compiled with AVX-512.
+SIMD_AVX2_FLAGS   := -mavx2 -mfma
+SIMD_AVX512_FLAGS := -mavx512f -mavx512dq -mavx512vl -mavx512bw -mavx2 -mfma
+SIMD_OBJ := $(BUILD)/common/simd/packet_renderer.o $(BUILD)/common/simd/packets_avx2.o \
+            $(BUILD)/common/simd/packets_avx512.o
+$(BUILD)/common/simd/%.o: LAB_INCLUDES = -Icommon/simd
+$(BUILD)/common/simd/packets_avx2.o: CXXFLAGS += $(SIMD_AVX2_FLAGS)
+$(BUILD)/common/simd/packets_avx512.o: CXXFLAGS += $(SIMD_AVX512_FLAGS)
 
 # The library part of common/host (what unit tests link) and the driver every lab binary adds.
 LIB_SRC    := common/host/scene_loader.cpp common/host/json_with_positions.cpp common/host/image.cpp common/host/cli.cpp \

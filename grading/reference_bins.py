@@ -34,9 +34,12 @@ import subprocess
 from grading.harness import ROOT
 
 # The binaries a lab ships when its solution does not: what the grader runs and what students
-# time themselves against. Lab 02 has two parts.
-REFERENCES = {"01": ["lab01-ref"], "02": ["lab02-ref", "lab02a-ref"], "03": ["lab03-ref"],
-              "04": ["lab04-ref"], "05": ["lab05-ref"], "06": ["lab06-ref"], "07": ["lab07-ref"]}
+# time themselves against. Lab 02 has two parts, and Part B two references: lab02-ref-avx2 is
+# what students write (8 AVX2 lanes), the yardstick of their speed; lab02-ref runs at the
+# CPU's width with compacted packets (handout 02, section 8).
+REFERENCES = {"01": ["lab01-ref"], "02": ["lab02-ref", "lab02-ref-avx2", "lab02a-ref"],
+              "03": ["lab03-ref"], "04": ["lab04-ref"], "05": ["lab05-ref"], "06": ["lab06-ref"],
+              "07": ["lab07-ref"]}
 # Built where nvcc is; a release without them says so (GPU labs then build only the
 # student's own code).
 GPU_LABS = ("05", "06", "07")

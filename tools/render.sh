@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # `make render`: the default scene (Cornell box, 600x600, 512 spp, 4 bounces) to cornell.ppm
 # with the fastest reference this machine can run: the CUDA megakernel where a GPU and nvcc
-# are present, else OpenMP on every core over lab 02's AVX2 packets, else plain OpenMP.
+# are present, else OpenMP on every core over lab 02's packets at the CPU's width (16 AVX-512
+# lanes where it has them, else 8 of AVX2, compacted), else plain OpenMP.
 set -uo pipefail
 cd "$(dirname "$0")/.."
 MAKE=${MAKE:-make}
@@ -28,7 +29,11 @@ if command -v nvcc >/dev/null && nvidia-smi -L >/dev/null 2>&1; then
     say "the GPU render failed; falling back to the CPU"
 fi
 if grep -qw avx2 /proc/cpuinfo && grep -qw fma /proc/cpuinfo; then
-    try lab03-simd-ref "OpenMP on all $(nproc) cores, 8 paths per AVX2 packet" && done_with lab03-simd-ref
+    width="8 paths per AVX2 packet"
+    if grep -w avx512f /proc/cpuinfo | grep -w avx512dq | grep -w avx512vl | grep -qw avx512bw; then
+        width="16 paths per AVX-512 packet"
+    fi
+    try lab03-simd-ref "OpenMP on all $(nproc) cores, $width, compacted" && done_with lab03-simd-ref
 else
     try lab03-ref "OpenMP on all $(nproc) cores" && done_with lab03-ref
 fi

@@ -1,23 +1,29 @@
-// Lab 02's renderer of one pixel: the packet tracer (packet_tracer.h), 8 samples per AVX2
-// packet. It stands in for common/host/pixel_renderer.h (same name, same interface) in the
-// builds that put common/simd/ first on the include path: the "SIMD" variants of labs 03
-// and 04.
+// Lab 02's packet tracer as the renderer of one pixel: it stands in for
+// common/host/pixel_renderer.h (same name, same interface) in the builds that put common/simd/
+// first on the include path, the "SIMD" variants of labs 03 and 04. Each pixel's samples go
+// through the widest packets this CPU runs, compacted (packet_renderer.h): 16 AVX-512 lanes
+// where the CPU has them, else 8 AVX2 lanes; the image is lab 01's, bit for bit.
 //
-// Include it only in a translation unit built with -mavx2 -mfma, and call require_avx2()
-// (cpu_features.h) from one built without, before any AVX2 code runs.
+// No intrinsics here: the SIMD code lives in the library's objects (SIMD_OBJ in Makefile),
+// reached through a function pointer chosen at run time. Construct it only once
+// require_avx2() (cpu_features.h) has passed, as the labs' simd_entry.cpp does.
 #pragma once
 
 #include <lab.h>
-#include <packet_tracer.h>
+#include <packet_renderer.h>
 
 class PixelRenderer {
 public:
     explicit PixelRenderer(const RenderJob& job)
-        : scene_(job.scene), camera_(job.camera), settings_(job.settings) {}
+        : scene_(job.scene), camera_(job.camera), settings_(job.settings),
+          packets_(widest_packet_renderer()) {}
 
     // Reads only: safe to call from any number of threads at once.
     Vec3 operator()(int x, int y) const {
-        return render_pixel_packets(scene_, camera_, settings_, x, y);
+        Vec3 mean;
+        packets_.render(scene_, camera_, settings_, static_cast<long>(y) * settings_.width + x, 1,
+                        &mean);
+        return mean;
     }
 
     static const char* name() { return "SIMD"; }
@@ -27,4 +33,5 @@ private:
     SceneView scene_;
     Camera camera_;
     RenderSettings settings_;
+    PacketRenderer packets_;  // the width chosen for this CPU
 };

@@ -1,19 +1,18 @@
-// Lab 02 Part B: 8-lane values for AVX2 and the renderer's math on them.
+// Lab 02 Part B: 8-lane values for AVX2, and (through lane_math.h) the renderer's math on them.
 //
-// Float8 holds 8 floats (one __m256), Mask8 a true/false per lane, Int8 8 ints, Vec3x8 eight
-// Vec3s as three registers: all x in one, all y in another, all z in a third (a structure of
-// arrays, where Part A's Vec3 was one array of structures per register). Every operator is
-// one named intrinsic, so what the hardware does stays visible, and the code that uses them
-// reads like the scalar code of vec3.h, ray.h and material.h.
+// Float8 holds 8 floats (one __m256), Mask8 a true/false per lane, Int8 8 ints. Every
+// operator is one named intrinsic, so what the hardware does stays visible. simd16.h is the
+// same interface on 16 AVX-512 lanes; lane_math.h and the packet tracer are written once over
+// either (a template parameter F: Float8 or Float16), so the width is chosen at build time.
 //
 // Per lane, each function does exactly the scalar function's operations in the scalar
 // function's order, and never a fused multiply-add (the intrinsics below are separate
 // multiplies and adds; the build's -ffp-contract=off keeps the compiler from fusing them).
-// So a lane computes the same bits as the scalar code, sin and cos included (sincos_2pi8 is
-// material.h's sincos_2pi, lane by lane), and lab 02's image is lab 01's, bit for bit.
+// So a lane computes the same bits as the scalar code, sin and cos included (sincos_2pi in
+// lane_math.h is material.h's, lane by lane), and lab 02's image is lab 01's, bit for bit.
 #pragma once
 
-#if !defined(__AVX2__)
+#if !defined(__AVX2__) || !defined(__FMA__)
 #error "simd8.h needs AVX2: compile this file with -mavx2 -mfma (labs/02-simd/lab.mk does)"
 #endif
 
@@ -21,12 +20,34 @@
 
 #include <cstdint>
 
-#include <material.h>
-#include <ray.h>
-#include <rng.h>
-#include <triangle.h>
+#include <vec3.h>
 
-constexpr int kLanes = 8;  // floats in one AVX2 register
+struct Mask8;
+struct Int8;
+struct U64x8;
+class Compress8;
+
+// ---- floats ----------------------------------------------------------------------------
+
+// 8 floats. A plain float converts to all 8 lanes.
+struct Float8 {
+    using Mask = Mask8;  // what its comparisons give
+    using Int = Int8;    // indices of the same width
+    using U64 = U64x8;   // 8 unsigned 64-bit integers (random numbers)
+    using Compress = Compress8;  // moves chosen lanes to the front
+    static constexpr int kLanes = 8;
+
+    __m256 v;
+
+    Float8() = default;
+    Float8(__m256 v_) : v(v_) {}                     // NOLINT: implicit by design
+    Float8(float s) : v(_mm256_set1_ps(s)) {}        // NOLINT: broadcast
+    static Float8 load(const float* p) { return {_mm256_loadu_ps(p)}; }
+    void store(float* p) const { _mm256_storeu_ps(p, v); }
+    float lane(int i) const {
+        return _mm256_cvtss_f32(_mm256_permutevar8x32_ps(v, _mm256_set1_epi32(i)));
+    }
+};
 
 // ---- masks -----------------------------------------------------------------------------
 
@@ -41,7 +62,7 @@ struct Mask8 {
         const __m256i lane = _mm256_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7);
         return {_mm256_castsi256_ps(_mm256_cmpgt_epi32(_mm256_set1_epi32(count), lane))};
     }
-    int bits() const { return _mm256_movemask_ps(m); }  // bit i: lane i
+    unsigned bits() const { return static_cast<unsigned>(_mm256_movemask_ps(m)); }  // bit i: lane i
 };
 
 inline Mask8 operator&(Mask8 a, Mask8 b) { return {_mm256_and_ps(a.m, b.m)}; }
@@ -50,24 +71,10 @@ inline Mask8 operator~(Mask8 a) { return {_mm256_xor_ps(a.m, Mask8::all().m)}; }
 inline Mask8 and_not(Mask8 a, Mask8 b) { return {_mm256_andnot_ps(b.m, a.m)}; }  // a & ~b
 inline Mask8& operator&=(Mask8& a, Mask8 b) { return a = a & b; }
 inline Mask8& operator|=(Mask8& a, Mask8 b) { return a = a | b; }
-inline bool any(Mask8 a) { return a.bits() != 0; }
-inline bool none(Mask8 a) { return a.bits() == 0; }
+inline bool any(Mask8 a) { return _mm256_testz_ps(a.m, a.m) == 0; }
+inline bool none(Mask8 a) { return _mm256_testz_ps(a.m, a.m) != 0; }
 
-// ---- floats ----------------------------------------------------------------------------
-
-// 8 floats. A plain float converts to all 8 lanes.
-struct Float8 {
-    __m256 v;
-
-    Float8() = default;
-    Float8(__m256 v_) : v(v_) {}                     // NOLINT: implicit by design
-    Float8(float s) : v(_mm256_set1_ps(s)) {}        // NOLINT: broadcast
-    static Float8 load(const float* p) { return {_mm256_loadu_ps(p)}; }
-    void store(float* p) const { _mm256_storeu_ps(p, v); }
-    float lane(int i) const {
-        return _mm256_cvtss_f32(_mm256_permutevar8x32_ps(v, _mm256_set1_epi32(i)));
-    }
-};
+// ---- float arithmetic ------------------------------------------------------------------
 
 inline Float8 operator+(Float8 a, Float8 b) { return _mm256_add_ps(a.v, b.v); }
 inline Float8 operator-(Float8 a, Float8 b) { return _mm256_sub_ps(a.v, b.v); }
@@ -84,6 +91,11 @@ inline Mask8 operator>(Float8 a, Float8 b) { return {_mm256_cmp_ps(a.v, b.v, _CM
 inline Mask8 operator>=(Float8 a, Float8 b) { return {_mm256_cmp_ps(a.v, b.v, _CMP_GE_OQ)}; }
 inline Mask8 operator==(Float8 a, Float8 b) { return {_mm256_cmp_ps(a.v, b.v, _CMP_EQ_OQ)}; }
 inline Mask8 operator!=(Float8 a, Float8 b) { return {_mm256_cmp_ps(a.v, b.v, _CMP_NEQ_OQ)}; }
+// !(a <= b) and !(a >= b): true where a lane holds NaN, as the negated scalar test is.
+inline Mask8 not_less_equal(Float8 a, Float8 b) { return {_mm256_cmp_ps(a.v, b.v, _CMP_NLE_UQ)}; }
+inline Mask8 not_greater_equal(Float8 a, Float8 b) {
+    return {_mm256_cmp_ps(a.v, b.v, _CMP_NGE_UQ)};
+}
 
 // mask ? a : b in each lane: how a branch of the scalar code becomes straight-line code.
 inline Float8 select(Mask8 mask, Float8 a, Float8 b) { return _mm256_blendv_ps(b.v, a.v, mask.m); }
@@ -99,6 +111,10 @@ inline Float8 copysign(Float8 magnitude, Float8 sign) {
     const __m256 sign_bit = _mm256_set1_ps(-0.0f);
     return _mm256_or_ps(_mm256_andnot_ps(sign_bit, magnitude.v), _mm256_and_ps(sign_bit, sign.v));
 }
+// rint: to the nearest integer, ties to even (the scalar code's rounding mode).
+inline Float8 round_to_nearest(Float8 a) {
+    return _mm256_round_ps(a.v, _MM_FROUND_TO_NEAREST_INT | _MM_FROUND_NO_EXC);
+}
 
 // ---- ints (indices) --------------------------------------------------------------------
 
@@ -106,8 +122,12 @@ struct Int8 {
     __m256i v;
 
     Int8() = default;
-    Int8(__m256i v_) : v(v_) {}                   // NOLINT: implicit by design
+    Int8(__m256i v_) : v(v_) {}                        // NOLINT: implicit by design
     explicit Int8(int s) : v(_mm256_set1_epi32(s)) {}  // broadcast
+    static Int8 load(const int32_t* p) {
+        return {_mm256_loadu_si256(reinterpret_cast<const __m256i*>(p))};
+    }
+    void store(int32_t* p) const { _mm256_storeu_si256(reinterpret_cast<__m256i*>(p), v); }
     int lane(int i) const {
         return _mm256_cvtsi256_si32(_mm256_permutevar8x32_epi32(v, _mm256_set1_epi32(i)));
     }
@@ -118,119 +138,112 @@ inline Mask8 operator==(Int8 a, Int8 b) {
 }
 inline Mask8 operator==(Int8 a, int b) { return a == Int8(b); }
 inline Int8 operator+(Int8 a, int b) { return _mm256_add_epi32(a.v, _mm256_set1_epi32(b)); }
+inline Int8 operator&(Int8 a, int b) { return _mm256_and_si256(a.v, _mm256_set1_epi32(b)); }
+inline Int8 operator^(Int8 a, Int8 b) { return _mm256_xor_si256(a.v, b.v); }
+inline Int8 operator>>(Int8 a, int bits) { return _mm256_srli_epi32(a.v, bits); }
 inline Int8 select(Mask8 mask, Int8 a, Int8 b) {
     return _mm256_castps_si256(
         _mm256_blendv_ps(_mm256_castsi256_ps(b.v), _mm256_castsi256_ps(a.v), mask.m));
 }
-// ---- 8 Vec3s as three registers ----------------------------------------------------------
+// static_cast<int>(a) of a float that holds an integer.
+inline Int8 to_int(Float8 a) { return _mm256_cvtps_epi32(a.v); }
 
-struct Vec3x8 {
-    Float8 x, y, z;  // component c of lane i is c.lane(i)
+// ---- reading the scene -----------------------------------------------------------------
 
-    Vec3x8() = default;
-    Vec3x8(Float8 x_, Float8 y_, Float8 z_) : x(x_), y(y_), z(z_) {}
-    Vec3x8(Vec3 v) : x(v.x), y(v.y), z(v.z) {}  // NOLINT: the same Vec3 in every lane
-    Vec3 lane(int i) const { return {x.lane(i), y.lane(i), z.lane(i)}; }
+// v[k] lane by lane for a Vec3 that is the same in every lane: one in-lane permute of the 16
+// bytes at &v, no selects. (Reads one float past v: the caller guarantees it exists.)
+inline Float8 permuted(const Vec3& v, Int8 k) {
+    const __m256 row = _mm256_broadcast_ps(reinterpret_cast<const __m128*>(&v.x));
+    return _mm256_permutevar_ps(row, k.v);
+}
+
+// Per-lane fields of the scene's arrays: lane i reads (&first)[index_i * stride] where `mask`
+// holds, 0 elsewhere.
+inline Float8 gather(const float& first, int stride, Int8 index, Mask8 mask) {
+    return _mm256_mask_i32gather_ps(_mm256_setzero_ps(), &first,
+                                    _mm256_mullo_epi32(index.v, _mm256_set1_epi32(stride)),
+                                    mask.m, 4);
+}
+inline Int8 gather(const int& first, int stride, Int8 index, Mask8 mask) {
+    return _mm256_mask_i32gather_epi32(_mm256_setzero_si256(), &first,
+                                       _mm256_mullo_epi32(index.v, _mm256_set1_epi32(stride)),
+                                       _mm256_castps_si256(mask.m), 4);
+}
+
+// ---- moving lanes together (compaction) ------------------------------------------------
+
+// Moves the lanes of `keep` to the front, in order, and the others behind them: one
+// permutation per mask, from a table of all 256, applied to every field of a packet.
+class Compress8 {
+public:
+    explicit Compress8(Mask8 keep) {
+        // Entry m packs the 8 source lanes for mask m, 4 bits each, lane 0 lowest.
+        static const uint32_t* const table = [] {
+            static uint32_t t[256];
+            for (unsigned m = 0; m < 256; ++m) {
+                uint32_t packed = 0;
+                int at = 0;
+                for (int pass = 0; pass < 2; ++pass) {
+                    for (unsigned lane = 0; lane < 8; ++lane) {
+                        if (((m >> lane) & 1u) == (pass == 0 ? 1u : 0u)) {
+                            packed |= lane << (4 * at++);
+                        }
+                    }
+                }
+                t[m] = packed;
+            }
+            return t;
+        }();
+        const unsigned bits = keep.bits();
+        count_ = __builtin_popcount(bits);
+        index_ = _mm256_and_si256(
+            _mm256_srlv_epi32(_mm256_set1_epi32(static_cast<int>(table[bits])),
+                              _mm256_setr_epi32(0, 4, 8, 12, 16, 20, 24, 28)),
+            _mm256_set1_epi32(15));
+    }
+    int count() const { return count_; }  // lanes kept
+    Float8 operator()(Float8 a) const { return _mm256_permutevar8x32_ps(a.v, index_); }
+    Int8 operator()(Int8 a) const { return _mm256_permutevar8x32_epi32(a.v, index_); }
+
+private:
+    __m256i index_;
+    int count_;
 };
 
-inline Vec3x8 operator+(const Vec3x8& a, const Vec3x8& b) { return {a.x + b.x, a.y + b.y, a.z + b.z}; }
-inline Vec3x8 operator-(const Vec3x8& a, const Vec3x8& b) { return {a.x - b.x, a.y - b.y, a.z - b.z}; }
-inline Vec3x8 operator-(const Vec3x8& a) { return {-a.x, -a.y, -a.z}; }
-inline Vec3x8 operator*(const Vec3x8& a, const Vec3x8& b) { return {a.x * b.x, a.y * b.y, a.z * b.z}; }
-inline Vec3x8 operator*(const Vec3x8& a, Float8 s) { return {a.x * s, a.y * s, a.z * s}; }
-inline Vec3x8& operator+=(Vec3x8& a, const Vec3x8& b) { return a = a + b; }
-inline Vec3x8& operator*=(Vec3x8& a, const Vec3x8& b) { return a = a * b; }
-inline Vec3x8 select(Mask8 mask, const Vec3x8& a, const Vec3x8& b) {
-    return {select(mask, a.x, b.x), select(mask, a.y, b.y), select(mask, a.z, b.z)};
-}
-
-// No horizontal work anywhere: a dot product of 8 pairs is 3 multiplies and 2 adds.
-inline Float8 dot(const Vec3x8& a, const Vec3x8& b) { return a.x * b.x + a.y * b.y + a.z * b.z; }
-inline Float8 length_squared(const Vec3x8& a) { return dot(a, a); }
-inline Vec3x8 normalize(const Vec3x8& a) { return a * (Float8(1.0f) / sqrt(dot(a, a))); }
-inline Vec3x8 abs(const Vec3x8& a) { return {abs(a.x), abs(a.y), abs(a.z)}; }
-inline Float8 max_component(const Vec3x8& a) { return max(a.x, max(a.y, a.z)); }
-inline Vec3x8 reflect(const Vec3x8& d, const Vec3x8& n) { return d - n * (2.0f * dot(d, n)); }
-
-// offset_ray_origin (ray.h), lane by lane.
-inline Vec3x8 offset_ray_origin(const Vec3x8& p, const Vec3x8& n, Float8 distance_travelled,
-                                Float8 extent) {
-    constexpr float kRelativeOffset = 1.0f / (1 << 20);
-    const Float8 scale = max_component(abs(p)) + distance_travelled + extent;
-    return p + n * (scale * kRelativeOffset);
-}
-
-// orthonormal_basis (vec3.h), lane by lane.
-inline void orthonormal_basis(const Vec3x8& n, Vec3x8& t, Vec3x8& b) {
-    const Float8 sign = copysign(1.0f, n.z);
-    const Float8 a = Float8(-1.0f) / (sign + n.z);
-    const Float8 c = n.x * n.y * a;
-    t = {Float8(1.0f) + sign * n.x * n.x * a, sign * c, -sign * n.x};
-    b = {c, sign + n.y * n.y * a, -n.y};
-}
-
-// sin(2 pi u) and cos(2 pi u) for u in [0, 1). The quadrant comes exactly from 4u, the rest
-// from Cephes' single-precision polynomials on [-pi/4, pi/4] (about 1 ulp): sincos_2pi
-// (material.h) with the same operations in the same order, so the same bits.
-inline void sincos_2pi8(Float8 u, Float8& s, Float8& c) {
-    const Float8 t = u * 4.0f;                                   // exact
-    const Float8 q = _mm256_round_ps(t.v, _MM_FROUND_TO_NEAREST_INT | _MM_FROUND_NO_EXC);
-    const Float8 x = (t - q) * 1.57079632679489661923f;          // in [-pi/4, pi/4]
-    const Float8 z = x * x;
-    const Float8 sin_x =
-        x + x * z * ((Float8(-1.9515295891e-4f) * z + 8.3321608736e-3f) * z - 1.6666654611e-1f);
-    const Float8 cos_x = Float8(1.0f) - z * 0.5f +
-                         z * z * ((Float8(2.443315711809948e-5f) * z - 1.388731625493765e-3f) * z +
-                                  4.166664568298827e-2f);
-    // Quadrant k = q mod 4: sin = (sin x, cos x, -sin x, -cos x)[k], cos = (cos, -sin, -cos, sin)[k].
-    const __m256i k = _mm256_and_si256(_mm256_cvtps_epi32(q.v), _mm256_set1_epi32(3));
-    const Mask8 odd{_mm256_castsi256_ps(_mm256_cmpeq_epi32(
-        _mm256_and_si256(k, _mm256_set1_epi32(1)), _mm256_set1_epi32(1)))};
-    const Mask8 sin_negative{_mm256_castsi256_ps(_mm256_slli_epi32(_mm256_srli_epi32(k, 1), 31))};
-    const Mask8 cos_negative{_mm256_castsi256_ps(
-        _mm256_slli_epi32(_mm256_xor_si256(k, _mm256_srli_epi32(k, 1)), 31))};
-    const Float8 s_abs = select(odd, cos_x, sin_x);
-    const Float8 c_abs = select(odd, sin_x, cos_x);
-    s = _mm256_xor_ps(s_abs.v, _mm256_and_ps(sin_negative.m, _mm256_set1_ps(-0.0f)));
-    c = _mm256_xor_ps(c_abs.v, _mm256_and_ps(cos_negative.m, _mm256_set1_ps(-0.0f)));
-}
-
-// sample_cosine_hemisphere (material.h), lane by lane; sin/cos by sincos_2pi8.
-inline Vec3x8 sample_cosine_hemisphere(const Vec3x8& n, Float8 u1, Float8 u2) {
-    const Float8 r = sqrt(u1);
-    Float8 sin_phi, cos_phi;
-    sincos_2pi8(u2, sin_phi, cos_phi);
-    const Float8 x = r * cos_phi;
-    const Float8 y = r * sin_phi;
-    const Float8 z = sqrt(max(Float8(0.0f), Float8(1.0f) - u1));  // max_float's argument order
-    Vec3x8 t, b;
-    orthonormal_basis(n, t, b);
-    return t * x + b * y + n * z;
-}
-
-// fresnel_dielectric (material.h), lane by lane.
-inline Float8 fresnel_dielectric(Float8 cos_i, Float8 eta, Float8& cos_t) {
-    const Float8 sin2_t = eta * eta * max(Float8(0.0f), Float8(1.0f) - cos_i * cos_i);
-    const Mask8 total = sin2_t >= 1.0f;
-    cos_t = select(total, Float8(0.0f), sqrt(Float8(1.0f) - sin2_t));
-    const Float8 r_parallel = (cos_i - eta * cos_t) / (cos_i + eta * cos_t);
-    const Float8 r_perpendicular = (eta * cos_i - cos_t) / (eta * cos_i + cos_t);
-    const Float8 r = Float8(0.5f) * (r_parallel * r_parallel + r_perpendicular * r_perpendicular);
-    return select(total, Float8(1.0f), r);
-}
-
-// refract (material.h), lane by lane.
-inline Vec3x8 refract(const Vec3x8& d, const Vec3x8& n, Float8 eta, Float8 cos_t) {
-    const Float8 cos_i = -dot(d, n);
-    return normalize(d * eta + n * (eta * cos_i - cos_t));
-}
-
-// ---- random numbers ----------------------------------------------------------------------
+// ---- 64-bit integers, for the random numbers --------------------------------------------
 
 // 8 unsigned 64-bit integers, lanes 0-3 in lo and 4-7 in hi.
 struct U64x8 {
     __m256i lo, hi;
+
+    // Lane i: low | high << 32, from two arrays of 8 words.
+    static U64x8 load(const uint32_t* low, const uint32_t* high) {
+        const auto half = [](const uint32_t* l, const uint32_t* h) {
+            const auto words = [](const uint32_t* w) {
+                return _mm256_cvtepu32_epi64(_mm_loadu_si128(reinterpret_cast<const __m128i*>(w)));
+            };
+            const __m256i lo32 = words(l);
+            const __m256i hi32 = words(h);
+            return _mm256_or_si256(lo32, _mm256_slli_epi64(hi32, 32));
+        };
+        return {half(low, high), half(low + 4, high + 4)};
+    }
+    // first + i in lane i.
+    static U64x8 sequence(uint64_t first) {
+        const __m256i s = _mm256_set1_epi64x(static_cast<long long>(first));
+        return {_mm256_add_epi64(s, _mm256_setr_epi64x(0, 1, 2, 3)),
+                _mm256_add_epi64(s, _mm256_setr_epi64x(4, 5, 6, 7))};
+    }
 };
+
+inline U64x8 operator+(U64x8 a, uint64_t b) {
+    const __m256i s = _mm256_set1_epi64x(static_cast<long long>(b));
+    return {_mm256_add_epi64(a.lo, s), _mm256_add_epi64(a.hi, s)};
+}
+inline U64x8 operator^(U64x8 a, uint64_t b) {
+    const __m256i s = _mm256_set1_epi64x(static_cast<long long>(b));
+    return {_mm256_xor_si256(a.lo, s), _mm256_xor_si256(a.hi, s)};
+}
 
 // x * c mod 2^64 per 64-bit lane. AVX2 multiplies only 32 x 32 -> 64 bits, so the product is
 // lo(x)lo(c) + (hi(x)lo(c) + lo(x)hi(c)) << 32: three multiplies where the scalar code has one.
@@ -249,54 +262,24 @@ inline __m256i mix64(__m256i z) {
     z = mul64(_mm256_xor_si256(z, _mm256_srli_epi64(z, 27)), 0x94d049bb133111ebull);
     return _mm256_xor_si256(z, _mm256_srli_epi64(z, 31));
 }
+inline U64x8 mix64(U64x8 z) { return {mix64(z.lo), mix64(z.hi)}; }
 
-// SampleStream (rng.h) for 8 consecutive samples of one pixel: lane i is sample first + i,
-// and at() gives, per lane, exactly the float the scalar SampleStream gives.
-class SampleStream8 {
-public:
-    SampleStream8(uint64_t seed, uint64_t pixel, uint64_t first_sample) {
-        const uint64_t pixel_key = ::mix64(::mix64(seed ^ 0x9e3779b97f4a7c15ull) ^ pixel);
-        const __m256i key = _mm256_set1_epi64x(static_cast<long long>(pixel_key));
-        const __m256i s = _mm256_set1_epi64x(static_cast<long long>(first_sample));
-        key_.lo = mix64(_mm256_xor_si256(key, _mm256_add_epi64(s, _mm256_setr_epi64x(0, 1, 2, 3))));
-        key_.hi = mix64(_mm256_xor_si256(key, _mm256_add_epi64(s, _mm256_setr_epi64x(4, 5, 6, 7))));
-    }
-
-    Float8 at(uint32_t dimension) const {
-        const __m256i step = _mm256_set1_epi64x(
-            static_cast<long long>(0x9e3779b97f4a7c15ull * (dimension + 1ull)));
-        // unit_float: the top 24 bits of each 64-bit word, as an int below 2^24, scaled.
-        const __m256i lo = _mm256_srli_epi64(mix64(_mm256_add_epi64(key_.lo, step)), 40);
-        const __m256i hi = _mm256_srli_epi64(mix64(_mm256_add_epi64(key_.hi, step)), 40);
-        // 32-bit words (lo0, hi0, lo1, hi1, ...) -> (lo0, lo1, lo2, lo3, hi0, ..., hi3).
-        const __m256i interleaved = _mm256_or_si256(lo, _mm256_slli_epi64(hi, 32));
-        const __m256i bits = _mm256_permutevar8x32_epi32(
-            interleaved, _mm256_setr_epi32(0, 2, 4, 6, 1, 3, 5, 7));
-        return Float8(_mm256_cvtepi32_ps(bits)) * (1.0f / 16777216.0f);
-    }
-
-private:
-    U64x8 key_;  // hash of (seed, pixel, sample) per lane
-};
-
-// The watertight triangle test's rare case, 8 lanes wide: where an edge function rounded to
-// exactly zero (`on_edge`), recompute u, v, w of those lanes in double (triangle.h's
-// edge_function_exact), so the sign is exact there too.
-inline void redo_edges_exactly(Mask8 on_edge, Float8 ax, Float8 ay, Float8 bx, Float8 by,
-                               Float8 cx, Float8 cy, Float8& u, Float8& v, Float8& w) {
-    float uvw[3][kLanes];
-    u.store(uvw[0]);
-    v.store(uvw[1]);
-    w.store(uvw[2]);
-    for (int lane = 0; lane < kLanes; ++lane) {
-        if (!(on_edge.bits() >> lane & 1)) continue;
-        const float lax = ax.lane(lane), lay = ay.lane(lane), lbx = bx.lane(lane);
-        const float lby = by.lane(lane), lcx = cx.lane(lane), lcy = cy.lane(lane);
-        uvw[0][lane] = static_cast<float>(edge_function_exact(lcx, lcy, lbx, lby));
-        uvw[1][lane] = static_cast<float>(edge_function_exact(lax, lay, lcx, lcy));
-        uvw[2][lane] = static_cast<float>(edge_function_exact(lbx, lby, lax, lay));
-    }
-    u = Float8::load(uvw[0]);
-    v = Float8::load(uvw[1]);
-    w = Float8::load(uvw[2]);
+// unit_float (rng.h) lane by lane: the top 24 bits of each word, as a float in [0, 1).
+inline Float8 unit_float(U64x8 bits) {
+    const __m256i lo = _mm256_srli_epi64(bits.lo, 40);
+    const __m256i hi = _mm256_srli_epi64(bits.hi, 40);
+    // 32-bit words (lo0, hi0, lo1, hi1, ...) -> (lo0, lo1, lo2, lo3, hi0, ..., hi3).
+    const __m256i interleaved = _mm256_or_si256(lo, _mm256_slli_epi64(hi, 32));
+    const __m256i words =
+        _mm256_permutevar8x32_epi32(interleaved, _mm256_setr_epi32(0, 2, 4, 6, 1, 3, 5, 7));
+    return Float8(_mm256_cvtepi32_ps(words)) * (1.0f / 16777216.0f);
 }
+
+#include <lane_math.h>
+
+// The 8-lane names of lane_math.h's types.
+using Vec3x8 = Vec3xN<Float8>;
+using SampleStream8 = SampleStreamN<Float8>;
+
+// material.h's sincos_2pi on 8 lanes (lane_math.h has it for any width).
+inline void sincos_2pi8(Float8 u, Float8& s, Float8& c) { sincos_2pi(u, s, c); }

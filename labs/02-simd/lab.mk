@@ -1,6 +1,10 @@
 # Lab 02: SIMD.
-#   Part B, 8 paths per AVX2 packet (one per lane): ./lab02 (skeleton/) and ./lab02-ref
-#   (solution/).
+#   Part B, one path per SIMD lane: ./lab02 (skeleton/, 8 lanes of AVX2, what students write)
+#   and ./lab02-ref-avx2 (solution/, the same finished: the yardstick of the students' speed).
+#   ./lab02-ref: the reference at the width the CPU has (16 AVX-512 lanes, else 8 of AVX2),
+#   with compacted packets (render_widest.cpp over the SIMD library, SIMD_OBJ in Makefile).
+#   ./lab02-bench: lab02-ref whose width and method RT_SIMD_LANES (8, 16) and RT_SIMD_COMPACT
+#   (0, 1) choose, for the handout's table (tools/bench_simd.py).
 #   Part A, the lab-01 renderer with an SSE Vec3: ./lab02a (with skeleton/part-a/vec3.h) and
 #   ./lab02a-ref (with solution/part-a/vec3.h), each standing in for common/core/vec3.h.
 #   ./lab02-prims, a worked example: SIMD across primitives (one ray, 8 triangles).
@@ -12,15 +16,23 @@ ifneq ($(filter x86_64% i686% i386%,$(shell $(CXX) -dumpmachine)),)
 # render.cpp checks the CPU at run time and is built for any x86-64; render_avx2.cpp holds
 # every AVX2 instruction and is the only file built with -mavx2 -mfma (no-ops under
 # -march=native on an AVX2 machine; what lets another machine build it at all).
-# Part B's objects see lab 02's AVX2 library (common/simd/) on the include path; not their
+# Part B's objects see lab 02's SIMD library (common/simd/) on the include path.
 $(BUILD)/$(LAB02)/%.o: LAB_INCLUDES = -Icommon/simd
 $(BUILD)/$(LAB02)/skeleton/render_avx2.o $(BUILD)/$(LAB02)/solution/render_avx2.o \
-$(BUILD)/$(LAB02)/render_prims.o: CXXFLAGS += -mavx2 -mfma
+$(BUILD)/$(LAB02)/render_prims.o: CXXFLAGS += $(SIMD_AVX2_FLAGS)
 
 lab02: $(BUILD)/$(LAB02)/skeleton/render.o $(BUILD)/$(LAB02)/skeleton/render_avx2.o $(COMMON_OBJ)
 	$(CXX) $(CXXFLAGS) $^ -o $@
-lab02-ref: $(BUILD)/$(LAB02)/solution/render.o $(BUILD)/$(LAB02)/solution/render_avx2.o \
+lab02-ref-avx2: $(BUILD)/$(LAB02)/solution/render.o $(BUILD)/$(LAB02)/solution/render_avx2.o \
 	$(COMMON_OBJ)
+	$(CXX) $(CXXFLAGS) $^ -o $@
+# render_widest.cpp has no SIMD flags; SIMD_OBJ comes last (see Makefile).
+lab02-ref: $(BUILD)/$(LAB02)/render_widest.o $(COMMON_OBJ) $(SIMD_OBJ)
+	$(CXX) $(CXXFLAGS) $^ -o $@
+$(BUILD)/$(LAB02)/bench/render_widest.o: $(LAB02)/render_widest.cpp
+	@mkdir -p $(dir $@)
+	$(CXX) $(CXXFLAGS) -DRT_PACKETS_FROM_ENV $(SIMD_INCLUDES) -c $< -o $@
+lab02-bench: $(BUILD)/$(LAB02)/bench/render_widest.o $(COMMON_OBJ) $(SIMD_OBJ)
 	$(CXX) $(CXXFLAGS) $^ -o $@
 # A worked example for comparison, not graded: SIMD across primitives (simd_geometry.h).
 lab02-prims: $(BUILD)/$(LAB02)/solution/render.o $(BUILD)/$(LAB02)/render_prims.o \
@@ -48,21 +60,21 @@ lab02a-ref: $(patsubst %.cpp,$(BUILD)/vec3-sse-ref/%.o,$(LAB02A_SRC))
 lab02a: $(patsubst %.cpp,$(BUILD)/vec3-sse/%.o,$(LAB02A_SRC))
 	$(CXX) $(CXXFLAGS) $^ -o $@
 
-LAB_BINARIES += lab02 lab02-ref lab02a lab02a-ref lab02-prims
+LAB_BINARIES += lab02 lab02-ref lab02-ref-avx2 lab02-bench lab02a lab02a-ref lab02-prims
 
 # Variants (make variant): Part B as one AVX2 build; Part A against lab02a-ref's driver
 # objects (the same 16-byte Vec3 layout; only the operators' bodies differ).
-VARIANT_FLAGS_02-simd := -Icommon/simd -mavx2 -mfma
+VARIANT_FLAGS_02-simd := -Icommon/simd $(SIMD_AVX2_FLAGS)
 VARIANT_DRIVER_02-simd := $(COMMON_OBJ)
 VARIANT_DRIVER_02-simd-a := $(patsubst %.cpp,$(BUILD)/vec3-sse-ref/%.o,$(LIB_SRC) \
                             common/host/lab_main.cpp common/host/main.cpp)
 
 else
 
-lab02 lab02-ref lab02a lab02a-ref lab02-prims:
+lab02 lab02-ref lab02-ref-avx2 lab02-bench lab02a lab02a-ref lab02-prims:
 	@echo "$@: lab 02 needs an x86-64 CPU and compiler (SSE, AVX2); this is $(shell $(CXX) -dumpmachine)" >&2
 	@exit 1
 
 endif
 
-.PHONY: lab02 lab02-ref lab02a lab02a-ref lab02-prims
+.PHONY: lab02 lab02-ref lab02-ref-avx2 lab02-bench lab02a lab02a-ref lab02-prims

@@ -2,8 +2,8 @@
 # handout measures, all with the shared command line:
 #   lab03-bench            the solution with schedule(runtime): OMP_SCHEDULE picks the loop
 #                          schedule (tools/bench_openmp.py; the default build keeps the best)
-#   lab03-simd-ref         the solution on lab 02's AVX2 packet tracer (common/simd/ first on
-#                          the include path); only on x86-64
+#   lab03-simd-ref         the solution on lab 02's packet tracer at the CPU's width (16
+#                          AVX-512 lanes or 8 AVX2, compacted); only on x86-64
 #   lab03-shared-rng       the classic mistake: one generator shared by all threads, locked
 #   lab03-shared-rng-race  the same without the lock: a data race
 #   lab03-row-costs        lab 01's serial render, timing each row (the cost profile)
@@ -41,13 +41,15 @@ LAB_BINARIES += lab03 lab03-ref lab03-bench lab03-shared-rng lab03-shared-rng-ra
                 lab03-row-costs
 
 # The SIMD variant: solution/render.cpp with common/simd/ first on the include path (its
-# pixel_renderer.h is the AVX2 one) and -DRT_USE_SIMD (which renames its render() to
-# render_avx2), entered through simd_entry.cpp (built without AVX2), which checks the CPU.
+# pixel_renderer.h renders with lab 02's packets at the CPU's width) and -DRT_USE_SIMD (which
+# renames its render() to render_avx2), entered through simd_entry.cpp (built without SIMD
+# flags), which checks the CPU; the SIMD library's objects (SIMD_OBJ, Makefile) come last.
 ifneq ($(filter x86_64% i686% i386%,$(shell $(CXX) -dumpmachine)),)
 $(LAB03_BUILD)/simd/render.o: $(LAB03)/solution/render.cpp
 	@mkdir -p $(dir $@)
-	$(CXX) $(CXXFLAGS) -DRT_USE_SIMD -mavx2 -mfma $(SIMD_INCLUDES) -c $< -o $@
-lab03-simd-ref: $(LAB03_BUILD)/simd/render.o $(LAB03_BUILD)/simd_entry.o $(COMMON_OBJ)
+	$(CXX) $(CXXFLAGS) -DRT_USE_SIMD $(SIMD_INCLUDES) -c $< -o $@
+$(LAB03_BUILD)/simd_entry.o: LAB_INCLUDES = -Icommon/simd
+lab03-simd-ref: $(LAB03_BUILD)/simd/render.o $(LAB03_BUILD)/simd_entry.o $(COMMON_OBJ) $(SIMD_OBJ)
 	$(CXX) $(CXXFLAGS) $^ -o $@ -fopenmp
 LAB_BINARIES += lab03-simd-ref
 else

@@ -1,7 +1,7 @@
 """Lab 03 (OpenMP): the reference renders lab 01's image bit for bit for any thread count and
 is faster by a margin scaled to the cores present; the skeleton is correct but serial (same
-bits, no speedup); the SIMD+OpenMP variant passes the golden comparison; the shared-RNG
-variant, the classic mistake, renders but not lab 01's image."""
+bits, no speedup); the SIMD+OpenMP variant renders lab 01's bits too, at the CPU's width and
+at 8 lanes; the shared-RNG variant, the classic mistake, renders but not lab 01's image."""
 import os
 
 import pytest
@@ -130,15 +130,23 @@ def lab03_simd_ref():
 
 
 def test_simd_variant_passes_golden(lab03_simd_ref):
-    """SIMD may differ from lab 01 in the last bits, so it is compared statistically."""
     result = checks.check_golden(lab03_simd_ref, "cornell")
     assert result.passed, str(result)
 
 
-def test_simd_variant_same_for_any_thread_count(lab03_simd_ref):
-    """Its pixels still do not depend on the thread that renders them."""
-    images = {run_lab(lab03_simd_ref, threads=t, **SMALL).image.tobytes() for t in (1, 3)}
-    assert len(images) == 1
+@pytest.mark.parametrize("force_8_lanes", [False, True], ids=["widest", "8-lanes"])
+def test_simd_variant_is_lab01_bit_for_bit(lab03_simd_ref, lab01_bits, monkeypatch,
+                                           force_8_lanes):
+    """Lab 02's packets (the widest the CPU runs, or 8 AVX2 lanes as on a CPU without AVX-512)
+    under OpenMP: lab 01's image for any thread count, and the summary names the width."""
+    if force_8_lanes:
+        monkeypatch.setenv("RT_FORCE_NO_AVX512", "1")
+    for threads in (1, 3):
+        run = run_lab(lab03_simd_ref, threads=threads, **SMALL)
+        assert run.image.tobytes() == lab01_bits, f"{threads} threads: not lab 01's bits"
+        assert "paths per packet, compacted" in run.json["device"], run.json["device"]
+    if force_8_lanes:
+        assert "AVX2, 8 paths per packet" in run.json["device"], run.json["device"]
 
 
 @pytest.mark.parametrize("variant", ["lab03-shared-rng", "lab03-shared-rng-race"])

@@ -159,15 +159,24 @@ def lab04_simd_ref():
     return build("lab04-simd-ref")[0]
 
 
-def test_simd_variant(lab04_simd_ref, monkeypatch):
-    """Lab 02's AVX2 pixels under MPI: the same image for any ranks and distribution (its last
-    bits may differ from lab 01's), and right by the golden comparison."""
+def test_simd_variant(lab01_ref, lab04_simd_ref, monkeypatch):
+    """Lab 02's packets (the widest each rank's CPU runs) under MPI: lab 01's image for any
+    ranks and distribution, also with 8 AVX2 lanes forced, and right by the golden
+    comparison."""
+    lab01 = run_lab(lab01_ref, **SMALL, seed=3)
     one = run_lab(lab04_simd_ref, **SMALL, seed=3, launcher=mpirun(1), timeout=120)
     assert one.json["lab"] == "04-mpi-simd"
+    assert "paths per packet, compacted" in one.json["device"], one.json["device"]
+    assert_bitwise(one.image, lab01.image, "SIMD, 1 rank", "lab 01")
     for distribution in DISTRIBUTIONS:
         monkeypatch.setenv("RT_MPI_DISTRIBUTION", distribution)
         run = run_lab(lab04_simd_ref, **SMALL, seed=3, launcher=mpirun(3), timeout=120)
-        assert_bitwise(run.image, one.image, f"SIMD, 3 ranks, {distribution}", "1 rank")
+        assert_bitwise(run.image, lab01.image, f"SIMD, 3 ranks, {distribution}", "lab 01")
+    monkeypatch.setenv("RT_FORCE_NO_AVX512", "1")
+    run = run_lab(lab04_simd_ref, **SMALL, seed=3, launcher=mpirun(2), timeout=120)
+    assert "AVX2, 8 paths per packet" in run.json["device"], run.json["device"]
+    assert_bitwise(run.image, lab01.image, "SIMD, 8 lanes, 2 ranks", "lab 01")
+    monkeypatch.delenv("RT_FORCE_NO_AVX512")
     result = checks.check_golden(lab04_simd_ref, "cornell", launcher=mpirun(2))
     assert result.passed, str(result)
 
