@@ -3,6 +3,7 @@
 #
 #   make cuda-variant VARIANT_LAB=<lab folder> VARIANT=DIR   a CUDA lab from a folder of sources
 #   make kernel-report           registers, spills, stack and shared memory of every kernel
+#   make check-gpu-headers       every header of common/cuda and common/wavefront compiles alone
 #   make gpu-check OUT=DIR       on a GPU machine: build, test, benchmark, report (tools/gpu_check.sh)
 #
 # The shared GPU code is on the include path of every CUDA build, after the lab's own folder:
@@ -65,9 +66,9 @@ $(1)-ref: $(patsubst %.cu,$(BUILD)/%.o,$(wildcard labs/$(2)/solution/*.cu)) $(CO
 	$(NVCC) $(CUDA_ARCH) $$^ -o $$@
 endef
 
-.PHONY: kernel-report gpu-check print-cuda-build-command cuda-variant
+.PHONY: kernel-report gpu-check print-cuda-build-command cuda-variant check-gpu-headers
 ifeq ($(HAVE_NVCC),)
-kernel-report cuda-variant:
+kernel-report cuda-variant check-gpu-headers:
 	@echo "$@: needs the CUDA toolkit ($(NVCC) not found)" >&2
 	@exit 1
 else
@@ -81,10 +82,21 @@ cuda-variant: $(COMMON_OBJ)
 	@test -n "$(VARIANT)" -a -n "$(filter $(VARIANT_LAB),$(CUDA_LAB_FOLDERS))" || \
 	    { echo "cuda-variant: needs VARIANT=DIR and VARIANT_LAB=<a CUDA lab folder: $(CUDA_LAB_FOLDERS)>" >&2; exit 2; }
 	@missing="$(filter-out $(notdir $(wildcard $(VARIANT)/*)),$(CUDA_STUDENT_FILES_$(VARIANT_LAB)))"; \
-	    test -z "$$missing" || { echo "cuda-variant: $(VARIANT) has no $$missing (lab $(VARIANT_LAB)'s students write it)" >&2; exit 2; }
+	    test -z "$$missing" || { echo "error: $(VARIANT) has no $$missing: lab $(VARIANT_LAB)'s students write it" >&2; exit 2; }
 	$(NVCC) $(NVCCFLAGS) $(CUDA_ARCH) -I$(VARIANT) $(CUDA_SHARED_INCLUDES_$(VARIANT_LAB)) \
 	    $(CUDA_INCLUDES) $(INCLUDES) $(sort $(wildcard $(VARIANT)/*.cu)) $(COMMON_OBJ) -o $(VARIANT)/lab
 
+
+# Each shared GPU header compiles alone, for sm_90 with warnings as errors: it includes what
+# it uses, whichever file includes it first (make check-nvcc does the same for common/core).
+GPU_HEADERS := $(wildcard common/cuda/*.h common/cuda/*.cuh common/wavefront/*.cuh)
+$(BUILD)/gpu-headers/%.o: common/%
+	@mkdir -p $(dir $@)
+	@printf '#include <%s>\n' $(notdir $<) > $(@:.o=.cu)
+	$(NVCC) -std=c++17 -arch=sm_90 -Xcompiler -Wall,-Werror -Werror all-warnings -Icommon/wavefront \
+	    $(CUDA_INCLUDES) $(INCLUDES) -MMD -MP -MF $(@:.o=.d) -MT $@ -c $(@:.o=.cu) -o $@
+check-gpu-headers: $(patsubst common/%,$(BUILD)/gpu-headers/%.o,$(GPU_HEADERS))
+	@echo "check-gpu-headers: $(words $(GPU_HEADERS)) headers of common/cuda and common/wavefront compile alone for sm_90"
 
 # The compiler's resource report (ptxas -v) for every kernel of the GPU references and
 # lab 05's benchmark (the course report's Table 1 for our kernels), for one architecture: the

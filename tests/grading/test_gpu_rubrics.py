@@ -123,8 +123,11 @@ def test_a_gpu_submission_including_the_solution_does_not_compile(nvcc_and_sandb
     """As for the CPU labs: the solution is out of the sandboxed compiler's view (a lab 05
     render.cu that #includes it), and in view when trusted, so the test can fail."""
     from grading.grade import build_lab
+    from grading.variants import pristine_skeleton_sources
     solution = ROOT / "labs" / GPU_LABS["05"] / "solution"
     (tmp_path / "render.cu").write_text(f'#include "{solution}/render.cu"\n')
+    # The other file lab 05's students write: a hand-in without it does not build at all.
+    (tmp_path / "megakernel.cuh").write_text(pristine_skeleton_sources(GPU_LABS["05"])["megakernel.cuh"])
     binary, errors = build_lab("05", tmp_path, trusted=False)
     assert binary is None and "No such file or directory" in errors, errors
     binary, errors = build_lab("05", tmp_path, trusted=True)

@@ -59,6 +59,15 @@ def test_architectures(nvcc):
         assert codes == {"sm_" + c.replace(".", "") for c in caps}, command
 
 
+def test_shared_gpu_headers_compile_alone(nvcc):
+    """Every header of common/cuda and common/wavefront compiles on its own (it includes what it
+    uses), for sm_90 with warnings as errors."""
+    p = make("-j2", "check-gpu-headers")
+    assert p.returncode == 0, p.stdout + p.stderr
+    headers = sorted((ROOT / "common" / "cuda").glob("*.*h")) + sorted((ROOT / "common" / "wavefront").glob("*.cuh"))
+    assert f"check-gpu-headers: {len(headers)} headers" in p.stdout, p.stdout
+
+
 def test_skeleton_in_sync():
     """The committed skeleton is exactly what tools/skeletons.py makes from the solution."""
     from grading.variants import pristine_skeleton_sources
