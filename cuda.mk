@@ -4,6 +4,7 @@
 #   make cuda-variant VARIANT_LAB=<lab folder> VARIANT=DIR   a CUDA lab from a folder of sources
 #   make kernel-report           registers, spills, stack and shared memory of every kernel
 #   make check-gpu-headers       every header of common/cuda and common/wavefront compiles alone
+#   make check-speed-targets     the benchmarks' speed-target verdicts, on the host (no GPU needed)
 #   make gpu-check OUT=DIR       on a GPU machine: build, test, benchmark, report (tools/gpu_check.sh)
 #
 # The shared GPU code is on the include path of every CUDA build, after the lab's own folder:
@@ -66,9 +67,10 @@ $(1)-ref: $(patsubst %.cu,$(BUILD)/%.o,$(wildcard labs/$(2)/solution/*.cu)) $(CO
 	$(NVCC) $(CUDA_ARCH) $$^ -o $$@
 endef
 
-.PHONY: kernel-report gpu-check print-cuda-build-command cuda-variant check-gpu-headers
+.PHONY: kernel-report gpu-check print-cuda-build-command cuda-variant check-gpu-headers \
+        check-speed-targets
 ifeq ($(HAVE_NVCC),)
-kernel-report cuda-variant check-gpu-headers:
+kernel-report cuda-variant check-gpu-headers check-speed-targets:
 	@echo "$@: needs the CUDA toolkit ($(NVCC) not found)" >&2
 	@exit 1
 else
@@ -97,6 +99,14 @@ $(BUILD)/gpu-headers/%.o: common/%
 	    $(CUDA_INCLUDES) $(INCLUDES) -MMD -MP -MF $(@:.o=.d) -MT $@ -c $(@:.o=.cu) -o $@
 check-gpu-headers: $(patsubst common/%,$(BUILD)/gpu-headers/%.o,$(GPU_HEADERS))
 	@echo "check-gpu-headers: $(words $(GPU_HEADERS)) headers of common/cuda and common/wavefront compile alone for sm_90"
+
+# Host code only: the verdicts the benchmarks print (tests/cuda/speed_targets_check.cu).
+$(BUILD)/cuda/speed_targets_check: tests/cuda/speed_targets_check.cu
+	@mkdir -p $(dir $@)
+	$(NVCC) -std=c++17 -arch=sm_90 -Xcompiler -Wall,-Werror -Werror all-warnings $(CUDA_INCLUDES) \
+	    $(INCLUDES) -MMD -MP -MF $@.d $< -o $@
+check-speed-targets: $(BUILD)/cuda/speed_targets_check
+	@$<
 
 # The compiler's resource report (ptxas -v) for every kernel of the GPU references and
 # lab 05's benchmark (the course report's Table 1 for our kernels), for one architecture: the

@@ -16,9 +16,9 @@
 #      DIR/wavefront.tar.gz.
 # Writes DIR/gpu-check.json (everything) and DIR/summary.md (the tables, the speed targets
 # first), plus the logs; exits 0 only when every step that ran succeeded.
-# GPU_CHECK_SKIP="sanitizer ncu wavefront" leaves those steps out (when time on the machine is
-# short: their results change only when the kernels do; labs/06-cuda-split/measure.sh runs
-# the wavefront step alone).
+# GPU_CHECK_SKIP="tests bench sanitizer ncu report wavefront" leaves any of those steps out, and
+# GPU_CHECK_TESTS="FILE ..." runs only those test files: one call can be split into several
+# that each fit a time limit (build outputs are reused; each call writes its own DIR).
 #
 #   tools/gpu_check.sh DIR          run it (on the GPU machine)
 #   tools/gpu_check.sh --prepare    here, before sending the tree to a machine without the
@@ -110,17 +110,22 @@ if command -v cuobjdump >/dev/null && [ -x lab05-bench ]; then
         END { for (k in n) print k "\t" n[k] }' | sort > /tmp/gpu-check-sass-loads.tsv
 fi
 
+# A step named in GPU_CHECK_SKIP is recorded as skipped and left out.
+skipped() { [[ " ${GPU_CHECK_SKIP:-} " == *" $1 "* ]] && { step[$1]=skipped; say "$1: skipped (GPU_CHECK_SKIP)"; }; }
+
 # ---- 4. the GPU tests -------------------------------------------------------------------
-# GPU_CHECK_TESTS overrides the selection (a call split in two to fit its time limit).
 gpu_tests=${GPU_CHECK_TESTS:-"tests/labs/test_lab05.py tests/labs/test_lab06.py tests/labs/test_lab07.py tests/labs/test_device_code.py tests/grading/test_gpu_rubrics.py"}
-say "tests: pytest $gpu_tests"
-python3 -m pytest -q -rs -p no:cacheprovider $gpu_tests \
-    --junitxml=/tmp/gpu-check-junit.xml > "$out/pytest.txt" 2>&1
-step[tests]=$([ $? -eq 0 ] && echo ok || echo failed)
-tail -3 "$out/pytest.txt" | tee -a "$log"
+rm -f /tmp/gpu-check-junit.xml
+if ! skipped tests; then
+    say "tests: pytest $gpu_tests"
+    python3 -m pytest -q -rs -p no:cacheprovider $gpu_tests \
+        --junitxml=/tmp/gpu-check-junit.xml > "$out/pytest.txt" 2>&1
+    step[tests]=$([ $? -eq 0 ] && echo ok || echo failed)
+    tail -3 "$out/pytest.txt" | tee -a "$log"
+fi
 
 # ---- 5-7. measurements ------------------------------------------------------------------
-if [ -x lab05-bench ]; then
+if ! skipped bench && [ -x lab05-bench ]; then
     say "benchmark: lab05-bench --repeat 5 (the baseline)"
     ./lab05-bench --repeat 5 > "$out/bench.json" 2>> "$log" && step[bench]=ok || step[bench]=failed
     say "benchmark: lab05-bench-fast-math (--use_fast_math), the main shapes"
@@ -130,7 +135,7 @@ fi
 # The wavefront labs' references and their targets on the baseline (measure.sh, step 8, has
 # every configuration on four scenes).
 for lab in lab06 lab07; do
-    if [ -x $lab-bench ]; then
+    if [[ " ${GPU_CHECK_SKIP:-} " != *" bench "* ]] && [ -x $lab-bench ]; then
         say "benchmark: $lab-bench --repeat 5 (the baseline: the pools and the megakernel)"
         ./$lab-bench --repeat 5 --only AoS,SoA,megakernel > "$out/bench-$lab.json" 2>> "$log" \
             && step[bench_$lab]=ok || step[bench_$lab]=failed
@@ -139,7 +144,6 @@ done
 
 # The memory checker on a small render: no out-of-bounds access, no uninitialised read, no
 # race on the shared-memory copy of the scene (lab05-bench's scene-shared shape).
-skipped() { [[ " ${GPU_CHECK_SKIP:-} " == *" $1 "* ]] && { step[$1]=skipped; say "$1: skipped (GPU_CHECK_SKIP)"; }; }
 if ! skipped sanitizer && command -v compute-sanitizer >/dev/null && [ -x lab05-ref ]; then
     say "compute-sanitizer: memcheck and initcheck on lab05-ref, memcheck on lab06-ref and lab07-ref, racecheck on scene-shared"
     { compute-sanitizer --tool memcheck --error-exitcode 3 ./lab05-ref --quiet --width 48 --height 40 --spp 4 &&
@@ -167,7 +171,10 @@ if ! skipped ncu && [ -n "$ncu_bin" ] && [ -x lab05-bench ]; then
 fi
 
 # Accuracy, process time, and the JSON and Markdown reports (tools/gpu_report.py).
-GPU_CHECK_METRICS=${metrics:-} python3 tools/gpu_report.py "$out" 2>&1 | tee -a "$log"
+if ! skipped report; then
+    GPU_CHECK_METRICS=${metrics:-} python3 tools/gpu_report.py "$out" 2>&1 | tee -a "$log"
+    step[report]=$([ "${PIPESTATUS[0]}" -eq 0 ] && echo ok || echo failed)
+fi
 
 # ---- 8. the wavefront labs --------------------------------------------------------------
 if ! skipped wavefront && [ -x lab07-bench ]; then

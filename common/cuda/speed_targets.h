@@ -64,7 +64,7 @@ std::string targets_json(const SpeedTarget (&targets)[N],
         else std::snprintf(buffer, sizeof buffer, "\"best_ms\": null, ");
         out += buffer;
         out += std::string("\"met\": ") + verdict;
-        if (!measured) out += ", \"why_not\": \"not run (--only)\"";
+        if (!measured) out += ", \"why_not\": \"not run in this call\"";
         else if (!why_not.empty()) out += ", \"why_not\": \"" + why_not + "\"";
         out += "}";
     }

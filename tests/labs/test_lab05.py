@@ -68,6 +68,14 @@ def test_shared_gpu_headers_compile_alone(nvcc):
     assert f"check-gpu-headers: {len(headers)} headers" in p.stdout, p.stdout
 
 
+def test_speed_target_verdicts(nvcc):
+    """What the benchmarks say of their speed targets (common/cuda/speed_targets.h): judged
+    only for the baseline on the GPU the bars are set on; met, missed, not judged, not run
+    (tests/cuda/speed_targets_check.cu holds the cases)."""
+    p = make("check-speed-targets")
+    assert p.returncode == 0 and "every case holds" in p.stdout, p.stdout + p.stderr
+
+
 def test_skeleton_in_sync():
     """The committed skeleton is exactly what tools/skeletons.py makes from the solution."""
     from grading.variants import pristine_skeleton_sources
