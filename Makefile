@@ -45,8 +45,8 @@ COMMON_OBJ := $(LIB_OBJ) $(DRIVER_OBJ)
 
 # The double build (common/core/real.h): the same sources with -DRT_DOUBLE, every object in
 # build/double/ (a float object and a double one must never be linked together: Vec3 differs).
-# Offered for lab 01 and the GPU megakernel (lab05-ref-double, cuda.mk); labs 02-04 use lab
-# 02's 8-wide float AVX2 code and have no double build.
+# Offered for lab 01 and the GPU megakernel (lab05-ref-double, labs/05-cuda-mega/lab.mk);
+# labs 02-04 use lab 02's 8-wide float AVX2 code and have no double build.
 DOUBLE_BUILD      := $(BUILD)/double
 DOUBLE_LIB_OBJ    := $(LIB_OBJ:$(BUILD)/%=$(DOUBLE_BUILD)/%)
 DOUBLE_COMMON_OBJ := $(COMMON_OBJ:$(BUILD)/%=$(DOUBLE_BUILD)/%)

@@ -1,13 +1,17 @@
-# CUDA labs (05-07): the nvcc rules. Included by the Makefile before the labs' lab.mk files (labs 06 and 07 use cuda_lab).
+# CUDA labs (05-07): the nvcc rules. Included by the Makefile before the labs' lab.mk files,
+# which build their labs with cuda_lab (below); each lab's own targets are in its lab.mk.
 #
-#   make lab05 / lab05-ref       lab 05's student build / reference (labs/05-cuda-mega)
-#   make lab05-bench             the kernel shapes the handout measures (labs/05-cuda-mega/bench.cu)
-#   make lab05-bench-fast-math   the same built with --use_fast_math
-#   make lab05-ref-fast-math     the reference built with --use_fast_math (accuracy table)
-#   make lab05-ref-no-fma        the reference built with --fmad=false (no fused multiply-add)
-#   make lab05-ref-double        the reference in double precision (common/core/real.h)
+#   make cuda-variant VARIANT_LAB=<lab folder> VARIANT=DIR   a CUDA lab from a folder of sources
 #   make kernel-report           registers, spills, stack and shared memory of every kernel
+#   make check-gpu-headers       every header of common/cuda and common/wavefront compiles alone
+#   make check-speed-targets     the benchmarks' speed-target verdicts, on the host (no GPU needed)
 #   make gpu-check OUT=DIR       on a GPU machine: build, test, benchmark, report (tools/gpu_check.sh)
+#
+# The shared GPU code is on the include path of every CUDA build, after the lab's own folder:
+# common/cuda/ (error checks, device memory, timers, the scene upload, the reference
+# megakernel), and for the wavefront labs common/wavefront/ (queues, pool layouts, kernels,
+# stage loop, renderer). A file students write (labs/NN/skeleton/) stands in for the shared
+# file of the same name, as lab 01's path_tracer.h does (DESIGN.md, section 1).
 #
 # Architectures: the GPUs present (nvidia-smi's compute capability), or, where there is none
 # (CI), machine code for sm_75 (Turing), sm_80 (A100), sm_86 (RTX 30), sm_89 (L4, RTX 40) and
@@ -35,83 +39,74 @@ endif
 # --threads 0: one compiler process per architecture, in parallel.
 NVCCFLAGS := -std=c++17 -O3 --threads 0 $(CUDA_WARN)
 
+# After a lab's own folders (LAB_INCLUDES), before common/core and common/host.
+CUDA_INCLUDES := -Icommon/cuda
+
 $(BUILD)/%.o: %.cu
 	@mkdir -p $(dir $@)
-	$(NVCC) $(NVCCFLAGS) $(CUDA_ARCH) $(CUDA_VARIANT_FLAGS) $(LAB_INCLUDES) $(INCLUDES) \
-	    -MMD -MP -MF $(@:.o=.d) -c $< -o $@
+	$(NVCC) $(NVCCFLAGS) $(CUDA_ARCH) $(CUDA_VARIANT_FLAGS) $(LAB_INCLUDES) $(CUDA_INCLUDES) \
+	    $(INCLUDES) -MMD -MP -MF $(@:.o=.d) -c $< -o $@
 
 # The exact nvcc command lab objects are built with (tests build the pristine skeleton so).
 print-cuda-build-command:
-	@echo $(NVCC) $(NVCCFLAGS) $(CUDA_ARCH) $(INCLUDES)
+	@echo $(NVCC) $(NVCCFLAGS) $(CUDA_ARCH) $(CUDA_INCLUDES) $(INCLUDES)
 
-# $(1): binary stem (lab05), $(2): lab folder (05-cuda-mega). The lab's own folder is on the
-# include path after skeleton/ or solution/, for the files both share.
+# $(1): binary stem (lab05), $(2): lab folder (05-cuda-mega), $(3): the shared GPU folders
+# the lab builds on besides common/cuda (common/wavefront), $(4): the files its students
+# write that stand in for shared ones (megakernel.cuh; tools/skeletons.py's SHARED_SOURCES).
+# skeleton/ or solution/ comes first on the include path, then $(3), then CUDA_INCLUDES.
 define cuda_lab
-$(BUILD)/labs/$(2)/skeleton/%.o: LAB_INCLUDES = -Ilabs/$(2)/skeleton -Ilabs/$(2)
-$(BUILD)/labs/$(2)/solution/%.o: LAB_INCLUDES = -Ilabs/$(2)/solution -Ilabs/$(2)
+CUDA_LAB_FOLDERS += $(2)
+CUDA_SHARED_INCLUDES_$(2) := $(addprefix -I,$(3))
+CUDA_STUDENT_FILES_$(2) := $(4)
+$(BUILD)/labs/$(2)/skeleton/%.o: LAB_INCLUDES = -Ilabs/$(2)/skeleton $(addprefix -I,$(3))
+$(BUILD)/labs/$(2)/solution/%.o: LAB_INCLUDES = -Ilabs/$(2)/solution $(addprefix -I,$(3))
 $(1): $(patsubst %.cu,$(BUILD)/%.o,$(wildcard labs/$(2)/skeleton/*.cu)) $(COMMON_OBJ)
 	$(NVCC) $(CUDA_ARCH) $$^ -o $$@
 $(1)-ref: $(patsubst %.cu,$(BUILD)/%.o,$(wildcard labs/$(2)/solution/*.cu)) $(COMMON_OBJ)
 	$(NVCC) $(CUDA_ARCH) $$^ -o $$@
 endef
 
-# ---- lab 05 -------------------------------------------------------------------------------
-LAB05 := labs/05-cuda-mega
-LAB05_BUILD := $(BUILD)/$(LAB05)
-LAB05_TARGETS := lab05 lab05-ref lab05-bench lab05-bench-fast-math lab05-ref-fast-math \
-                 lab05-ref-no-fma lab05-ref-double
-.PHONY: $(LAB05_TARGETS) kernel-report gpu-check print-cuda-build-command cuda-variant
-
+.PHONY: kernel-report gpu-check print-cuda-build-command cuda-variant check-gpu-headers \
+        check-speed-targets
 ifeq ($(HAVE_NVCC),)
-$(LAB05_TARGETS) kernel-report cuda-variant:
+kernel-report cuda-variant check-gpu-headers check-speed-targets:
 	@echo "$@: needs the CUDA toolkit ($(NVCC) not found)" >&2
 	@exit 1
 else
-$(eval $(call cuda_lab,lab05,05-cuda-mega))
-
-# Variants of the reference: the same source under other flags, objects in their own folders.
-$(LAB05_BUILD)/fast-math/render.o: CUDA_VARIANT_FLAGS = --use_fast_math
-$(LAB05_BUILD)/no-fma/render.o: CUDA_VARIANT_FLAGS = --fmad=false
-$(LAB05_BUILD)/fast-math/render.o $(LAB05_BUILD)/no-fma/render.o: $(LAB05)/solution/render.cu
-	@mkdir -p $(dir $@)
-	$(NVCC) $(NVCCFLAGS) $(CUDA_ARCH) $(CUDA_VARIANT_FLAGS) -I$(LAB05)/solution -I$(LAB05) \
-	    $(INCLUDES) -MMD -MP -MF $(@:.o=.d) -c $< -o $@
-lab05-ref-fast-math: $(LAB05_BUILD)/fast-math/render.o $(COMMON_OBJ)
-	$(NVCC) $(CUDA_ARCH) $^ -o $@
-lab05-ref-no-fma: $(LAB05_BUILD)/no-fma/render.o $(COMMON_OBJ)
-	$(NVCC) $(CUDA_ARCH) $^ -o $@
-# The reference in double: -DRT_DOUBLE, linked with the double build's host objects (Makefile).
-$(LAB05_BUILD)/double/render.o: $(LAB05)/solution/render.cu
-	@mkdir -p $(dir $@)
-	$(NVCC) $(NVCCFLAGS) $(CUDA_ARCH) -DRT_DOUBLE -I$(LAB05)/solution -I$(LAB05) \
-	    $(INCLUDES) -MMD -MP -MF $(@:.o=.d) -c $< -o $@
-lab05-ref-double: $(LAB05_BUILD)/double/render.o $(DOUBLE_COMMON_OBJ)
-	$(NVCC) $(CUDA_ARCH) $^ -o $@
-
-# A CUDA lab built from a folder of edited sources (the pristine skeleton, a mutant), as
-# `make variant` does for the CPU labs: `make cuda-variant VARIANT_LAB=05-cuda-mega
-# VARIANT=DIR` compiles DIR/*.cu with DIR first on the include path, then the folders the
-# lab's own build uses (VARIANT_INCLUDES_<lab>), and links the shared driver into DIR/lab.
-VARIANT_INCLUDES_05-cuda-mega := -I$(LAB05)
+# A CUDA lab built from a folder of edited sources (the pristine skeleton, a mutant, a
+# submission), as `make variant` does for the CPU labs: `make cuda-variant VARIANT_LAB=
+# 05-cuda-mega VARIANT=DIR` compiles DIR/*.cu with DIR first on the include path, then the
+# shared folders the lab's own build uses, and links the shared driver into DIR/lab. DIR
+# must hold every file the lab's students write: without one, the shared reference of the
+# same name would be compiled in its place.
 cuda-variant: $(COMMON_OBJ)
-	@test -n "$(VARIANT)" -a -n "$(VARIANT_INCLUDES_$(VARIANT_LAB))" || \
-	    { echo "cuda-variant: needs VARIANT=DIR and VARIANT_LAB=<a CUDA lab folder>" >&2; exit 2; }
-	$(NVCC) $(NVCCFLAGS) $(CUDA_ARCH) -I$(VARIANT) $(VARIANT_INCLUDES_$(VARIANT_LAB)) $(INCLUDES) \
-	    $(sort $(wildcard $(VARIANT)/*.cu)) $(COMMON_OBJ) -o $(VARIANT)/lab
+	@test -n "$(VARIANT)" -a -n "$(filter $(VARIANT_LAB),$(CUDA_LAB_FOLDERS))" || \
+	    { echo "cuda-variant: needs VARIANT=DIR and VARIANT_LAB=<a CUDA lab folder: $(CUDA_LAB_FOLDERS)>" >&2; exit 2; }
+	@missing="$(filter-out $(notdir $(wildcard $(VARIANT)/*)),$(CUDA_STUDENT_FILES_$(VARIANT_LAB)))"; \
+	    test -z "$$missing" || { echo "error: $(VARIANT) has no $$missing: lab $(VARIANT_LAB)'s students write it" >&2; exit 2; }
+	$(NVCC) $(NVCCFLAGS) $(CUDA_ARCH) -I$(VARIANT) $(CUDA_SHARED_INCLUDES_$(VARIANT_LAB)) \
+	    $(CUDA_INCLUDES) $(INCLUDES) $(sort $(wildcard $(VARIANT)/*.cu)) $(COMMON_OBJ) -o $(VARIANT)/lab
 
-# The benchmark has its own main; it links the library part of common/host only.
-$(LAB05_BUILD)/bench.o: LAB_INCLUDES = -I$(LAB05)/solution -I$(LAB05)
-lab05-bench: $(LAB05_BUILD)/bench.o $(LIB_OBJ)
-	$(NVCC) $(CUDA_ARCH) $^ -o $@
-$(LAB05_BUILD)/fast-math/bench.o: $(LAB05)/bench.cu
+
+# Each shared GPU header compiles alone, for sm_90 with warnings as errors: it includes what
+# it uses, whichever file includes it first (make check-nvcc does the same for common/core).
+GPU_HEADERS := $(wildcard common/cuda/*.h common/cuda/*.cuh common/wavefront/*.cuh)
+$(BUILD)/gpu-headers/%.o: common/%
 	@mkdir -p $(dir $@)
-	$(NVCC) $(NVCCFLAGS) $(CUDA_ARCH) --use_fast_math -I$(LAB05)/solution -I$(LAB05) \
-	    $(INCLUDES) -MMD -MP -MF $(@:.o=.d) -c $< -o $@
-lab05-bench-fast-math: $(LAB05_BUILD)/fast-math/bench.o $(LIB_OBJ)
-	$(NVCC) $(CUDA_ARCH) $^ -o $@
+	@printf '#include <%s>\n' $(notdir $<) > $(@:.o=.cu)
+	$(NVCC) -std=c++17 -arch=sm_90 -Xcompiler -Wall,-Werror -Werror all-warnings -Icommon/wavefront \
+	    $(CUDA_INCLUDES) $(INCLUDES) -MMD -MP -MF $(@:.o=.d) -MT $@ -c $(@:.o=.cu) -o $@
+check-gpu-headers: $(patsubst common/%,$(BUILD)/gpu-headers/%.o,$(GPU_HEADERS))
+	@echo "check-gpu-headers: $(words $(GPU_HEADERS)) headers of common/cuda and common/wavefront compile alone for sm_90"
 
-LAB_BINARIES += $(LAB05_TARGETS)
-labs: $(LAB05_TARGETS)
+# Host code only: the verdicts the benchmarks print (tests/cuda/speed_targets_check.cu).
+$(BUILD)/cuda/speed_targets_check: tests/cuda/speed_targets_check.cu
+	@mkdir -p $(dir $@)
+	$(NVCC) -std=c++17 -arch=sm_90 -Xcompiler -Wall,-Werror -Werror all-warnings $(CUDA_INCLUDES) \
+	    $(INCLUDES) -MMD -MP -MF $@.d $< -o $@
+check-speed-targets: $(BUILD)/cuda/speed_targets_check
+	@$<
 
 # The compiler's resource report (ptxas -v) for every kernel of the GPU references and
 # lab 05's benchmark (the course report's Table 1 for our kernels), for one architecture: the
@@ -119,22 +114,20 @@ labs: $(LAB05_TARGETS)
 # its own build uses.
 KERNEL_REPORT_ARCH = $(if $(CUDA_GPU_CAPS),sm_$(firstword $(CUDA_GPU_CAPS)),sm_90)
 KERNEL_REPORT_NVCC = $(NVCC) -std=c++17 -O3 -arch=$(KERNEL_REPORT_ARCH) -Xptxas -v
+kernel_report_compile = $(KERNEL_REPORT_NVCC) -Ilabs/$(1)/solution $(CUDA_SHARED_INCLUDES_$(1)) \
+    $(CUDA_INCLUDES) $(INCLUDES) -c labs/$(1)/$(2) -o $(BUILD)/kernel-report/$(3).o
 kernel-report:
 	@mkdir -p $(BUILD)/kernel-report
-	@{ $(KERNEL_REPORT_NVCC) -I$(LAB05)/solution -I$(LAB05) $(INCLUDES) \
-	       -c $(LAB05)/solution/render.cu -o $(BUILD)/kernel-report/lab05.o && \
-	   $(KERNEL_REPORT_NVCC) -I$(LAB05)/solution -I$(LAB05) $(INCLUDES) \
-	       -c $(LAB05)/bench.cu -o $(BUILD)/kernel-report/lab05-bench.o && \
-	   $(KERNEL_REPORT_NVCC) -Ilabs/06-cuda-split/solution $(VARIANT_INCLUDES_06-cuda-split) \
-	       $(INCLUDES) -c labs/06-cuda-split/solution/render.cu -o $(BUILD)/kernel-report/lab06.o && \
-	   $(KERNEL_REPORT_NVCC) -Ilabs/07-soa/solution $(VARIANT_INCLUDES_07-soa) \
-	       $(INCLUDES) -c labs/07-soa/solution/render.cu -o $(BUILD)/kernel-report/lab07.o; \
+	@{ $(call kernel_report_compile,05-cuda-mega,solution/render.cu,lab05) && \
+	   $(call kernel_report_compile,05-cuda-mega,bench.cu,lab05-bench) && \
+	   $(call kernel_report_compile,06-cuda-split,solution/render.cu,lab06) && \
+	   $(call kernel_report_compile,07-soa,solution/render.cu,lab07); \
 	 } > $(BUILD)/kernel-report/ptxas.log 2>&1 || { cat $(BUILD)/kernel-report/ptxas.log; exit 1; }
-	@$(PYTHON) $(LAB05)/kernel_report.py $(BUILD)/kernel-report/ptxas.log \
+	@$(PYTHON) labs/05-cuda-mega/kernel_report.py $(BUILD)/kernel-report/ptxas.log \
 	    --arch $(KERNEL_REPORT_ARCH) --out $(BUILD)/kernel-report.md
 endif
 
-# Everything the device machine should do, in one call: tools/gpu_check.sh OUT.
+# Everything a GPU machine should check, in one call: tools/gpu_check.sh OUT.
 OUT ?= $(BUILD)/gpu-check
 gpu-check:
 	bash tools/gpu_check.sh $(OUT)

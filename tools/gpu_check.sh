@@ -1,18 +1,24 @@
 #!/usr/bin/env bash
 # Everything the CUDA labs need a GPU for, in one call (`make gpu-check OUT=DIR`):
 #   1. the machine: GPU, driver, nvcc, host compiler;
-#   2. build every CUDA target for the GPU present (plus lab 01's reference): labs 05-07;
+#   2. build every CUDA target for the GPU present (plus lab 01's reference): labs 05-07, their
+#      benchmarks and lab 05's flag and precision variants;
 #   3. the compiler's resource report (make kernel-report) and the scene loads in the SASS;
 #   4. the GPU tests (pytest), for real;
-#   5. the benchmark: every kernel shape of lab05-bench on the baseline, CUDA events, best and
-#      median of 5 after a warm-up; process time against kernel time;
+#   5. the benchmarks on the baseline, CUDA events, best and median of 5 after a warm-up, each
+#      with its lab's speed targets (common/cuda/speed_targets.h) judged: every kernel shape
+#      of lab05-bench (DIR/bench.json), lab06-bench (bench-lab06.json) and lab07-bench
+#      (bench-lab07.json); process time against kernel time;
 #   6. accuracy of --use_fast_math and --fmad=false against the golden image and lab 01;
-#   7. divergence and occupancy from Nsight Compute's counters, where ncu can read them;
-#   8. the wavefront labs (06, 07): labs/06-cuda-split/measure.sh, into DIR/wavefront.tar.gz.
-# Writes DIR/gpu-check.json (everything) and DIR/summary.md (the tables), plus the logs.
-# GPU_CHECK_SKIP="sanitizer ncu wavefront" leaves those steps out (a short lease, or a call's
-# time limit: their results change only when the kernels do; labs/06-cuda-split/measure.sh
-# runs the wavefront step alone).
+#   7. compute-sanitizer on labs 05-07; divergence and occupancy from Nsight Compute's
+#      counters, where ncu can read them;
+#   8. the wavefront labs (06, 07) on four scenes: labs/06-cuda-split/measure.sh, into
+#      DIR/wavefront.tar.gz.
+# Writes DIR/gpu-check.json (everything) and DIR/summary.md (the tables, the speed targets
+# first), plus the logs; exits 0 only when every step that ran succeeded.
+# GPU_CHECK_SKIP="tests bench sanitizer ncu report wavefront" leaves any of those steps out, and
+# GPU_CHECK_TESTS="FILE ..." runs only those test files: one call can be split into several
+# that each fit a time limit (build outputs are reused; each call writes its own DIR).
 #
 #   tools/gpu_check.sh DIR          run it (on the GPU machine)
 #   tools/gpu_check.sh --prepare    here, before sending the tree to a machine without the
@@ -89,7 +95,8 @@ fi
 jobs=$(nproc)
 start=$(date +%s)
 run_step build make -j"$jobs" lab01-ref lab05 lab05-ref lab05-bench lab05-bench-fast-math \
-    lab05-ref-fast-math lab05-ref-no-fma lab06 lab06-ref lab06-bench lab07 lab07-ref lab07-bench
+    lab05-ref-fast-math lab05-ref-no-fma lab05-ref-double lab06 lab06-ref lab06-bench \
+    lab07 lab07-ref lab07-bench
 say "build took $(( $(date +%s) - start )) s"
 
 # ---- 3. the compiler's report -----------------------------------------------------------
@@ -103,31 +110,46 @@ if command -v cuobjdump >/dev/null && [ -x lab05-bench ]; then
         END { for (k in n) print k "\t" n[k] }' | sort > /tmp/gpu-check-sass-loads.tsv
 fi
 
+# A step named in GPU_CHECK_SKIP is recorded as skipped and left out.
+skipped() { [[ " ${GPU_CHECK_SKIP:-} " == *" $1 "* ]] && { step[$1]=skipped; say "$1: skipped (GPU_CHECK_SKIP)"; }; }
+
 # ---- 4. the GPU tests -------------------------------------------------------------------
-# GPU_CHECK_TESTS overrides the selection (a call split in two to fit its time limit).
 gpu_tests=${GPU_CHECK_TESTS:-"tests/labs/test_lab05.py tests/labs/test_lab06.py tests/labs/test_lab07.py tests/labs/test_device_code.py tests/grading/test_gpu_rubrics.py"}
-say "tests: pytest $gpu_tests"
-python3 -m pytest -q -rs -p no:cacheprovider $gpu_tests \
-    --junitxml=/tmp/gpu-check-junit.xml > "$out/pytest.txt" 2>&1
-step[tests]=$([ $? -eq 0 ] && echo ok || echo failed)
-tail -3 "$out/pytest.txt" | tee -a "$log"
+rm -f /tmp/gpu-check-junit.xml
+if ! skipped tests; then
+    say "tests: pytest $gpu_tests"
+    python3 -m pytest -q -rs -p no:cacheprovider $gpu_tests \
+        --junitxml=/tmp/gpu-check-junit.xml > "$out/pytest.txt" 2>&1
+    step[tests]=$([ $? -eq 0 ] && echo ok || echo failed)
+    tail -3 "$out/pytest.txt" | tee -a "$log"
+fi
 
 # ---- 5-7. measurements ------------------------------------------------------------------
-if [ -x lab05-bench ]; then
+if ! skipped bench && [ -x lab05-bench ]; then
     say "benchmark: lab05-bench --repeat 5 (the baseline)"
     ./lab05-bench --repeat 5 > "$out/bench.json" 2>> "$log" && step[bench]=ok || step[bench]=failed
     say "benchmark: lab05-bench-fast-math (--use_fast_math), the main shapes"
     ./lab05-bench-fast-math --repeat 5 --only "${GPU_CHECK_FAST_MATH_VARIANTS:-all-materials,diffuse-split-16,diffuse-regs-64,diffuse-scene-global,reference-16,plain,whole-paths,scene-constant,split-1}" \
         > "$out/bench-fast-math.json" 2>> "$log" && step[bench_fast_math]=ok || step[bench_fast_math]=failed
 fi
+# The wavefront labs' references and their targets on the baseline (measure.sh, step 8, has
+# every configuration on four scenes).
+for lab in lab06 lab07; do
+    if [[ " ${GPU_CHECK_SKIP:-} " != *" bench "* ]] && [ -x $lab-bench ]; then
+        say "benchmark: $lab-bench --repeat 5 (the baseline: the pools and the megakernel)"
+        ./$lab-bench --repeat 5 --only AoS,SoA,megakernel > "$out/bench-$lab.json" 2>> "$log" \
+            && step[bench_$lab]=ok || step[bench_$lab]=failed
+    fi
+done
 
 # The memory checker on a small render: no out-of-bounds access, no uninitialised read, no
 # race on the shared-memory copy of the scene (lab05-bench's scene-shared shape).
-skipped() { [[ " ${GPU_CHECK_SKIP:-} " == *" $1 "* ]] && { step[$1]=skipped; say "$1: skipped (GPU_CHECK_SKIP)"; }; }
 if ! skipped sanitizer && command -v compute-sanitizer >/dev/null && [ -x lab05-ref ]; then
-    say "compute-sanitizer: memcheck and initcheck on lab05-ref, racecheck on scene-shared"
+    say "compute-sanitizer: memcheck and initcheck on lab05-ref, memcheck on lab06-ref and lab07-ref, racecheck on scene-shared"
     { compute-sanitizer --tool memcheck --error-exitcode 3 ./lab05-ref --quiet --width 48 --height 40 --spp 4 &&
       compute-sanitizer --tool initcheck --error-exitcode 3 ./lab05-ref --quiet --width 48 --height 40 --spp 4 &&
+      compute-sanitizer --tool memcheck --error-exitcode 3 ./lab06-ref --quiet --width 48 --height 40 --spp 4 &&
+      compute-sanitizer --tool memcheck --error-exitcode 3 ./lab07-ref --quiet --width 48 --height 40 --spp 4 &&
       compute-sanitizer --tool racecheck --error-exitcode 3 ./lab05-bench --width 48 --height 40 --spp 4 --repeat 1 --only reference >/dev/null
     } >> "$log" 2>&1 && step[sanitizer]=ok || step[sanitizer]=failed
     say "compute-sanitizer: ${step[sanitizer]}"
@@ -149,7 +171,10 @@ if ! skipped ncu && [ -n "$ncu_bin" ] && [ -x lab05-bench ]; then
 fi
 
 # Accuracy, process time, and the JSON and Markdown reports (tools/gpu_report.py).
-GPU_CHECK_METRICS=${metrics:-} python3 tools/gpu_report.py "$out" 2>&1 | tee -a "$log"
+if ! skipped report; then
+    GPU_CHECK_METRICS=${metrics:-} python3 tools/gpu_report.py "$out" 2>&1 | tee -a "$log"
+    step[report]=$([ "${PIPESTATUS[0]}" -eq 0 ] && echo ok || echo failed)
+fi
 
 # ---- 8. the wavefront labs --------------------------------------------------------------
 if ! skipped wavefront && [ -x lab07-bench ]; then

@@ -56,6 +56,8 @@ def collect(out: pathlib.Path) -> dict:
 
     result["bench"] = load_json("bench.json")
     result["bench_fast_math"] = load_json("bench-fast-math.json")
+    result["bench_lab06"] = load_json("bench-lab06.json")
+    result["bench_lab07"] = load_json("bench-lab07.json")
 
     # Every correctness check of the CPU labs on each build: the default, fast math, no FMA.
     result["checks"] = {}
@@ -140,6 +142,26 @@ def collect(out: pathlib.Path) -> dict:
     return result
 
 
+TARGET_BENCHES = (("bench", "lab05-bench"), ("bench_lab06", "lab06-bench"), ("bench_lab07", "lab07-bench"))
+
+
+def targets_table(result: dict) -> list[str]:
+    """The speed targets each benchmark printed (common/cuda/speed_targets.h) and whether the
+    run met them; nothing for a call whose benchmarks printed none."""
+    rows = []
+    for key, bench in TARGET_BENCHES:
+        b = result.get(key) or {}
+        for t in b.get("targets") or []:
+            best = "-" if t.get("best_ms") is None else f"{t['best_ms']:.2f}"
+            met = {True: "yes", False: "**no**", None: "not judged"}[t.get("met")]
+            why = f" ({t['why_not']})" if t.get("why_not") else ""
+            rows.append(f"| {bench} | {t['config']} | {t['bar']} | {best} | {met}{why} |")
+    if not rows:
+        return []
+    return ["Speed targets:", "", "| benchmark | configuration | bar | best ms | met |",
+            "|---|---|---|---:|---|", *rows, ""]
+
+
 def summary(result: dict) -> str:
     """summary.md: the tables of a gpu-check.json, for people."""
     b = result.get("bench", {})
@@ -152,6 +174,7 @@ def summary(result: dict) -> str:
         md += [f"Tests: {n['passed']} passed, {n['failure']} failed, {n['error']} errors, {n['skipped']} skipped", ""]
         md += [f"- {c['test']}: {c['result']}" for c in result["tests"] if not c["result"].startswith("passed")]
         md.append("")
+    md += targets_table(result)
     b = result["bench"]
     if "variants" in b:
         md += [f"Benchmark: {b['device']}, {b['width']}x{b['height']}, {b['spp']} spp, {b['bounces']} bounces; {b['timing']}", "",

@@ -14,7 +14,9 @@ the "//>" lines (keeping their indentation). Comment lines that start with "//!"
 instructors only (how the file becomes a skeleton, where its solution lives): the skeleton
 drops them too. A lab's solution/ files become skeleton/ files of
 the same name; the shared files a lab lists in SHARED_SOURCES (code the lab's students write
-but later labs reuse, such as common/core/path_tracer.h) become skeleton/ files too.
+but later labs reuse, such as common/core/path_tracer.h) become skeleton/ files too; the
+lab's build puts skeleton/ first on the include path, so there they stand in for the shared
+file.
 
     tools/skeletons.py           regenerate every skeleton
     tools/skeletons.py --check   exit 1 and name the files that differ (used by the tests)
@@ -30,6 +32,9 @@ ROOT = pathlib.Path(__file__).resolve().parent.parent
 SHARED_SOURCES = {
     "01-serial": ["common/core/path_tracer.h"],
     "02-simd": ["common/simd/packet_tracer.h"],
+    "05-cuda-mega": ["common/cuda/megakernel.cuh"],
+    "06-cuda-split": ["common/wavefront/path_queue.cuh", "common/wavefront/stage_loop.cuh"],
+    "07-soa": ["common/wavefront/path_pool_soa.cuh"],
 }
 
 BEGIN = re.compile(r"^\s*// BEGIN SOLUTION\s*$")

@@ -1,6 +1,7 @@
 // The measurements behind lab 05's choices (handouts/05-cuda-mega.md): the megakernel in
 // several shapes, each timed by CUDA events on the same scene and settings, after a
-// warm-up, best and median of --repeat runs. Prints one JSON object.
+// warm-up, best and median of --repeat runs. Prints one JSON object, ending with lab 05's
+// speed targets (speed_targets.h) and whether this run meets them.
 //
 //   ./lab05-bench [the shared flags: --scene --width --height --spp --bounces --seed]
 //                 [--repeat N] [--only NAME[,NAME...]] [--list]
@@ -23,14 +24,20 @@
 #include <cstring>
 #include <string>
 #include <type_traits>
+#include <utility>
 #include <vector>
 
 #include <cli.h>
 #include <scene_loader.h>
 
-#include "cuda_check.h"
-#include "megakernel.cuh"
-#include "scene_pool.cuh"
+#include <bench_main.h>
+#include <cuda_check.h>
+#include <device_array.h>
+#include <gpu_device.h>
+#include <gpu_timer.h>
+#include <megakernel.cuh>
+#include <scene_pool.cuh>
+#include <speed_targets.h>
 
 // The first kernel anyone writes: one thread per pixel, the whole pixel in one call.
 __global__ void plain_kernel(SceneView scene, Camera camera, RenderSettings settings,
@@ -121,6 +128,9 @@ static const std::vector<Variant>& variants() {
     };
     return all;
 }
+
+// Lab 05's bar: the reference kernel (what lab05-ref runs on the baseline) on an H200.
+constexpr SpeedTarget kLab05Targets[] = {{"reference", 13.0, nullptr}};
 
 struct Timing {
     double best_ms, median_ms;
@@ -226,6 +236,7 @@ static int run(int argc, char** argv) {
                 static_cast<unsigned long long>(settings.seed), repeat);
     bool first = true;
     double first_load_ms = 0, download_ms = 0;
+    std::vector<std::pair<std::string, double>> best_ms;  // of each variant run
     const bool specular = has_specular_material(scene.view().materials, scene.view().num_materials);
     const char* const image_reference = specular ? "all-materials" : "reference";
     for (const Variant& v : variants()) {
@@ -266,19 +277,20 @@ static int run(int argc, char** argv) {
                     nonfinite, identical ? "true" : "false",
                     max_relative_difference(reference_image, image));
         std::fflush(stdout);
+        best_ms.emplace_back(v.name, t.best_ms);
         first = false;
     }
+    const auto best_of = [&](const char* name) {
+        for (const auto& [n, ms] : best_ms)
+            if (n == name) return ms;
+        return -1.0;
+    };
     std::printf("\n], \"host_ms\": {\"context_creation\": %.2f, \"module_load\": %.2f, "
-                "\"scene_upload\": %.3f, \"image_allocation\": %.3f, \"image_download\": %.3f}}\n",
-                context_ms, first_load_ms, scene_upload_ms, image_alloc_ms, download_ms);
+                "\"scene_upload\": %.3f, \"image_allocation\": %.3f, \"image_download\": %.3f}, "
+                "\"targets\": %s}\n",
+                context_ms, first_load_ms, scene_upload_ms, image_alloc_ms, download_ms,
+                targets_json(kLab05Targets, best_of, why_not_judged(prop, options.scene_path, settings)).c_str());
     return 0;
 }
 
-int main(int argc, char** argv) {
-    try {
-        return run(argc, argv);
-    } catch (const InputError& e) {
-        std::fprintf(stderr, "error: %s\n", e.what());
-        return kExitBadInput;
-    }
-}
+int main(int argc, char** argv) { return bench_main(run, argc, argv); }

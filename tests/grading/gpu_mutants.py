@@ -1,6 +1,6 @@
-"""Broken lab-05 hand-ins for the GPU rubrics' tests: the reference (labs/05-cuda-mega/
-solution) with one classic GPU bug each, built as `make cuda-variant` builds a student's
-folder. Each edit names the text it replaces, which must be in the solution exactly once, so
+"""Broken lab-05 hand-ins for the GPU rubrics' tests: the reference hand-in (labs/05-cuda-mega/
+solution/ and the megakernel, common/cuda/megakernel.cuh) with one classic GPU bug each, built
+as `make cuda-variant` builds a student's folder. Each edit names the text it replaces, which must be in the solution exactly once, so
 a change to the solution that moves that text fails the build loudly instead of testing a
 mutant that is no longer broken.
 """
@@ -12,14 +12,23 @@ import subprocess
 
 from grading.harness import ROOT
 from grading.variants import lab_sources
+from grading.leaks import skeletons
 
 LAB = "05-cuda-mega"
+
+
+def reference_hand_in(lab: str) -> dict[str, str]:
+    """What a student of `lab` hands in, as the reference has it: the solution folder's files
+    and the shared files the lab's students write (tools/skeletons.py's SHARED_SOURCES)."""
+    shared = {pathlib.Path(path).name: (ROOT / path).read_text()
+              for path in skeletons.SHARED_SOURCES.get(lab, [])}
+    return {**lab_sources(lab), **shared}
 
 
 @dataclasses.dataclass(frozen=True)
 class Mutant:
     what: str                             # the bug, as a student would make it
-    file: str                             # the solution file edited
+    file: str                             # the hand-in file edited
     edits: tuple[tuple[str, str], ...]    # (text in the solution, what replaces it)
 
 
@@ -64,11 +73,11 @@ MUTANTS = {
 def mutant_sources(name: str) -> dict[str, str]:
     """The solution's files with the mutant's edits applied."""
     mutant = MUTANTS[name]
-    files = lab_sources(LAB)
+    files = reference_hand_in(LAB)
     text = files[mutant.file]
     for old, new in mutant.edits:
         if text.count(old) != 1:
-            raise ValueError(f"mutant {name}: {LAB}/solution/{mutant.file} holds "
+            raise ValueError(f"mutant {name}: {LAB}'s reference {mutant.file} holds "
                              f"{text.count(old)} copies of the text to replace, not 1: "
                              f"{old.splitlines()[0].strip()!r}")
         text = text.replace(old, new)

@@ -30,7 +30,8 @@ from grading.grade import (GOLDENS, GPU_TIMED_SCALE, RUBRICS, describe, grade, g
                            passed_by_check)
 from grading.harness import ROOT, build
 from tests.grading import submissions
-from tests.grading.gpu_mutants import LAB, MUTANTS, build_cuda_folder, mutant_sources
+from tests.grading.gpu_mutants import (LAB, MUTANTS, build_cuda_folder, mutant_sources,
+                                       reference_hand_in)
 from tests.labs.cuda_env import missing_gpu, missing_nvcc
 
 GPU_LABS = {"05": "05-cuda-mega", "06": "06-cuda-split", "07": "07-soa"}
@@ -90,10 +91,9 @@ def test_speed_is_measured_against_the_labs_own_reference(lab, monkeypatch):
 def test_each_mutant_applies_to_the_solution_and_builds(name, tmp_path):
     """Each edit finds its text in today's solution (mutant_sources raises otherwise) and the
     result compiles: a mutant the solution has drifted away from would test nothing."""
-    from grading.variants import lab_sources
     files = mutant_sources(name)
     file = MUTANTS[name].file
-    assert files[file] != lab_sources(LAB)[file]
+    assert files[file] != reference_hand_in(LAB)[file]
     if reason := missing_nvcc():
         pytest.skip(reason)
     assert build_cuda_folder(LAB, tmp_path / name, files).is_file()
@@ -109,8 +109,8 @@ def nvcc_and_sandbox():
 
 
 def test_lab07_sources_build_in_the_sandbox(nvcc_and_sandbox, tmp_path):
-    """Lab 07's build reads lab 06's reference queue and stage loop (grading/compile.py,
-    SHARED_SOLUTIONS); without them in view its skeleton does not compile in the sandbox."""
+    """Lab 07's build reads lab 06's reference queue and stage loop (common/wavefront/);
+    without them in view its skeleton does not compile in the sandbox."""
     from grading.grade import build_lab
     from grading.variants import pristine_skeleton_sources
     for name, text in pristine_skeleton_sources(GPU_LABS["07"]).items():
@@ -123,8 +123,11 @@ def test_a_gpu_submission_including_the_solution_does_not_compile(nvcc_and_sandb
     """As for the CPU labs: the solution is out of the sandboxed compiler's view (a lab 05
     render.cu that #includes it), and in view when trusted, so the test can fail."""
     from grading.grade import build_lab
+    from grading.variants import pristine_skeleton_sources
     solution = ROOT / "labs" / GPU_LABS["05"] / "solution"
     (tmp_path / "render.cu").write_text(f'#include "{solution}/render.cu"\n')
+    # The other file lab 05's students write: a hand-in without it does not build at all.
+    (tmp_path / "megakernel.cuh").write_text(pristine_skeleton_sources(GPU_LABS["05"])["megakernel.cuh"])
     binary, errors = build_lab("05", tmp_path, trusted=False)
     assert binary is None and "No such file or directory" in errors, errors
     binary, errors = build_lab("05", tmp_path, trusted=True)
@@ -330,7 +333,7 @@ def test_swapped_x_and_y_are_named(tmp_path):
 
 def reporting_layout(folder: pathlib.Path, layout) -> pathlib.Path:
     """Lab 01's reference with `layout` added to its --json (left out when None): what a
-    wavefront lab reports about its path pool (labs/06-cuda-split/layout_probe.cuh)."""
+    wavefront lab reports about its path pool (common/wavefront/layout_probe.cuh)."""
     script = folder / f"layout-{abs(hash(json.dumps(layout)))}"
     script.write_text(f"""#!{sys.executable}
 import json, subprocess, sys

@@ -41,6 +41,18 @@ def test_summary_lists_every_benchmark_shape_with_its_time():
         assert f"| {v['best_ms']:.2f} |" in text
 
 
+def test_speed_targets_are_tabulated_with_their_verdict():
+    result = recorded()
+    result["bench"]["targets"] = [{"config": "reference", "bar": "at most 13 ms on an NVIDIA H200, the baseline",
+                                   "best_ms": 39.9, "met": False}]
+    result["bench_lab07"] = {"targets": [{"config": "SoA", "bar": "faster than AoS on an NVIDIA H200, the baseline",
+                                          "best_ms": 67.6, "met": None, "why_not": "not this GPU"}]}
+    text = gpu_report.summary(result)
+    assert "| lab05-bench | reference | at most 13 ms on an NVIDIA H200, the baseline | 39.90 | **no** |" in text
+    assert "| lab07-bench | SoA | faster than AoS on an NVIDIA H200, the baseline | 67.60 | not judged (not this GPU) |" in text
+    assert "Speed targets" not in gpu_report.summary(recorded())
+
+
 def test_missing_steps_are_said_not_crashed_on():
     result = recorded()
     result["bench"] = {"error": "bench.json: no such file"}

@@ -9,7 +9,7 @@
 
 #include <path_tracer.h>
 
-#include "scene_pool.cuh"
+#include <scene_pool.cuh>
 
 // What one launch renders: rows [first_row, first_row + rows) of the image, into `pixels`
 // (rows x width, row-major). A large image is rendered as several such bands.

@@ -13,9 +13,12 @@
 
 #include <lab.h>
 
-#include "cuda_check.h"
-#include "megakernel.cuh"
-#include "scene_pool.cuh"
+#include <cuda_check.h>
+#include <device_array.h>
+#include <gpu_device.h>
+#include <gpu_timer.h>
+#include <megakernel.cuh>
+#include <scene_pool.cuh>
 
 const char* const kLabName = "05-cuda-mega";
 
@@ -152,6 +155,5 @@ RenderStats render(const RenderJob& job, Image& image) {
         seconds = specular ? render_bands<SceneMemory::Global, AnyMaterial>(args, 0, image, job.progress)
                            : render_bands<SceneMemory::Global, DiffuseOnly>(args, 0, image, job.progress);
     }
-    return {seconds, describe(prop),
-            "kernel only (CUDA events); excludes context creation, module load and copies"};
+    return {seconds, describe(prop), kKernelTimeOnly};
 }

@@ -3,8 +3,8 @@
 // structures (path_pool_aos.cuh). What students write: the queue's reserve (path_queue.cuh)
 // and the stage loop (stage_loop.cuh). Lab 07 runs the same kernels on a structure of
 // arrays.
-#include "path_pool_aos.cuh"
-#include "wavefront_renderer.cuh"
+#include <path_pool_aos.cuh>
+#include <wavefront_renderer.cuh>
 
 const char* const kLabName = "06-cuda-split";
 

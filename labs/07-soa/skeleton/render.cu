@@ -1,8 +1,8 @@
 // Lab 07: your copy, yours to edit. Every place to fill in is marked TODO(lab07).
 // Lab 07: lab 06's wavefront renderer, its kernels unchanged, on a path pool laid out as a
 // structure of arrays (path_pool_soa.cuh) instead of an array of structures.
-#include "path_pool_soa.cuh"
-#include "wavefront_renderer.cuh"
+#include <path_pool_soa.cuh>
+#include <wavefront_renderer.cuh>
 
 const char* const kLabName = "07-soa";
 

@@ -11,8 +11,9 @@
 #include <string>
 #include <vector>
 
-#include "cuda_check.h"
-#include "path_pool.cuh"
+#include <cuda_check.h>
+#include <device_array.h>
+#include <path_pool.cuh>
 
 // The ray origin x of the probe's paths at places 0 and 1: values no other field holds.
 __host__ __device__ constexpr float probe_marker(int place) { return place == 0 ? 1234.5f : -4321.25f; }

@@ -22,10 +22,10 @@
 
 #include <path_tracer.h>
 
-#include "path_pool.cuh"
-#include "path_queue.cuh"
-#include "scene_pool.cuh"
-#include "wave.cuh"
+#include <path_pool.cuh>
+#include <path_queue.cuh>
+#include <scene_pool.cuh>
+#include <wave.cuh>
 
 template <class LayoutT, SceneMemory kMemory, Reserve kHow = Reserve::kPerBlock, class MaterialsT = AnyMaterial,
           int kMinBlocks = 1, bool kPrefetchNext = false, bool kGridPerItem = true>

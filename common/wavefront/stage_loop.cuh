@@ -7,6 +7,7 @@
 //!
 //! Lab 06 students write run_wave (the region between BEGIN/END SOLUTION); tools/skeletons.py
 //! turns this file into labs/06-cuda-split/skeleton/stage_loop.cuh.
+//! It stands in for this file in the lab's own build (first on the include path).
 #pragma once
 
 template <class Stages>

@@ -24,7 +24,7 @@
 // The bytes each stage moves per path, AoS against SoA: handouts/07-soa.md.
 #pragma once
 
-#include "path_pool.cuh"
+#include <path_pool.cuh>
 
 // One record of kRows 16-byte rows per place, taken from the pool's allocation.
 template <int kRows>

@@ -11,6 +11,7 @@
 //!
 //! Lab 06 students write reserve (the region between BEGIN/END SOLUTION); tools/skeletons.py
 //! turns this file into labs/06-cuda-split/skeleton/path_queue.cuh.
+//! It stands in for this file in the lab's own build (first on the include path).
 #pragma once
 
 #include <cooperative_groups.h>

@@ -2,13 +2,19 @@
 // shared core (trace_path, or the bounce_step it loops over), so the GPU image is lab 01's
 // estimator with lab 01's random numbers. The threads of one pixel split its samples between
 // them and add their partial sums in a fixed order, so the image is reproducible bit for bit.
+//!
+//! Lab 05's reference kernel; the wavefront benchmark (common/wavefront/wavefront_bench.cuh)
+//! measures the wavefront labs against it.
+//! Lab 05 students write the regions between BEGIN/END SOLUTION; tools/skeletons.py turns
+//! this file into labs/05-cuda-mega/skeleton/megakernel.cuh, which stands in for it in the
+//! lab's own build (it comes first on the include path).
 #pragma once
 
 #include <cstdint>
 
 #include <path_tracer.h>
 
-#include "scene_pool.cuh"
+#include <scene_pool.cuh>
 
 // What one launch renders: rows [first_row, first_row + rows) of the image, into `pixels`
 // (rows x width, row-major). A large image is rendered as several such bands.

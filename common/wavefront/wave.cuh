@@ -17,7 +17,7 @@
 #include <rng.h>
 #include <scene_view.h>
 
-#include "scene_pool.cuh"
+#include <scene_pool.cuh>
 
 struct Wave {
     int first_pixel;   // image pixel index (y * width + x) of slot 0

@@ -20,10 +20,13 @@
 #include <image.h>
 #include <lab.h>
 
-#include "cuda_check.h"
-#include "layout_probe.cuh"
-#include "stage_loop.cuh"
-#include "wavefront_kernels.cuh"
+#include <cuda_check.h>
+#include <device_array.h>
+#include <gpu_device.h>
+#include <gpu_timer.h>
+#include <layout_probe.cuh>
+#include <stage_loop.cuh>
+#include <wavefront_kernels.cuh>
 
 // The stages, for the per-kernel tables.
 enum Stage { kGenerate, kClosestHit, kShade, kShadow, kAccumulate, kStageCount };
@@ -306,5 +309,5 @@ RenderStats render_wavefront(const RenderJob& job, Image& image, WavefrontStats*
     };
     const double seconds = shared ? (specular ? render(S{}, AnyMaterial{}) : render(S{}, DiffuseOnly{}))
                                   : (specular ? render(G{}, AnyMaterial{}) : render(G{}, DiffuseOnly{}));
-    return {seconds, describe(prop), "", describe_layout<Layout>()};
+    return {seconds, describe(prop), kKernelTimeOnly, describe_layout<Layout>()};
 }

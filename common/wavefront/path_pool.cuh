@@ -28,7 +28,7 @@
 
 #include <path_tracer.h>
 
-#include "packed_hit.cuh"
+#include <packed_hit.cuh>
 
 // A path on its way to its next interaction; `slot` says which (pixel, sample) it is.
 struct QueuedPath {

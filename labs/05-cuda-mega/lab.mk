@@ -1,0 +1,50 @@
+# Lab 05 (CUDA megakernel): `make lab05` builds skeleton/, `make lab05-ref` solution/ (its
+# kernel is common/cuda/megakernel.cuh, which skeleton/megakernel.cuh stands in for), and
+#   make lab05-bench             the kernel shapes the handout measures (bench.cu)
+#   make lab05-bench-fast-math   the same built with --use_fast_math
+#   make lab05-ref-fast-math     the reference built with --use_fast_math (accuracy table)
+#   make lab05-ref-no-fma        the reference built with --fmad=false (no fused multiply-add)
+#   make lab05-ref-double        the reference in double precision (common/core/real.h)
+LAB05 := labs/05-cuda-mega
+LAB05_BUILD := $(BUILD)/$(LAB05)
+LAB05_TARGETS := lab05 lab05-ref lab05-bench lab05-bench-fast-math lab05-ref-fast-math \
+                 lab05-ref-no-fma lab05-ref-double
+# Real files, not phony: a test that asks make for a binary that is up to date must not get it
+# relinked under another test that is running it ("Text file busy").
+ifeq ($(HAVE_NVCC),)
+.PHONY: $(LAB05_TARGETS)
+$(LAB05_TARGETS):
+	@echo "$@: needs the CUDA toolkit ($(NVCC) not found)" >&2
+	@exit 1
+else
+$(eval $(call cuda_lab,lab05,05-cuda-mega,,megakernel.cuh))
+
+# Variants of the reference and the benchmark: the same source under other flags, objects in
+# folders of their own. $(1): the variant's folder, $(2): the source, $(3): the flags.
+define lab05_variant_object
+$(LAB05_BUILD)/$(1)/$(basename $(notdir $(2))).o: $(2)
+	@mkdir -p $$(dir $$@)
+	$$(NVCC) $$(NVCCFLAGS) $$(CUDA_ARCH) $(3) -I$(LAB05)/solution $$(CUDA_INCLUDES) \
+	    $$(INCLUDES) -MMD -MP -MF $$(@:.o=.d) -c $$< -o $$@
+endef
+$(eval $(call lab05_variant_object,fast-math,$(LAB05)/solution/render.cu,--use_fast_math))
+$(eval $(call lab05_variant_object,no-fma,$(LAB05)/solution/render.cu,--fmad=false))
+$(eval $(call lab05_variant_object,double,$(LAB05)/solution/render.cu,-DRT_DOUBLE))
+$(eval $(call lab05_variant_object,fast-math,$(LAB05)/bench.cu,--use_fast_math))
+lab05-ref-fast-math: $(LAB05_BUILD)/fast-math/render.o $(COMMON_OBJ)
+	$(NVCC) $(CUDA_ARCH) $^ -o $@
+lab05-ref-no-fma: $(LAB05_BUILD)/no-fma/render.o $(COMMON_OBJ)
+	$(NVCC) $(CUDA_ARCH) $^ -o $@
+# The reference in double: linked with the double build's host objects (Makefile).
+lab05-ref-double: $(LAB05_BUILD)/double/render.o $(DOUBLE_COMMON_OBJ)
+	$(NVCC) $(CUDA_ARCH) $^ -o $@
+
+# The benchmark has its own main; it links the library part of common/host only. It runs the
+# reference kernel (common/cuda/megakernel.cuh) in every shape it measures.
+lab05-bench: $(LAB05_BUILD)/bench.o $(LIB_OBJ)
+	$(NVCC) $(CUDA_ARCH) $^ -o $@
+lab05-bench-fast-math: $(LAB05_BUILD)/fast-math/bench.o $(LIB_OBJ)
+	$(NVCC) $(CUDA_ARCH) $^ -o $@
+endif
+
+LAB_BINARIES += $(LAB05_TARGETS)
