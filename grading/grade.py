@@ -341,7 +341,6 @@ def print_table(lab: str, binary: pathlib.Path, results: dict) -> None:
 
 LAB_FOLDERS = {"01": "01-serial", "02": "02-simd", "03": "03-openmp", "04": "04-mpi",
                "05": "05-cuda-mega", "06": "06-cuda-split", "07": "07-soa"}
-SOURCE_SUFFIXES = (".cpp", ".h", ".hpp", ".cu", ".cuh")
 
 
 def first_errors(text: str, lines: int = 20) -> str:
@@ -351,32 +350,24 @@ def first_errors(text: str, lines: int = 20) -> str:
     return "\n".join(errors[:lines])[:4000]
 
 
-def build_lab(lab: str, sources: pathlib.Path | None = None,
-              trusted: bool = True) -> tuple[pathlib.Path | None, str]:
-    """Build ./labNN, or a submission's folder of sources as the Makefile builds lab NN
-    (`make variant`; in the sandbox unless trusted, grading/compile.py says why);
-    (binary, "") or (None, the compiler's first errors)."""
+def build_lab(lab: str, sources: pathlib.Path | None = None, trusted: bool = True,
+              notes: list[str] | None = None) -> tuple[pathlib.Path | None, str]:
+    """Build ./labNN, or a submission's folder of sources as a student of lab NN would build
+    it, in the students' tree (grading/students_tree.py; in the sandbox unless trusted,
+    grading/compile.py says why); (binary, "") or (None, why: a one-line refusal or the
+    compiler's first errors). `notes` receives what the grade should say about the hand-in
+    (the expected files it lacked)."""
     import subprocess
-    import tempfile
     if sources is not None:
-        from grading.variants import build_sources
-        files = {f.name: f.read_text(errors="replace") for f in sorted(sources.iterdir())
-                 if f.is_file() and f.suffix in SOURCE_SUFFIXES}
+        from grading.compile import build_in_sandbox
         target = "cuda-variant" if gpu.is_gpu_lab(lab) else "variant"
-        workdir = pathlib.Path(tempfile.mkdtemp(prefix=f"lab{lab}-build-"))
-        if not trusted:
-            from grading.compile import build_in_sandbox
-            workdir.chmod(0o755)  # the sandbox user must reach src/
-            src = workdir / "src"
-            src.mkdir()
-            for name, text in files.items():
-                (src / name).write_text(text)
-            binary, errors = build_in_sandbox(LAB_FOLDERS[lab], src, target)
-            return binary, first_errors(errors) if errors else ""
-        try:
-            return build_sources(LAB_FOLDERS[lab], workdir, files, target=target), ""
-        except RuntimeError as e:
-            return None, first_errors(str(e))
+        binary, errors, note = build_in_sandbox(LAB_FOLDERS[lab], sources, target,
+                                                trusted=trusted)
+        if note and notes is not None:
+            notes.append(note)
+        if binary is None and errors.startswith("refused: "):
+            return None, errors
+        return binary, first_errors(errors) if errors else ""
     p = subprocess.run(["make", "-s", "-C", str(ROOT), f"lab{lab}"], capture_output=True,
                        text=True, errors="replace")
     if p.returncode == 0:
@@ -436,8 +427,15 @@ def main(argv=None) -> int:
                 results.refuse(f"no binary to grade: {binary} does not exist")
                 return 2
         else:
+            notes: list[str] = []
             binary, errors = build_lab(a.lab, pathlib.Path(a.sources) if a.sources else None,
-                                       trusted=a.trusted)
+                                       trusted=a.trusted, notes=notes)
+            results.notes.extend(notes)
+            if binary is None and errors.startswith("refused: "):
+                results.refuse(f"the hand-in was {errors}")
+                print(f"error: the hand-in was {errors}", file=sys.stderr)
+                print_table(a.lab, pathlib.Path(f"lab{a.lab}"), results.as_dict())
+                return 1
             if binary is None:
                 results.refuse("the code does not compile", detail=errors)
                 print_table(a.lab, pathlib.Path(f"lab{a.lab}"), results.as_dict())

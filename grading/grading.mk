@@ -21,3 +21,9 @@ release:
 	@test -f grading/release.py || \
 	    { echo "release: made from the course repository; this is a release" >&2; exit 2; }
 	@$(PYTHON) -m grading.release '$(LAB)' '$(OUT)'
+
+# The driver objects a variant of VARIANT_LAB links, and nothing else: the grader builds them
+# in a students' tree (grading/students_tree.py) before compiling a submission there.
+.PHONY: variant-driver cuda-variant-driver
+variant-driver: $(VARIANT_DRIVER_$(VARIANT_LAB))
+cuda-variant-driver: $(COMMON_OBJ)

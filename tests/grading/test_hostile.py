@@ -276,3 +276,107 @@ def test_no_sandbox_is_one_line_from_the_command_line(tmp_path):
     assert p.returncode == 2, p.stderr
     assert p.stderr.count("\n") == 1 and "bubblewrap (bwrap) is not installed" in p.stderr, p.stderr
     assert json.loads(out.read_text())["output"].startswith("refusing")
+
+
+# ---- hand-ins built in the students' tree (grading/students_tree.py) ----------------------
+
+def handin(folder: pathlib.Path, files: dict[str, str]) -> pathlib.Path:
+    for name, text in files.items():
+        (folder / name).parent.mkdir(parents=True, exist_ok=True)
+        (folder / name).write_text(text)
+    return folder
+
+
+def solution_text(lab_folder: str, name: str) -> str:
+    path = ROOT / "labs" / lab_folder / "solution" / name
+    return (path if path.exists() else ROOT / "common" / "core" / name).read_text()
+
+
+def grade_sources(lab: str, folder: pathlib.Path, tmp_path: pathlib.Path) -> dict:
+    from grading.grade import build_lab
+    binary, errors = build_lab(lab, folder, trusted=False)
+    assert binary is not None, errors
+    return grade(lab, binary, tmp_path)
+
+
+def test_a_missing_shared_file_is_the_skeletons_not_the_solution(tmp_path):
+    """Lab 01's render.cpp done, its path_tracer.h left out: in the course repository the
+    shared path_tracer.h is the solution; a student's tree has the skeleton's, and so does the
+    grader's build. At most what the skeleton earns."""
+    folder = handin(tmp_path / "in", {"render.cpp": solution_text("01-serial", "render.cpp")})
+    results = grade_sources("01", folder, tmp_path)
+    assert results["score"] <= 10, describe(results)
+
+
+def test_lab02_skeleton_without_its_header_scores_as_the_skeleton(tmp_path):
+    from grading.harness import cpu_has_avx2
+    from grading.students_tree import pristine_skeleton
+    if not cpu_has_avx2():
+        pytest.skip("this CPU has no AVX2/FMA: lab 02's Part B cannot run")
+    files = {n: t for n, t in pristine_skeleton("02-simd").items() if n.endswith(".cpp")}
+    results = grade_sources("02", handin(tmp_path / "in", files), tmp_path)
+    assert results["score"] <= 10, describe(results)
+
+
+@pytest.mark.parametrize("target", ["solution", "proc"])
+def test_a_link_is_refused_in_one_line(tmp_path, target):
+    """A link to the solution would hand it in; one into /proc would read the grader's
+    environment (and its secret) as root. Either is refused before anything is read."""
+    folder = handin(tmp_path / "in", {"render.cpp": solution_text("01-serial", "render.cpp")})
+    linked = (ROOT / "common" / "core" / "path_tracer.h" if target == "solution"
+              else pathlib.Path("/proc/self/environ"))
+    (folder / "path_tracer.h").symlink_to(linked)
+    out = tmp_path / "results.json"
+    p = subprocess.run([sys.executable, "-m", "grading.grade", "01", "--sources", str(folder),
+                        "--results", str(out)], cwd=ROOT, capture_output=True, text=True,
+                       timeout=300, env={**os.environ, "GRADING_SECRET": "leak-me-4711"})
+    results = json.loads(out.read_text())
+    assert p.returncode == 1 and results["score"] == 0, describe(results)
+    assert "path_tracer.h is a symbolic link" in results["output"], results["output"]
+    assert "\n" not in results["output"] and "leak-me-4711" not in out.read_text()
+
+
+def test_no_expected_file_is_one_line_naming_them(tmp_path):
+    folder = handin(tmp_path / "in", {"notes.txt": "I did it", "main.cpp": "int main(){}"})
+    from grading.grade import build_lab
+    binary, errors = build_lab("01", folder, trusted=False)
+    assert binary is None and "\n" not in errors, errors
+    assert "expected path_tracer.h, render.cpp" in errors, errors
+
+
+def test_a_nested_checkout_is_found_and_the_reference_scores_100(tmp_path):
+    """The files in a folder of a repository checkout (or a zipped folder): the folder with
+    the expected files is taken, not a stray copy higher up."""
+    folder = handin(tmp_path / "in", {
+        "lab01/labs/01-serial/skeleton/render.cpp": solution_text("01-serial", "render.cpp"),
+        "lab01/labs/01-serial/skeleton/path_tracer.h": solution_text("01-serial", "path_tracer.h"),
+        "lab01/common/core/vec3.h": (ROOT / "common" / "core" / "vec3.h").read_text()})
+    results = grade_sources("01", folder, tmp_path)
+    assert results["score"] == 100, describe(results)
+
+
+def test_the_sandbox_environment_is_empty(tmp_path, monkeypatch):
+    """Nothing of the grader's environment (its secret) reaches a submitted process."""
+    monkeypatch.setenv("GRADING_SECRET", "leak-me-4712")
+    binary = sub.script(tmp_path, "env\n")
+    with sandbox.Runner(trusted=False) as r:
+        out = r.run([r.input(binary)])
+    names = {line.split("=", 1)[0] for line in out.stdout.splitlines() if "=" in line}
+    assert "leak-me-4712" not in out.stdout, out.stdout
+    assert names <= {"PATH", "HOME", "TMPDIR", "LANG", "PWD", "SHLVL", "_", "OLDPWD"}, names
+
+
+def test_build_folders_are_removed(tmp_path):
+    """A graded hand-in leaves nothing behind in the temporary folder."""
+    folder = handin(tmp_path / "in", {"render.cpp": "int broken( {\n"})
+    tmp = tmp_path / "tmp"
+    tmp.mkdir()
+    subprocess.run([sys.executable, "-m", "grading.grade", "01", "--sources", str(folder),
+                    "--results", str(tmp_path / "r.json")], cwd=ROOT, capture_output=True,
+                   timeout=300, env={**os.environ, "TMPDIR": str(tmp)})
+    good = handin(tmp_path / "good", {"render.cpp": solution_text("01-serial", "render.cpp"),
+                                      "path_tracer.h": solution_text("01-serial", "path_tracer.h")})
+    subprocess.run([sys.executable, "-m", "grading.grade", "01", "--sources", str(good),
+                    "--results", str(tmp_path / "r2.json"), "--budget-seconds", "0"], cwd=ROOT,
+                   capture_output=True, timeout=300, env={**os.environ, "TMPDIR": str(tmp)})
+    assert not list(tmp.iterdir()), list(tmp.iterdir())
