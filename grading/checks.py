@@ -10,8 +10,8 @@ How often a correct renderer fails each check (its false-failure rate), and why:
   the two means equal to float rounding (~1e-7), bound 1e-5; a float sum drifts by ~1e-2.
 - lit plane: the only noise is where the pixel jitter lands; at 256 spp the per-pixel error
   is ~1e-3, bounds 3e-3 (mean) and 2e-2 (max) are far outside it.
-- glass pane: the mean of 262,144 Bernoulli(~4%) paths has a relative standard error of
-  ~1%; the 5% bound is five standard errors (two-sided rate ~6e-7).
+- glass pane: the mean of 262,144 Bernoulli(~4-5%) paths has a relative standard error of
+  ~1%; the 5% bound is five standard errors (two-sided rate ~6e-7) at each of 4 renders.
 - scale invariance: the scaled and unscaled renders use the same random numbers, so they
   differ only where rounding sends a path another way: measured 0.00% for the reference.
 A renderer whose float roundings differ (SIMD, GPU) is another random draw of the same
@@ -44,6 +44,13 @@ class CheckResult:
 
     def __str__(self) -> str:
         return f"{'PASS' if self.passed else 'FAIL'} {self.name}: {self.detail}"
+
+
+def worst_of(*values: float) -> float:
+    """The largest of `values`, NaN if any is NaN: `max(0.0, nan)` is 0.0, which would read
+    a NaN error as no error. Compare its result as `not (worst <= bound)`."""
+    values = [float(v) for v in values]
+    return float("nan") if any(v != v for v in values) else max(values)
 
 
 def image_checked(name: str):
@@ -131,9 +138,9 @@ def check_sphere_interior(binary, bounces=(1, 2, 4)) -> CheckResult:
                                       for b in bounces})
     for b, image in images.items():
         want = scenes.sphere_interior_radiance(**INTERIOR, bounces=b)
-        worst = max(worst, float(np.max(np.abs(image / want - 1.0))))
+        worst = worst_of(worst, np.max(np.abs(image.astype(np.float64) / want - 1.0)))
         symptom = symptom or black_pixels(image)
-    ok = worst < 3e-4
+    ok = worst <= 3e-4
     return CheckResult("analytic sphere interior", ok,
                        f"largest relative error {worst:.2e} over bounces {list(bounces)}"
                        f" (allowed 3e-4)" + ("" if ok else symptom))
@@ -170,8 +177,8 @@ def check_lit_plane(binary) -> CheckResult:
     # The only noise is where the jitter lands inside a pixel: ~0.2% at 256 spp here.
     def right(gray):
         err = np.abs(gray / want - 1.0)
-        return float(err.mean()) < 3e-3 and float(err.max()) < 2e-2, err
-    ok, err = right(image.mean(axis=2))
+        return float(err.mean()) <= 3e-3 and float(err.max()) <= 2e-2, err
+    ok, err = right(image.astype(np.float64).mean(axis=2))
     symptom = ""
     if not ok:
         # The light stands off the axes, so the image has no symmetry: a flipped or transposed
@@ -183,21 +190,30 @@ def check_lit_plane(binary) -> CheckResult:
                        f" (allowed 3e-3, 2e-2)" + symptom)
 
 
+GLASS_ANGLES = (0.0, 45.0)  # degrees from the pane's normal: head-on, and oblique
+
+
 @image_checked("analytic glass pane (Fresnel)")
-def check_glass_slab(binary) -> CheckResult:
-    """Closed form: Fresnel reflectance of a glass pane at normal incidence."""
-    scene = scenes.glass_slab(ior=1.5, albedo=0.8, intensity=4.0)
-    worst = 0.0
+def check_glass_slab(binary, angles=GLASS_ANGLES, ior: float = 1.5) -> CheckResult:
+    """Closed form: a glass pane's Fresnel reflectance, head-on and at 45 degrees, where the
+    reflectance is that of the exact Fresnel equations and the refracted path follows
+    Snell's law through the pane and back (grading/scenes.py, glass_slab)."""
+    worst, where = 0.0, ""
     with tempfile.TemporaryDirectory() as tmp:
-        path = scenes.write_scene(pathlib.Path(tmp) / "slab.json", scene)
-        for b in (2, 4):
-            # 32x32 pixels x 256 paths, each reflecting with probability ~4%: the mean has a
-            # relative standard error of about 1%, so 5% is a five-sigma bound.
-            image = run_lab(binary, path, width=32, height=32, spp=256, bounces=b, seed=5).image
-            want = scenes.glass_slab_radiance(scene, b)
-            worst = max(worst, abs(float(image.mean()) / want - 1.0))
-    return CheckResult("analytic glass pane (Fresnel)", worst < 0.05,
-                       f"largest relative error of the mean {worst:.2%} (allowed 5%)")
+        for angle in angles:
+            scene = scenes.glass_slab(ior=ior, albedo=0.8, intensity=4.0, angle_deg=angle)
+            path = scenes.write_scene(pathlib.Path(tmp) / "pane.json", scene)
+            for b in (2, 4):
+                # 32x32 pixels x 256 paths, each reflecting with probability ~4-5%: the mean
+                # has a relative standard error of about 1%, so 5% is a five-sigma bound.
+                image = run_lab(binary, path, width=32, height=32, spp=256, bounces=b,
+                                seed=5).image
+                want = scenes.glass_slab_radiance(scene, b, angle)
+                err = abs(float(image.astype(np.float64).mean()) / want - 1.0)
+                if not (err <= worst):
+                    worst, where = err, f"at {angle:g} degrees, {b} interactions"
+    return CheckResult("analytic glass pane (Fresnel)", worst <= 0.05,
+                       f"largest relative error of the mean {worst:.2%} {where} (allowed 5%)")
 
 
 SCALE_FACTORS = (1e-4, 1e-2, 1e3, 1e5)
@@ -217,13 +233,14 @@ def check_scale_invariance(binary, scene: str = "cornell", factors=SCALE_FACTORS
         base = render(base_scene, "base.json")
         for f in factors:
             img = render(scenes.scaled(base_scene, f), f"scaled-{f:g}.json")
-            mean_err = abs(float(img.mean()) / float(base.mean()) - 1.0)
-            rel = np.abs(img - base) / (np.abs(base) + 1e-3)
-            bad_fraction = float((rel > 0.05).mean())
-            if (mean_err, bad_fraction) > worst[:2]:
+            ours, plain = img.astype(np.float64), base.astype(np.float64)
+            mean_err = abs(float(ours.mean()) / float(plain.mean()) - 1.0)
+            rel = np.abs(ours - plain) / (np.abs(plain) + 1e-3)
+            bad_fraction = float((~(rel <= 0.05)).mean())
+            if not ((mean_err, bad_fraction) <= worst[:2]):  # a NaN counts as the worst
                 worst = (mean_err, bad_fraction, f)
     mean_err, bad_fraction, factor = worst
-    ok = mean_err < 0.01 and bad_fraction < 0.02
+    ok = mean_err <= 0.01 and bad_fraction <= 0.02
     return CheckResult("scale invariance 1e-4..1e5", ok,
                        f"worst factor {factor:g}: image mean off by {mean_err:.2%}, "
                        f"{bad_fraction:.2%} of pixel values off by > 5% (allowed 1%, 2%)")
@@ -291,7 +308,7 @@ def wrong_timed_image(image, spp: int, scale: int = 1) -> str | None:
     graded only for correct work, on the very runs that were timed."""
     g = golden(TIMED_SCENE)
     report = compare(box_filtered(image, scale) if scale > 1 else image, spp * scale * scale,
-                     g.mean, g.variance, g.meta["golden_spp"])
+                     g.mean, g.variance, g.meta["golden_spp"], per_pixel=scale == 1)
     return None if report.passed else f"the timed render is wrong ({report.summary()})"
 
 

@@ -112,7 +112,18 @@ def image_problem(image: np.ndarray, width: int | None, height: int | None) -> s
     if nan or inf:
         return (f"the image holds {nan} NaN and {inf} infinite values (of {image.size}): "
                 f"a non-finite pixel fails every check that reads the image")
+    # Radiance is never negative, and no test scene comes near PLAUSIBLE_RADIANCE; values near
+    # the float limit would overflow any sum of them.
+    low, high = float(np.min(image)), float(np.max(image))
+    if not (low >= 0.0 and high <= PLAUSIBLE_RADIANCE):
+        return (f"the image holds values from {low:.3g} to {high:.3g}: radiance is never "
+                f"negative and no test scene gives more than {PLAUSIBLE_RADIANCE:.0e}")
     return None
+
+
+# The largest pixel value a test scene can give is about 1e2 (the point light seen through
+# glass); 1e9 leaves room for any scene and keeps float32 sums of a million pixels finite.
+PLAUSIBLE_RADIANCE = 1e9
 
 
 def run_lab(binary: pathlib.Path | str, scene: pathlib.Path | str | None = None, *,

@@ -380,3 +380,55 @@ def test_build_folders_are_removed(tmp_path):
                     "--results", str(tmp_path / "r2.json"), "--budget-seconds", "0"], cwd=ROOT,
                    capture_output=True, timeout=300, env={**os.environ, "TMPDIR": str(tmp)})
     assert not list(tmp.iterdir()), list(tmp.iterdir())
+
+
+# ---- images that block means alone would pass (grading/compare.py, the per-pixel test) ----
+
+def golden_points(results) -> int:
+    return sum(t["score"] for t in results["tests"] if t["extra_data"]["check"] in
+               ("hidden", "golden-cornell", "golden-showcase", "scale"))
+
+
+def test_a_quarter_of_the_samples_fails_the_images(tmp_path):
+    """The analytic scenes are nearly noise-free by design (they test the light transport's
+    values, not its noise), so a renderer of fewer paths keeps their 40 points and the
+    reproducibility's 10; every image check fails."""
+    results = grade("01", sub.fewer_samples(tmp_path), tmp_path)
+    assert not passed_by_check(results)["hidden"], describe(results)
+    assert golden_points(results) == 0 and results["score"] <= 50, describe(results)
+    assert "too noisy" in describe(results), describe(results)
+
+
+@pytest.mark.parametrize("change", [sub.BLUR, sub.FLATTEN], ids=["blurred", "flattened"])
+def test_blurred_or_flattened_images_fail(tmp_path, change):
+    """Trusted: the stand-in runs the repository's Python (grading is the same). Where an
+    image's structure also moved (edges blurred across), the per-pixel test says too noisy
+    rather than too smooth: either way it names the per-pixel test."""
+    results = grade("01", sub.altered_reference(tmp_path, change), tmp_path, trusted=True)
+    assert golden_points(results) == 0 and results["score"] <= 40, describe(results)
+    assert "too smooth" in describe(results) or "too noisy" in describe(results), \
+        describe(results)
+
+
+def test_too_smooth_is_named_on_the_golden_image():
+    """The golden Cornell box rendered by the reference and blurred over 3x3 pixels: its block
+    means pass, its per-pixel noise is too small."""
+    import numpy as np
+    from grading.compare import compare
+    from grading.harness import build, golden, run_lab
+    reference, = build("lab01-ref")
+    g = golden("cornell")
+    image = run_lab(reference, g.scene, width=g.meta["width"], height=g.meta["height"], spp=64,
+                    bounces=g.meta["bounces"], seed=7).image
+    assert compare(image, 64, g.mean, g.variance, g.meta["golden_spp"]).passed
+    padded = np.pad(image, ((1, 1), (1, 1), (0, 0)), mode="edge")
+    blurred = np.lib.stride_tricks.sliding_window_view(padded, (3, 3), axis=(0, 1)).mean(axis=(-1, -2))
+    report = compare(blurred, 64, g.mean, g.variance, g.meta["golden_spp"])
+    assert not report.passed and "too smooth" in report.summary(), report.summary()
+
+
+def test_values_at_the_float_limit_fail_every_image_check(tmp_path):
+    results = grade("01", sub.altered_reference(tmp_path, sub.FLOAT_LIMIT), tmp_path,
+                    trusted=True)
+    assert results["score"] <= 10, describe(results)
+    assert "radiance is never negative and no test scene gives more" in describe(results)
