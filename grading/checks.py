@@ -22,7 +22,9 @@ from __future__ import annotations
 
 import dataclasses
 import functools
+import os
 import pathlib
+import shutil
 import tempfile
 import time
 
@@ -38,9 +40,13 @@ class CheckResult:
     name: str
     passed: bool
     detail: str
-    # The machine could not measure this (too busy, even after retries): the grader awards
-    # the points provisionally and marks the test for a regrade instead of failing it.
+    # The machine could not measure this (too busy, even after retries): marked for a
+    # regrade. Its points stay out of the score; `provisional` (a fraction of the points) is
+    # what the regrade may add, shown apart.
     regrade: bool = False
+    # A timed check's fraction of its points (speed_credit); None: all or nothing by `passed`.
+    credit: float | None = None
+    provisional: float = 0.0
 
     def __str__(self) -> str:
         return f"{'PASS' if self.passed else 'FAIL'} {self.name}: {self.detail}"
@@ -312,34 +318,93 @@ def wrong_timed_image(image, spp: int, scale: int = 1) -> str | None:
     return None if report.passed else f"the timed render is wrong ({report.summary()})"
 
 
+# Speed earns partial credit: full points at or above the bar, falling linearly to none at
+# ZERO_CREDIT_AT times the bar (grading/README.md). For a parallel lab on two cores (bar
+# 1.46x) that is 1.10x, where a serial program is; the CPU-time evidence below stops a serial
+# program from earning anything by noise.
+ZERO_CREDIT_AT = 0.75
+
+
+def speed_credit(measured: float, bar: float) -> float:
+    """The fraction of a speed check's points for `measured` against `bar` (NaN earns 0)."""
+    floor = ZERO_CREDIT_AT * bar
+    if not (measured > floor):
+        return 0.0
+    return min(1.0, (measured - floor) / (bar - floor))
+
+
+def credit_note(credit: float, bar: float) -> str:
+    if credit >= 1.0:
+        return ""
+    return (f"; {credit:.0%} of the points (full at {bar:.2f}x, none at or below "
+            f"{ZERO_CREDIT_AT * bar:.2f}x)")
+
+
+def cores_used(run) -> float:
+    """CPU time over wall time of a run's whole process tree, both measured by the grader."""
+    if run.cpu_seconds is None or not run.wall_seconds > 0:
+        return float("nan")
+    return run.cpu_seconds / run.wall_seconds
+
+
+def one_cpu() -> list[str]:
+    """A launcher confining a run to one CPU (lab 02's lesson is SIMD, not threads). A program
+    may widen its own affinity again, so the timed runs' CPU time is checked as well."""
+    cpu = min(os.sched_getaffinity(0))
+    return [shutil.which("taskset") or "taskset", "-c", str(cpu)]
+
+
+# A program whose tree never used more CPU time than this many times its wall time did not
+# run in parallel (a serial renderer measures 0.95-1.0 cores on a quiet machine; a correct
+# parallel one on two cores ~1.9, ~1.3 beside a process burning one of them). On a machine
+# others load, every thread gets a share of a core: there the parallel check compares the
+# cores a program used with those the serial reference used in the same round.
+SERIAL_CORES = 1.1
+
+
 @image_checked("speedup")
 def check_speedup(binary, baseline, min_speedup: float, *, threads=None, launcher=(),
                   repeat: int = 3, spp: int = 256, scale: int = 1,
-                  overhead_reference=None) -> CheckResult:
+                  overhead_reference=None, one_core: bool = False) -> CheckResult:
     """Wall-clock time against a baseline binary (the lab-01 reference; a GPU lab's own
     reference), measured by the grader around each whole process (never the `seconds` a
     program reports about itself), interleaved, best of `repeat`: a ratio, so a busy machine
     slows both sides alike. Every timed image must match the golden image, or there is no
     speed to grade. `scale` renders the golden view that many times larger (checked box-
     filtered down to the golden size); `overhead_reference` (a trusted binary) measures a
-    start-up cost, rendering one pixel, that is subtracted from both sides (launch_overhead)."""
+    start-up cost, rendering one pixel, that is subtracted from both sides (launch_overhead).
+    `one_core` (lab 02): both sides run confined to one CPU, and a program whose timed runs
+    used more than SERIAL_CORES cores' worth of CPU time earns nothing (threads are not the
+    lesson). Points: speed_credit of the speedup."""
     name = f"speedup >= {min_speedup:g}x"
     settings = timed_settings(spp, scale)
+    pinned = one_cpu() if one_core else []
     overhead = launch_overhead(overhead_reference, launcher) if overhead_reference else 0.0
-    base, fast = [], []
+    base, fast, used = [], [], []
     for _ in range(repeat):
-        base.append(max(run_lab(baseline, **settings).wall_seconds - overhead, 1e-3))
-        run = run_lab(binary, threads=threads, launcher=launcher, **settings)
+        base.append(max(run_lab(baseline, launcher=pinned, **settings).wall_seconds - overhead,
+                        1e-3))
+        run = run_lab(binary, threads=threads, launcher=[*pinned, *launcher], **settings)
         wrong = wrong_timed_image(run.image, spp, scale)
         if wrong:
-            return CheckResult(name, False, f"{wrong}: speed is graded only for a correct image")
+            return CheckResult(name, False, f"{wrong}: speed is graded only for a correct image",
+                               credit=0.0)
         fast.append(max(run.wall_seconds - overhead, 1e-3))
+        used.append(cores_used(run))
+    if one_core and not (max(used) <= SERIAL_CORES):
+        return CheckResult(name, False,
+                           f"the timed runs used up to {max(used):.2f} cores' worth of CPU time "
+                           f"(measured by the grader; allowed {SERIAL_CORES:g}): lab 02 is timed "
+                           f"on one core, its speed must come from SIMD, not threads", credit=0.0)
     speedup = min(base) / min(fast)
+    credit = speed_credit(speedup, min_speedup)
     note = (f", less {overhead:.3f} s of start-up measured on the reference rendering one pixel"
             if overhead else "")
-    return CheckResult(name, speedup >= min_speedup,
+    where = ", both on one CPU" if one_core else ""
+    return CheckResult(name, credit > 0,
                        f"{speedup:.2f}x ({min(base):.3f} s -> {min(fast):.3f} s wall clock "
-                       f"measured by the grader{note}, best of {repeat})")
+                       f"measured by the grader{note}{where}, best of {repeat})"
+                       + credit_note(credit, min_speedup), credit=credit)
 
 
 def launch_overhead(reference, launcher, rounds: int = 3) -> float:
@@ -354,10 +419,12 @@ def launch_overhead(reference, launcher, rounds: int = 3) -> float:
 # gives 1.9-2.0) a missed bar may be the machine's fault: under bursts of other load the
 # reference measured 0.95x with 1.79x capacity measured in the same rounds, and ~1x under a
 # steady load of 9 on two cores. Such a result is measured again and, failing that, marked
-# for regrade. On a quiet machine a speedup below VISIBLY_PARALLEL is a serial program (a
-# serial renderer measures 0.95-1.05x against the serial reference) and fails at once.
-VISIBLY_PARALLEL = 1.1
+# for regrade, with only the points measured in the score. Whether the program runs in
+# parallel at all is told apart from the load by its CPU time over its wall time: where the
+# machine gave at least SERIAL_TELLABLE cores' worth, a parallel program uses more than
+# SERIAL_CORES of them (CFS shares the CPUs by thread), a serial one cannot.
 BUSY = 1.9
+SERIAL_TELLABLE = 1.25
 
 
 @image_checked("parallel speedup")
@@ -367,55 +434,96 @@ def check_parallel_speedup(binary, baseline, *, threads=None, launcher=(),
     """Speedup of a parallel lab over the serial baseline, in wall-clock time measured by the
     grader, against the machine's capacity measured alongside (grading.harness.
     measure_parallel). Every timed image must be the baseline's, bit for bit (what labs 03 and
-    04 promise). A machine too busy to measure is retried; if it stays too busy the test is
-    marked for regrade (points provisional), never failed: that is not the student's doing."""
+    04 promise). It fails closed:
+    - a program whose timed runs never used more than SERIAL_CORES cores' worth of CPU time
+      (the grader's own measurement of the sandboxed tree) on a machine giving at least
+      SERIAL_TELLABLE is serial: no points, not a regrade, whatever the speedup looked like;
+    - points follow speed_credit of the speedup against the bar; where the machine stays too
+      busy to reach a verdict, the test is marked for regrade and only the points measured
+      count: the rest is shown apart, never in the score."""
+    import threading
     from grading.harness import measure_parallel
     settings = timed_settings(spp)
     want: list[bytes] = []
     wrong: list[str] = []
+    used: list[float] = []       # cores' worth of CPU time of each of your timed runs
+    base_used: list[float] = []  # the same of the serial reference run alone, same rounds
     overhead = launch_overhead(overhead_reference, launcher) if overhead_reference else 0.0
 
     def base() -> float:
         run = run_lab(baseline, **settings)
         if not want:
             want.append(run.image.tobytes())
+        if threading.current_thread() is threading.main_thread():  # alone, not the capacity's
+            base_used.append(cores_used(run))
         return run.wall_seconds
 
     def yours() -> float:
         run = run_lab(binary, threads=threads, launcher=launcher, **settings)
         if want and run.image.tobytes() != want[0] and not wrong:
             wrong.append("the timed render differs from the serial reference's image")
+        used.append(cores_used(run))
         return max(run.wall_seconds - overhead, 1e-3)
 
-    best = None  # the measurable attempt closest to the bar
+    def copies(n: int) -> float:
+        """n copies of the baseline at once as one process tree (one session, as a parallel
+        program is: measure_parallel says why)."""
+        run = run_lab(baseline, launcher=together_launcher(n), check=False, **settings)
+        return run.wall_seconds
+
+    def share() -> float:
+        """Cores your runs used over the cores the serial reference used in the same rounds
+        (the median over rounds): ~1 for a serial program whatever the load, NaN unknown."""
+        ratios = sorted(y / b for y, b in zip(used, base_used) if b > 0)
+        return ratios[len(ratios) // 2] if ratios else float("nan")
+
+    note = f" (launch overhead {overhead:.3f} s subtracted)" if overhead else ""
+    best = None  # (credit, timing) of the attempt closest to the bar
+    capacity = 0.0
     for attempt in range(1, attempts + 1):
-        timing = measure_parallel(base, {"yours": yours})
+        timing = measure_parallel(base, {"yours": yours}, together=copies)
+        capacity = max(capacity, timing.capacity)
         if wrong:
             return CheckResult("parallel speedup", False,
-                               f"{wrong[0]}: speed is graded only for a correct image")
+                               f"{wrong[0]}: speed is graded only for a correct image", credit=0.0)
+        if not (share() > SERIAL_CORES) and capacity >= SERIAL_TELLABLE:
+            return CheckResult("parallel speedup", False,
+                               f"serial: the timed runs used {share():.2f}x the CPU time per "
+                               f"second of the serial reference's ({max(used):.2f} cores at "
+                               f"most; measured by the grader) on a machine giving "
+                               f"{capacity:.2f} cores' worth; a parallel program uses more than "
+                               f"{SERIAL_CORES:g}x ({timing.describe('yours')}{note})", credit=0.0)
         if timing.capacity >= 1.5:
-            margin = timing.speedup("yours") / timing.required(fraction)
-            if best is None or margin > best[0]:
-                best = (margin, timing)
-            if margin >= 1:
-                break
-            if timing.speedup("yours") < VISIBLY_PARALLEL and timing.capacity >= BUSY:
-                break  # serial on a quiet machine: measuring again would not change that
+            credit = speed_credit(timing.speedup("yours"), timing.required(fraction))
+            if best is None or credit > best[0]:
+                best = (credit, timing)
+            if credit >= 1 or timing.capacity >= BUSY:
+                break  # reached the bar, or measured on a machine quiet enough to judge
         if attempt < attempts:
             time.sleep(2.0 * attempt)  # let the other load pass
-    note = f" (launch overhead {overhead:.3f} s subtracted)" if overhead else ""
+    parallel = share() > SERIAL_CORES
     if best is None:
-        return CheckResult("parallel speedup", True,
-                           f"not measurable: the machine gave only {timing.capacity:.2f} cores' "
-                           f"worth of throughput in {attempts} attempts; points provisional, "
-                           f"marked for regrade", regrade=True)
-    margin, timing = best
-    if margin < 1 and timing.capacity < BUSY:
-        return CheckResult("parallel speedup", True,
-                           f"not measurable: short of the bar on a machine too busy to judge "
-                           f"({timing.describe('yours')}{note}); points provisional, "
-                           f"marked for regrade", regrade=True)
-    return CheckResult("parallel speedup", margin >= 1, timing.describe("yours") + note)
+        return CheckResult("parallel speedup", parallel,
+                           f"not measurable: the machine gave only {capacity:.2f} cores' worth "
+                           f"of throughput in {attempts} attempts (the timed runs used "
+                           f"{share():.2f}x the serial reference's CPU share); no points now, "
+                           f"marked for regrade",
+                           regrade=True, credit=0.0, provisional=1.0)
+    credit, timing = best
+    bar = timing.required(fraction)
+    detail = timing.describe("yours") + note + credit_note(credit, bar)
+    if credit < 1 and timing.capacity < BUSY:
+        return CheckResult("parallel speedup", credit > 0 or parallel,
+                           f"short of the bar on a machine too busy to judge ({detail}); "
+                           f"marked for regrade", regrade=True, credit=credit,
+                           provisional=1.0 - credit)
+    return CheckResult("parallel speedup", credit > 0, detail, credit=credit)
+
+
+def together_launcher(n: int) -> list[str]:
+    """A launcher running its command n times at once and waiting for all of them."""
+    return ["/bin/sh", "-c", f'i=0; while [ $i -lt {n} ]; do "$@" & i=$((i + 1)); done; wait',
+            "copies"]
 
 
 @image_checked("bit-identical to lab 01")

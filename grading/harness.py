@@ -268,20 +268,30 @@ class ParallelTiming:
 
 
 def measure_parallel(baseline: Callable[[], float], candidates: dict[str, Callable[[], float]],
-                     rounds: int = 5) -> ParallelTiming:
+                     rounds: int = 5,
+                     together: Callable[[int], float] | None = None) -> ParallelTiming:
     """Interleaved rounds of: the baseline alone, `cores` copies of the baseline at once (the
     capacity: about `cores` when idle, close to 1 when other users' jobs share the CPUs, and
-    then no program can show a speedup), and each candidate. Best of `rounds` each."""
+    then no program can show a speedup), and each candidate. Best of `rounds` each.
+
+    `together(n)` (seconds for n copies at once, in one process tree) measures the copies as
+    one program: where the kernel shares the CPUs by session (sched_autogroup), copies started
+    as separate sessions get a share each, which a multithreaded program, one session, never
+    gets; the grader's checks pass it. Without it the copies run from threads."""
     cores = available_cores()
-    single, together = [], []
+    single, side_by_side_times = [], []
     times: dict[str, list[float]] = {name: [] for name in candidates}
     with concurrent.futures.ThreadPoolExecutor(cores) as pool:
         for _ in range(rounds):
             single.append(baseline())
-            side_by_side = list(pool.map(lambda _: baseline(), range(cores)))
-            together.append(sum(side_by_side) / len(side_by_side))
+            if together is not None:
+                side_by_side_times.append(together(cores))
+            else:
+                side_by_side = list(pool.map(lambda _: baseline(), range(cores)))
+                side_by_side_times.append(sum(side_by_side) / len(side_by_side))
             for name, candidate in candidates.items():
                 times[name].append(candidate())
+    together_times = side_by_side_times
     base = min(single)
-    capacity = min(cores, cores * base / min(together))
+    capacity = min(cores, cores * base / min(together_times))
     return ParallelTiming(cores, capacity, base, {n: min(t) for n, t in times.items()})

@@ -59,9 +59,11 @@ class Outcome:
     stdout: str                 # decoded leniently: a stray byte is U+FFFD, never an error
     stderr: str
     wall_seconds: float         # measured by the grader around the whole tree
-    cpu_seconds: float | None   # user + system time of the tree, when the grader can know
-                                # it: trusted runs only (bubblewrap's monitor does not reap
-                                # the sandbox, so its rusage holds nothing of it)
+    cpu_seconds: float | None   # user + system time of the whole tree: in trusted runs the
+                                # rusage of the reaped tree; in the sandbox (whose monitor does
+                                # not reap it, so its rusage holds nothing of it) sampled by the
+                                # grader from /proc every SAMPLE_SECONDS, so it misses at most
+                                # the last interval of each process (TreeClock)
     killed: str | None = None   # why the grader killed it, e.g. "timed out after 60 s"
     cut: tuple[str, ...] = ()   # streams cut at the output cap
 
@@ -283,14 +285,54 @@ class Runner:
                              stderr=subprocess.PIPE, env=full_env, cwd=cwd,
                              start_new_session=True, **user)
         outcome = _supervise(p, start, limits)
-        if not self.trusted:
-            outcome.cpu_seconds = None
         if outcome.killed is None and outcome.returncode == 0:
             used = _tree_size(self._scratch_dir())
             if used > limits.scratch_bytes:
                 outcome.killed = (f"left {used / 2**20:.0f} MiB in its scratch folder "
                                   f"(allowed {limits.scratch_bytes / 2**20:.0f} MiB)")
         return outcome
+
+
+SAMPLE_SECONDS = 0.05
+_CLOCK_TICKS = os.sysconf("SC_CLK_TCK")
+
+
+class TreeClock:
+    """CPU time of every process descended from one pid, read from /proc by the grader (the
+    processes cannot change what the kernel reports there): utime + stime of each process
+    (all its threads) plus cutime + cstime (its reaped children). A process that ends is
+    counted in its parent's cutime once reaped; `seconds` keeps the largest total seen."""
+
+    def __init__(self, pid: int):
+        self.pid = pid
+        self.seconds = 0.0
+
+    def sample(self) -> None:
+        parents: dict[int, int] = {}
+        times: dict[int, int] = {}
+        for entry in os.scandir("/proc"):
+            if not entry.name.isdigit():
+                continue
+            try:
+                with open(f"/proc/{entry.name}/stat", "rb") as f:
+                    stat_line = f.read()
+            except OSError:
+                continue
+            fields = stat_line[stat_line.rfind(b")") + 2:].split()
+            pid = int(entry.name)
+            parents[pid] = int(fields[1])
+            times[pid] = sum(int(v) for v in fields[11:15])  # utime stime cutime cstime
+        tree, frontier = {self.pid}, [self.pid]
+        children: dict[int, list[int]] = {}
+        for pid, ppid in parents.items():
+            children.setdefault(ppid, []).append(pid)
+        while frontier:
+            for child in children.get(frontier.pop(), []):
+                if child not in tree:
+                    tree.add(child)
+                    frontier.append(child)
+        total = sum(times.get(pid, 0) for pid in tree) / _CLOCK_TICKS
+        self.seconds = max(self.seconds, total)
 
 
 def _tree_size(folder: pathlib.Path) -> int:
@@ -321,6 +363,7 @@ def _supervise(p: subprocess.Popen, start: float, limits: Limits) -> Outcome:
     for fd in streams:
         os.set_blocking(fd, False)
     pidfd = os.pidfd_open(p.pid)
+    clock = TreeClock(p.pid)
     killed, cut, exited_at, status, usage = None, [], None, None, None
     try:
         open_fds = set(streams)
@@ -334,6 +377,9 @@ def _supervise(p: subprocess.Popen, start: float, limits: Limits) -> Outcome:
                 break
             # After the exit, give stragglers (trusted mode: children keep pipes open) 1 s.
             limit = max(timeout, 0.05) if exited_at is None else max(exited_at + 1 - time.perf_counter(), 0)
+            if exited_at is None:
+                clock.sample()
+                limit = min(limit, SAMPLE_SECONDS)
             ready, _, _ = select.select(wait_on, [], [], limit)
             if not ready and exited_at is not None:
                 _kill_tree(p)
@@ -369,7 +415,7 @@ def _supervise(p: subprocess.Popen, start: float, limits: Limits) -> Outcome:
         p.stderr.close()
     end = exited_at or time.perf_counter()
     p.returncode = os.waitstatus_to_exitcode(status) if status is not None else None
-    cpu = usage.ru_utime + usage.ru_stime if usage else 0.0
+    cpu = max(usage.ru_utime + usage.ru_stime if usage else 0.0, clock.seconds)
     (_, out), (_, err) = streams.values()
     return Outcome(p.returncode, decode(bytes(out)), decode(bytes(err)), end - start, cpu,
                    killed, tuple(cut))

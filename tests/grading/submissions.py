@@ -21,10 +21,12 @@ def script(folder: pathlib.Path, body: str, name: str = "lab") -> pathlib.Path:
     return path
 
 
-def carrying_reference(folder: pathlib.Path, body: str, name: str = "lab") -> pathlib.Path:
-    """A script whose payload is the lab-01 reference: `body` runs after `./ref` (the
-    unpacked reference) exists in the working folder, with the script's arguments in "$@"."""
-    payload = REFERENCE.read_bytes()
+def carrying_reference(folder: pathlib.Path, body: str, name: str = "lab",
+                       reference: pathlib.Path = REFERENCE) -> pathlib.Path:
+    """A script whose payload is the lab-01 reference (or `reference`): `body` runs after
+    `./ref` (the unpacked binary) exists in the working folder, with the script's arguments
+    in "$@"."""
+    payload = reference.read_bytes()
     head = (f"tail -c {len(payload)} \"$0\" > ./ref && chmod +x ./ref || exit 99\n"
             f"{body}\nexit $?\n")
     path = folder / name
@@ -194,3 +196,12 @@ FLATTEN = ("(image.reshape(image.shape[0] // 8, 8, image.shape[1] // 8, 8, 3).me
            ".repeat(8, 0).repeat(8, 1).astype('float32') if image.shape[0] % 8 == 0 == "
            "image.shape[1] % 8 else image)")
 FLOAT_LIMIT = "__import__('numpy').where(image == image.max(), 3.3e38, image).astype('float32')"
+
+
+def threads_on_every_cpu(folder, parallel_reference: pathlib.Path) -> pathlib.Path:
+    """Lab 03's scalar OpenMP reference handed in for lab 02, widening its CPU affinity to
+    every CPU of the machine before it starts (undoing a confinement to one)."""
+    import os
+    cpus = ",".join(str(c) for c in sorted(os.sched_getaffinity(0)))
+    return carrying_reference(folder, f'exec taskset -c {cpus} ./ref "$@"',
+                              reference=parallel_reference)

@@ -432,3 +432,41 @@ def test_values_at_the_float_limit_fail_every_image_check(tmp_path):
                     trusted=True)
     assert results["score"] <= 10, describe(results)
     assert "radiance is never negative and no test scene gives more" in describe(results)
+
+
+# ---- speed that fails closed (grading/checks.py) -------------------------------------------
+
+def test_threads_in_the_simd_lab_earn_no_speed(tmp_path):
+    """Scalar code on every core, handed in for lab 02: the timed runs are confined to one
+    CPU and their CPU time is measured, so widening the affinity again earns nothing."""
+    from grading.harness import build
+    lab03_ref, = build("lab03-ref")
+    results = grade("02", sub.threads_on_every_cpu(tmp_path, lab03_ref), tmp_path)
+    speed = next(t for t in results["tests"] if t["extra_data"]["check"] == "speedup")
+    assert speed["score"] == 0, describe(results)
+    assert results["score"] <= 70, describe(results)
+
+
+@pytest.fixture
+def cpu_burner():
+    """A process burning one core, in a session of its own (as another user's job would)."""
+    p = subprocess.Popen(["/bin/sh", "-c", "while :; do :; done"], start_new_session=True)
+    yield p
+    p.kill()
+    p.wait()
+
+
+def test_serial_lab03_beside_a_cpu_burner_earns_nothing(tmp_path, cpu_burner):
+    """The unmodified lab 03 skeleton renders lab 01's bits on one core (lab01-ref stands in
+    for it): beside a process burning one core noise once made it look 1.1-1.4x faster than
+    the serial reference. Its CPU time over its wall time shows it serial; where the machine
+    is so busy that even that cannot be told, the test is marked for regrade with no points
+    in the score, the possible ones shown apart."""
+    results = grade("03", sub.REFERENCE, tmp_path)
+    speed = next(t for t in results["tests"] if t["extra_data"]["check"] == "parallel-speedup")
+    assert speed["score"] == 0 and results["score"] <= 10, describe(results)
+    if speed["extra_data"]["regrade"]:
+        assert "if the regrade confirms" in results["output"], results["output"]
+        assert results["score"] == sum(t["score"] for t in results["tests"])
+    else:
+        assert speed["output"].startswith("serial:"), describe(results)
