@@ -30,7 +30,7 @@ import time
 
 import numpy as np
 
-from grading import report_html, scenes, symptoms
+from grading import draws, report_html, scenes, symptoms
 from grading.compare import compare
 from grading.harness import GOLDEN, ImageError, golden, run_lab
 
@@ -79,11 +79,13 @@ GOLDEN_TEST_SPP = 64
 
 
 @image_checked("golden image")
-def check_golden(binary, scene: str, *, seed: int = 7, spp: int = GOLDEN_TEST_SPP,
+def check_golden(binary, scene: str, *, seed: int | None = None, spp: int = GOLDEN_TEST_SPP,
                  heatmap_dir: pathlib.Path | None = None, launcher=(), threads=None,
                  extra=()) -> CheckResult:
-    """Noise-aware comparison with the converged golden image (grading/compare.py)."""
+    """Noise-aware comparison with the converged golden image (grading/compare.py), rendered
+    at a seed drawn from the grading secret (grading/draws.py)."""
     g = golden(scene)
+    seed = draws.seed(f"golden-{scene}") if seed is None else seed
     run = run_lab(binary, g.scene, width=g.meta["width"], height=g.meta["height"], spp=spp,
                   bounces=g.meta["bounces"], seed=seed, launcher=launcher, threads=threads,
                   extra=extra)
@@ -116,11 +118,18 @@ def stored_golden_copied(image: np.ndarray) -> str | None:
 INTERIOR = dict(albedo=0.6, radius=2.0, intensity=3.0)
 
 
-def render_interior(binary, runs: dict) -> dict:
+def drawn_interior() -> dict:
+    """The graded sphere interior's albedo, radius and intensity, drawn from the secret."""
+    return dict(albedo=draws.uniform("interior-albedo", 0.3, 0.8),
+                radius=draws.uniform("interior-radius", 0.5, 4.0),
+                intensity=draws.uniform("interior-intensity", 0.5, 6.0))
+
+
+def render_interior(binary, runs: dict, interior: dict = INTERIOR) -> dict:
     """Renders the sphere interior once per entry of `runs` (key -> run_lab settings)."""
     with tempfile.TemporaryDirectory() as tmp:
-        path = scenes.write_scene(pathlib.Path(tmp) / "interior.json",
-                                  scenes.sphere_interior(**INTERIOR))
+        path = scenes.write_scene(pathlib.Path(tmp) / "scene.json",
+                                  scenes.sphere_interior(**interior))
         return {label: run_lab(binary, path, **how).image for label, how in runs.items()}
 
 
@@ -140,10 +149,12 @@ def black_pixels(image: np.ndarray) -> str:
 def check_sphere_interior(binary, bounces=(1, 2, 4)) -> CheckResult:
     """Closed form: camera and light inside a diffuse sphere (grading/scenes.py)."""
     worst, symptom = 0.0, ""
-    images = render_interior(binary, {b: dict(width=16, height=16, spp=4, bounces=b)
-                                      for b in bounces})
+    interior = drawn_interior()
+    images = render_interior(binary, {b: dict(width=16, height=16, spp=4, bounces=b,
+                                              seed=draws.seed("interior"))
+                                      for b in bounces}, interior)
     for b, image in images.items():
-        want = scenes.sphere_interior_radiance(**INTERIOR, bounces=b)
+        want = scenes.sphere_interior_radiance(**interior, bounces=b)
         worst = worst_of(worst, np.max(np.abs(image.astype(np.float64) / want - 1.0)))
         symptom = symptom or black_pixels(image)
     ok = worst <= 3e-4
@@ -175,10 +186,14 @@ def check_million_samples(binary, spp: int = 1 << 22) -> CheckResult:
 def check_lit_plane(binary) -> CheckResult:
     """Closed form: a diffuse floor lit by a point light, one bounce, per-pixel integral."""
     w = h = 24
-    scene = scenes.lit_plane(albedo=0.5, height=1.0, intensity=2.0, vfov=70)
+    scene = scenes.lit_plane(albedo=draws.uniform("plane-albedo", 0.3, 0.8),
+                             height=draws.uniform("plane-height", 0.5, 2.0),
+                             intensity=draws.uniform("plane-intensity", 1.0, 4.0),
+                             vfov=draws.uniform("plane-vfov", 60.0, 80.0))
     with tempfile.TemporaryDirectory() as tmp:
-        path = scenes.write_scene(pathlib.Path(tmp) / "plane.json", scene)
-        image = run_lab(binary, path, width=w, height=h, spp=256, bounces=1).image
+        path = scenes.write_scene(pathlib.Path(tmp) / "scene.json", scene)
+        image = run_lab(binary, path, width=w, height=h, spp=256, bounces=1,
+                        seed=draws.seed("plane")).image
     want = scenes.lit_plane_expected(scene, w, h)
     # The only noise is where the jitter lands inside a pixel: ~0.2% at 256 spp here.
     def right(gray):
@@ -196,28 +211,30 @@ def check_lit_plane(binary) -> CheckResult:
                        f" (allowed 3e-3, 2e-2)" + symptom)
 
 
-GLASS_ANGLES = (0.0, 45.0)  # degrees from the pane's normal: head-on, and oblique
-
-
 @image_checked("analytic glass pane (Fresnel)")
-def check_glass_slab(binary, angles=GLASS_ANGLES, ior: float = 1.5) -> CheckResult:
-    """Closed form: a glass pane's Fresnel reflectance, head-on and at 45 degrees, where the
-    reflectance is that of the exact Fresnel equations and the refracted path follows
-    Snell's law through the pane and back (grading/scenes.py, glass_slab)."""
+def check_glass_slab(binary, angles=None, ior: float | None = None) -> CheckResult:
+    """Closed form: a glass pane's Fresnel reflectance, head-on and at an oblique angle
+    (35-55 degrees, drawn from the grading secret, as is the index of refraction, 1.4-1.7),
+    where the reflectance is that of the exact Fresnel equations and the refracted path
+    follows Snell's law through the pane and back (grading/scenes.py, glass_slab)."""
+    angles = angles or (0.0, round(draws.uniform("pane-angle", 35.0, 55.0), 3))
+    ior = ior or round(draws.uniform("pane-ior", 1.4, 1.7), 4)
     worst, where = 0.0, ""
     with tempfile.TemporaryDirectory() as tmp:
         for angle in angles:
-            scene = scenes.glass_slab(ior=ior, albedo=0.8, intensity=4.0, angle_deg=angle)
-            path = scenes.write_scene(pathlib.Path(tmp) / "pane.json", scene)
+            scene = scenes.glass_slab(ior=ior, albedo=draws.uniform("pane-albedo", 0.6, 0.9),
+                                      intensity=draws.uniform("pane-intensity", 2.0, 6.0),
+                                      angle_deg=angle)
+            path = scenes.write_scene(pathlib.Path(tmp) / "scene.json", scene)
             for b in (2, 4):
-                # 32x32 pixels x 256 paths, each reflecting with probability ~4-5%: the mean
+                # 32x32 pixels x 256 paths, each reflecting with probability ~4-7%: the mean
                 # has a relative standard error of about 1%, so 5% is a five-sigma bound.
                 image = run_lab(binary, path, width=32, height=32, spp=256, bounces=b,
-                                seed=5).image
+                                seed=draws.seed(f"pane-{angle}-{b}")).image
                 want = scenes.glass_slab_radiance(scene, b, angle)
                 err = abs(float(image.astype(np.float64).mean()) / want - 1.0)
                 if not (err <= worst):
-                    worst, where = err, f"at {angle:g} degrees, {b} interactions"
+                    worst, where = err, f"at {angle:g} degrees, {b} interactions, ior {ior:g}"
     return CheckResult("analytic glass pane (Fresnel)", worst <= 0.05,
                        f"largest relative error of the mean {worst:.2%} {where} (allowed 5%)")
 
@@ -235,10 +252,11 @@ def check_scale_invariance(binary, scene: str = "cornell", factors=SCALE_FACTORS
     with tempfile.TemporaryDirectory() as tmp:
         def render(s, name):
             path = scenes.write_scene(pathlib.Path(tmp) / name, s)
-            return run_lab(binary, path, width=w, height=h, spp=16, bounces=4, seed=3).image
-        base = render(base_scene, "base.json")
+            return run_lab(binary, path, width=w, height=h, spp=16, bounces=4,
+                           seed=draws.seed("scale")).image
+        base = render(base_scene, "a.json")
         for f in factors:
-            img = render(scenes.scaled(base_scene, f), f"scaled-{f:g}.json")
+            img = render(scenes.scaled(base_scene, f), f"b{factors.index(f)}.json")
             ours, plain = img.astype(np.float64), base.astype(np.float64)
             mean_err = abs(float(ours.mean()) / float(plain.mean()) - 1.0)
             rel = np.abs(ours - plain) / (np.abs(plain) + 1e-3)
@@ -256,9 +274,10 @@ def check_scale_invariance(binary, scene: str = "cornell", factors=SCALE_FACTORS
 def check_reproducible(binary, **kwargs) -> CheckResult:
     """Same seed, same bits; another seed, another image."""
     args = dict(width=32, height=32, spp=8, **kwargs)
-    a = run_lab(binary, seed=11, **args).image
-    b = run_lab(binary, seed=11, **args).image
-    c = run_lab(binary, seed=12, **args).image
+    seed = draws.seed("reproducible")
+    a = run_lab(binary, seed=seed, **args).image
+    b = run_lab(binary, seed=seed, **args).image
+    c = run_lab(binary, seed=seed + 1, **args).image
     same = a.tobytes() == b.tobytes()
     differs = a.tobytes() != c.tobytes()
     return CheckResult("reproducible", same and differs,
@@ -295,7 +314,7 @@ def timed_settings(spp: int, scale: int = 1) -> dict:
     """The golden Cornell view at `scale` times the golden image's width and height."""
     g = golden(TIMED_SCENE)
     return dict(scene=g.scene, width=g.meta["width"] * scale, height=g.meta["height"] * scale,
-                bounces=g.meta["bounces"], seed=1, spp=spp)
+                bounces=g.meta["bounces"], seed=draws.seed("timed"), spp=spp)
 
 
 def box_filtered(image: np.ndarray, scale: int) -> np.ndarray:
@@ -532,7 +551,7 @@ def check_bitwise_equal(binary, baseline, *, runs=None) -> CheckResult:
     rank counts): what a counter-based RNG and a race-free parallel loop guarantee. `runs`
     maps a label to run_lab keyword arguments; default: 1, 2, 3 and 7 threads."""
     runs = runs or {f"{t} threads": {"threads": t} for t in (1, 2, 3, 7)}
-    settings = dict(width=48, height=40, spp=8, seed=3)
+    settings = dict(width=48, height=40, spp=8, seed=draws.seed("bitwise"))
     want = run_lab(baseline, **settings).image.tobytes()
     differing = [label for label, how in runs.items()
                  if run_lab(binary, **settings, **how).image.tobytes() != want]

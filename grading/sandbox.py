@@ -194,7 +194,8 @@ class Runner:
         path = pathlib.Path(path).resolve()
         if self.trusted:
             return str(path)
-        name = f"{len(self.inputs)}-{path.name}"
+        # A neutral name: a submission must not tell which check runs it from a file's name.
+        name = f"{len(self.inputs)}{path.suffix if path.suffix in ('.json', '.pfm') else ''}"
         staged = self.root / "inputs" / name
         staged.parent.mkdir(mode=0o755, exist_ok=True)
         shutil.copyfile(path, staged)

@@ -195,6 +195,10 @@ def cached_tree(lab_folder: str, target: str = "variant") -> pathlib.Path:
         if p.returncode != 0:
             raise RuntimeError(f"the students' tree of {lab_folder} does not build its "
                                f"driver: {(p.stdout + p.stderr)[-1500:]}")
+        # The tree is never built again: its make dependency files would only reach the
+        # repository's own make, which includes every *.d under build/.
+        for dep in partial.rglob("*.d"):
+            dep.unlink()
         (partial / ".complete").write_text("")
         try:
             partial.rename(tree)
