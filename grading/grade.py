@@ -221,10 +221,9 @@ def grade(lab: str, binary: pathlib.Path, heatmap_dir: pathlib.Path, *, trusted:
     for item in rubric:
         results.add(Test(item.id, item.label, item.points, visibility=item.visibility))
     if not trusted:
-        reason = sandbox.probe()
+        reason = sandbox_problem(results)
         if reason:
-            results.refuse(f"refusing to grade untrusted code without a sandbox: {reason} "
-                           f"(pass --trusted to grade your own code without one)")
+            results.refuse(reason, regrade=True)
             return results.as_dict()
     reason = golden_sums.problem()
     if reason:  # every image check would compare with the wrong data: the grader's fault
@@ -267,6 +266,30 @@ def grade(lab: str, binary: pathlib.Path, heatmap_dir: pathlib.Path, *, trusted:
         results.changed()
     results.complete(time.perf_counter() - start)
     return results.as_dict()
+
+
+def sandbox_problem(results: Results | None = None) -> str | None:
+    """Why untrusted code cannot be graded here, in one line, or None; records which sandbox
+    was picked in `results`. The machine's fault, never the submission's: a refusal is marked
+    for regrade. In the user sandbox the repository is closed to the sandbox user; either
+    sandbox's user must reach the temporary folder where inputs and builds are staged."""
+    import tempfile
+    if os.geteuid() == 0:  # either sandbox runs as a user other than root: it must get in
+        closed = sandbox.unreachable(pathlib.Path(tempfile.gettempdir()), sandbox.NOBODY,
+                                     sandbox.NOBODY)
+        if closed:
+            return (f"refusing to grade: the sandbox user cannot enter {closed} (mode "
+                    f"{closed.stat().st_mode & 0o777:o}), where the grader stages every input "
+                    f"and build; set TMPDIR to a folder it can enter; marked for regrade")
+    reason = sandbox.probe()
+    if reason:
+        return (f"refusing to grade untrusted code without a sandbox: {reason} (pass "
+                f"--trusted to grade your own code without one); marked for regrade")
+    if os.geteuid() == 0:
+        sandbox.hide_from_sandbox(ROOT)
+    if results is not None:
+        results.sandbox = sandbox.description()
+    return None
 
 
 def no_gpu_line(lab: str, reason: str) -> str:
@@ -408,12 +431,10 @@ def main(argv=None) -> int:
         os.environ.setdefault("OMPI_ALLOW_RUN_AS_ROOT", "1")  # sandbox runs as nobody)
         os.environ.setdefault("OMPI_ALLOW_RUN_AS_ROOT_CONFIRM", "1")
     try:
-        reason = None if a.trusted else sandbox.probe()
-        if reason:  # one line, and a results.json that says the same
-            line = (f"refusing to grade untrusted code without a sandbox: {reason} "
-                    f"(pass --trusted to grade your own code without one)")
+        line = None if a.trusted else sandbox_problem(results)
+        if line:  # one line, and a results.json that says the same
             print(f"error: {line}", file=sys.stderr)
-            results.refuse(line)
+            results.refuse(line, regrade=True)
             return 2
         if gpu.is_gpu_lab(a.lab) and (reason := gpu.missing_gpu()):
             line = no_gpu_line(a.lab, reason)  # one line, and a results.json that says it

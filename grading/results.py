@@ -69,6 +69,7 @@ class Results:
         self.notes: list[str] = []
         self.refused = False
         self.start = time.perf_counter()
+        self.sandbox = "none (--trusted)"  # which sandbox ran the submission (grading/sandbox.py)
 
     def add(self, test: Test) -> None:
         if not any(t.id == test.id for t in self.tests):
@@ -121,6 +122,7 @@ class Results:
                 "max_score": sum(t.max_score for t in self.tests),
                 "execution_time": round(time.perf_counter() - self.start, 3),
                 "output": "\n".join(self.notes), "visibility": "visible",
+                "sandbox": self.sandbox,
                 "tests": [t.as_dict() for t in self.tests]}
 
     def changed(self) -> None:
