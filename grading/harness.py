@@ -46,9 +46,55 @@ def cpu_has_avx2() -> bool:
     return False
 
 
+def cpu_quota() -> float | None:
+    """Cores' worth of CPU time this process's cgroup may use (cgroup v2 cpu.max, v1
+    cpu.cfs_quota_us over cpu.cfs_period_us, the smallest along the cgroup's path), or None
+    without a quota. A container run with --cpus=0.5 (Gradescope's default) has 0.5 here and
+    still sees every CPU of the host."""
+    quotas = []
+    try:
+        lines = pathlib.Path("/proc/self/cgroup").read_text().splitlines()
+    except OSError:
+        lines = []
+    for line in lines:
+        hierarchy, controllers, path = (line.split(":", 2) + ["", ""])[:3]
+        if hierarchy == "0":  # v2
+            folders = [pathlib.Path("/sys/fs/cgroup") / path.lstrip("/")]
+            folders += list(folders[0].parents)
+            for folder in folders:
+                if not str(folder).startswith("/sys/fs/cgroup"):
+                    break
+                try:
+                    quota, period = (folder / "cpu.max").read_text().split()
+                except (OSError, ValueError):
+                    continue
+                if quota != "max":
+                    quotas.append(int(quota) / int(period))
+        elif "cpu" in controllers.split(","):
+            for base in ("/sys/fs/cgroup/cpu,cpuacct", "/sys/fs/cgroup/cpu"):
+                folder = pathlib.Path(base) / path.lstrip("/")
+                for f in (folder, pathlib.Path(base)):
+                    try:
+                        quota = int((f / "cpu.cfs_quota_us").read_text())
+                        period = int((f / "cpu.cfs_period_us").read_text())
+                    except (OSError, ValueError):
+                        continue
+                    if quota > 0:
+                        quotas.append(quota / period)
+    return min(quotas) if quotas else None
+
+
+def cpu_capacity() -> float:
+    """Cores' worth of CPU this process may use: its CPUs, or its cgroup's quota if smaller."""
+    cpus = len(os.sched_getaffinity(0))
+    quota = cpu_quota()
+    return min(cpus, quota) if quota else float(cpus)
+
+
 def available_cores() -> int:
-    """Cores this process may run on (what thresholds scale with)."""
-    return len(os.sched_getaffinity(0))
+    """Whole cores this process may use (what thresholds scale with): its CPUs, or fewer when
+    its cgroup's CPU quota is smaller (cpu_capacity)."""
+    return max(1, int(cpu_capacity()))
 
 
 @dataclasses.dataclass(frozen=True)

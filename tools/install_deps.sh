@@ -1,12 +1,13 @@
 #!/usr/bin/env bash
 # Installs what the labs need and is missing; says what it installs; safe to run again.
 # Compilers (g++, nvcc where present) come with the machine; this adds the JSON library,
-# GoogleTest, Google Benchmark, OpenMPI, bubblewrap (the grader's sandbox) and the Python test
-# packages (matplotlib: the plots of `make tradeoff`).
+# GoogleTest, Google Benchmark, OpenMPI, bubblewrap (the grader's sandbox), util-linux's setpriv,
+# prlimit and taskset and python3-seccomp (the grader's sandbox where namespaces cannot be had:
+# grading/README.md) and the Python test packages (matplotlib: the plots of `make tradeoff`).
 set -euo pipefail
 
 debian_packages=(g++ make nlohmann-json3-dev libgtest-dev libbenchmark-dev openmpi-bin
-                 libopenmpi-dev iproute2 bubblewrap)
+                 libopenmpi-dev iproute2 bubblewrap util-linux python3-seccomp)
 python_modules=(pytest numpy matplotlib)
 
 missing=()
