@@ -19,7 +19,7 @@ import sys
 import time
 from typing import Callable
 
-from grading import checks, golden_sums, gpu, hidden, report_html, sandbox
+from grading import checks, draws, golden_sums, gpu, hidden, report_html, sandbox
 from grading.harness import ROOT, RunPolicy, available_cores, build, policy
 from grading.results import Results, Test
 
@@ -242,6 +242,16 @@ def grade(lab: str, binary: pathlib.Path, heatmap_dir: pathlib.Path, *, trusted:
             results.refuse(reason, regrade=True)
             return results.as_dict()
     start = time.perf_counter()
+    with draws.secret(secret):
+        grade_items(rubric, binary, heatmap_dir, secret, results, run_policy, limits,
+                    budget_seconds, start)
+    results.complete(time.perf_counter() - start)
+    return results.as_dict()
+
+
+def grade_items(rubric, binary, heatmap_dir, secret, results, run_policy, limits,
+                budget_seconds, start) -> None:
+    """Each item of the rubric in grading order, results updated after each."""
     for item in grading_order(rubric):
         test = results.test(item.id)
         if time.perf_counter() - start > budget_seconds:
@@ -264,8 +274,6 @@ def grade(lab: str, binary: pathlib.Path, heatmap_dir: pathlib.Path, *, trusted:
                 limits = dataclasses.replace(
                     limits, wall_seconds=min(limits.wall_seconds, SHORT_RUN_SECONDS))
         results.changed()
-    results.complete(time.perf_counter() - start)
-    return results.as_dict()
 
 
 def sandbox_problem(results: Results | None = None) -> str | None:

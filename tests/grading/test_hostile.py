@@ -470,3 +470,36 @@ def test_serial_lab03_beside_a_cpu_burner_earns_nothing(tmp_path, cpu_burner):
         assert results["score"] == sum(t["score"] for t in results["tests"])
     else:
         assert speed["output"].startswith("serial:"), describe(results)
+
+
+# ---- nothing precomputable (grading/draws.py) -----------------------------------------------
+
+def test_printing_the_published_analytic_answers_earns_nothing(tmp_path):
+    """The analytic scenes' parameters come from the grading secret: the answers printed for
+    the published ones are wrong (trusted: the stand-in runs the repository's Python)."""
+    results = grade("01", sub.published_answers(tmp_path), tmp_path, trusted=True)
+    assert results["score"] <= 10, describe(results)
+
+
+def test_the_secret_draws_the_timed_and_tested_renders():
+    from grading import checks, draws
+    with draws.secret("one"):
+        one = (checks.timed_settings(64)["seed"], checks.drawn_interior())
+    with draws.secret("two"):
+        two = (checks.timed_settings(64)["seed"], checks.drawn_interior())
+    assert one[0] != two[0] and one[1] != two[1]
+    with draws.secret("one"):
+        assert checks.timed_settings(64)["seed"] == one[0]  # a regrade draws the same
+
+
+def test_the_reference_objects_are_out_of_the_compilers_reach(tmp_path):
+    """A render.cpp embedding the reference's binary or objects (.incbin) to run them: the
+    students' tree has no references, the repository is out of the sandbox's view."""
+    from grading.grade import build_lab
+    for target in (ROOT / "lab01-ref", ROOT / "build" / "common" / "host" / "lab_main.o"):
+        folder = handin(tmp_path / target.name, {
+            "render.cpp": f'__asm__(".section .rodata\\n.incbin \\"{target}\\"\\n.text");\n'
+                          + solution_text("01-serial", "render.cpp"),
+            "path_tracer.h": solution_text("01-serial", "path_tracer.h")})
+        binary, errors = build_lab("01", folder, trusted=False)
+        assert binary is None and "file not found" in errors, errors
