@@ -112,7 +112,7 @@ def bwrap_path() -> str | None:
 BUBBLEWRAP, USER = "bubblewrap", "user"
 DESCRIPTIONS = {
     BUBBLEWRAP: "bubblewrap (user, PID, network, IPC and mount namespaces)",
-    USER: "a dedicated user (setpriv, prlimit, seccomp filter; no namespaces here)",
+    USER: "a dedicated user (setpriv, prlimit, seccomp filter{landlock}; no namespaces here)",
 }
 SANDBOX_USER = "prt-sandbox"   # made by setup.sh (or the grader, as root) for the user sandbox
 SYSTEM_PYTHON = "/usr/bin/python3"  # runs grading/confine.py: python3-seccomp is its module
@@ -135,7 +135,19 @@ def isolation() -> str:
 
 
 def description() -> str:
-    return DESCRIPTIONS[isolation()]
+    return DESCRIPTIONS[isolation()].format(
+        landlock=", Landlock" if landlock_available() else "; no Landlock on this kernel")
+
+
+def landlock_available() -> bool:
+    """Whether the kernel (and a container's seccomp profile) offers Landlock (x86-64)."""
+    import ctypes
+    import platform
+    if platform.machine() != "x86_64":
+        return False
+    libc = ctypes.CDLL(None, use_errno=True)
+    libc.syscall.restype = ctypes.c_long
+    return libc.syscall(444, None, ctypes.c_size_t(0), ctypes.c_uint32(1)) >= 1
 
 
 def _probe() -> str | None:
@@ -425,10 +437,14 @@ class Runner:
             return inner
         if self.user_mode:
             uid, gid = self.owner
+            paths = ["--ro", str(pathlib.Path(_confine_script()).parent),
+                     "--ro", str(self.root / "inputs"), "--rw", str(self._scratch_dir())]
+            for path, writable in self.binds:
+                paths += ["--rw" if writable else "--ro", path]
             return [shutil.which("setpriv") or "setpriv", f"--reuid={uid}", f"--regid={gid}",
                     "--clear-groups", "--no-new-privs", "--inh-caps=-all", "--",
                     *inner[:inner.index("--") + 1],
-                    SYSTEM_PYTHON, "-I", _confine_script(), "--", *argv]
+                    SYSTEM_PYTHON, "-I", _confine_script(), *paths, "--", *argv]
         scratch = self._scratch_dir()
         cmd = [bwrap_path() or "bwrap", "--unshare-all", "--unshare-user",
                "--uid", str(NOBODY), "--gid", str(NOBODY), "--die-with-parent", "--new-session",
