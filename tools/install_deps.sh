@@ -28,6 +28,16 @@ missing_py=()
 for m in "${python_modules[@]}"; do
     "$python" -c "import $m" 2>/dev/null || missing_py+=("$m")
 done
+if ((${#missing_py[@]})) && ! "$python" -m pip --version >/dev/null 2>&1 &&
+        [ "$(command -v "$python")" = /usr/bin/python3 ]; then
+    # The system's Python without pip (a fresh Debian, the Gradescope image): Debian's packages.
+    echo "deps: installing Debian packages for $python: ${missing_py[*]/#/python3-}"
+    sudo=""
+    [ "$(id -u)" -eq 0 ] || sudo="sudo"
+    DEBIAN_FRONTEND=noninteractive $sudo apt-get install -y -qq --no-install-recommends \
+        "${missing_py[@]/#/python3-}" >/dev/null
+    missing_py=()
+fi
 if ((${#missing_py[@]})); then
     echo "deps: installing Python packages for $python: ${missing_py[*]}"
     "$python" -m pip install --quiet --disable-pip-version-check "${missing_py[@]}" 2>/dev/null ||
