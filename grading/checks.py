@@ -506,6 +506,12 @@ def check_parallel_speedup(binary, baseline, *, threads=None, launcher=(),
         ratios = sorted(y / b for y, b in zip(used, base_used) if b > 0)
         return ratios[len(ratios) // 2] if ratios else float("nan")
 
+    def parallel() -> bool:
+        """Shown to run on more than one core: a run used more than SERIAL_CORES cores' worth
+        of CPU time (one thread cannot use more than one core, whatever the load), or the runs
+        got more than SERIAL_CORES times the serial reference's share of a busy machine."""
+        return max(used, default=0.0) > SERIAL_CORES or share() > SERIAL_CORES
+
     note = f" (launch overhead {overhead:.3f} s subtracted)" if overhead else ""
     best = None  # (credit, timing) of the attempt closest to the bar
     capacity = 0.0
@@ -515,13 +521,13 @@ def check_parallel_speedup(binary, baseline, *, threads=None, launcher=(),
         if wrong:
             return CheckResult("parallel speedup", False,
                                f"{wrong[0]}: speed is graded only for a correct image", credit=0.0)
-        if not (share() > SERIAL_CORES) and capacity >= SERIAL_TELLABLE:
+        if not parallel() and capacity >= SERIAL_TELLABLE:
             return CheckResult("parallel speedup", False,
-                               f"serial: the timed runs used {share():.2f}x the CPU time per "
-                               f"second of the serial reference's ({max(used):.2f} cores at "
-                               f"most; measured by the grader) on a machine giving "
-                               f"{capacity:.2f} cores' worth; a parallel program uses more than "
-                               f"{SERIAL_CORES:g}x ({timing.describe('yours')}{note})", credit=0.0)
+                               f"serial: the timed runs used at most {max(used):.2f} cores' "
+                               f"worth of CPU time, {share():.2f}x the serial reference's share "
+                               f"(measured by the grader), on a machine giving {capacity:.2f} "
+                               f"cores' worth; a parallel program uses more than "
+                               f"{SERIAL_CORES:g} ({timing.describe('yours')}{note})", credit=0.0)
         if timing.capacity >= 1.5:
             credit = speed_credit(timing.speedup("yours"), timing.required(fraction))
             if best is None or credit > best[0]:
@@ -530,9 +536,8 @@ def check_parallel_speedup(binary, baseline, *, threads=None, launcher=(),
                 break  # reached the bar, or measured on a machine quiet enough to judge
         if attempt < attempts:
             time.sleep(2.0 * attempt)  # let the other load pass
-    parallel = share() > SERIAL_CORES
     if best is None:
-        return CheckResult("parallel speedup", parallel,
+        return CheckResult("parallel speedup", parallel(),
                            f"not measurable: the machine gave only {capacity:.2f} cores' worth "
                            f"of throughput in {attempts} attempts (the timed runs used "
                            f"{share():.2f}x the serial reference's CPU share); no points now, "
@@ -542,7 +547,7 @@ def check_parallel_speedup(binary, baseline, *, threads=None, launcher=(),
     bar = timing.required(fraction)
     detail = timing.describe("yours") + note + credit_note(credit, bar)
     if credit < 1 and timing.capacity < BUSY:
-        return CheckResult("parallel speedup", credit > 0 or parallel,
+        return CheckResult("parallel speedup", credit > 0 or parallel(),
                            f"short of the bar on a machine too busy to judge ({detail}); "
                            f"marked for regrade", regrade=True, credit=credit,
                            provisional=1.0 - credit)
