@@ -456,8 +456,9 @@ def check_parallel_speedup(binary, baseline, *, threads=None, launcher=(),
     measure_parallel). Every timed image must be the baseline's, bit for bit (what labs 03 and
     04 promise). It fails closed:
     - a program whose timed runs never used more than SERIAL_CORES cores' worth of CPU time
-      (the grader's own measurement of the sandboxed tree) on a machine giving at least
-      SERIAL_TELLABLE is serial: no points, not a regrade, whatever the speedup looked like;
+      (the grader's own measurement of the sandboxed tree) nor more than SERIAL_CORES times
+      the serial reference's share in the same rounds, on a machine giving at least
+      SERIAL_TELLABLE, is serial: no points, not a regrade, whatever its speedup looked like;
     - points follow speed_credit of the speedup against the bar; where the machine stays too
       busy to reach a verdict, the test is marked for regrade and only the points measured
       count: the rest is shown apart, never in the score."""
