@@ -10,8 +10,8 @@ How often a correct renderer fails each check (its false-failure rate), and why:
   the two means equal to float rounding (~1e-7), bound 1e-5; a float sum drifts by ~1e-2.
 - lit plane: the only noise is where the pixel jitter lands; at 256 spp the per-pixel error
   is ~1e-3, bounds 3e-3 (mean) and 2e-2 (max) are far outside it.
-- glass pane: the mean of 262,144 Bernoulli(~4%) paths has a relative standard error of
-  ~1%; the 5% bound is five standard errors (two-sided rate ~6e-7).
+- glass pane: the mean of 262,144 Bernoulli(~4-5%) paths has a relative standard error of
+  ~1%; the 5% bound is five standard errors (two-sided rate ~6e-7) at each of 4 renders.
 - scale invariance: the scaled and unscaled renders use the same random numbers, so they
   differ only where rounding sends a path another way: measured 0.00% for the reference.
 A renderer whose float roundings differ (SIMD, GPU) is another random draw of the same
@@ -22,13 +22,15 @@ from __future__ import annotations
 
 import dataclasses
 import functools
+import os
 import pathlib
+import shutil
 import tempfile
 import time
 
 import numpy as np
 
-from grading import report_html, scenes, symptoms
+from grading import draws, report_html, scenes, symptoms
 from grading.compare import compare
 from grading.harness import GOLDEN, ImageError, golden, run_lab
 
@@ -38,12 +40,23 @@ class CheckResult:
     name: str
     passed: bool
     detail: str
-    # The machine could not measure this (too busy, even after retries): the grader awards
-    # the points provisionally and marks the test for a regrade instead of failing it.
+    # The machine could not measure this (too busy, even after retries): marked for a
+    # regrade. Its points stay out of the score; `provisional` (a fraction of the points) is
+    # what the regrade may add, shown apart.
     regrade: bool = False
+    # A timed check's fraction of its points (speed_credit); None: all or nothing by `passed`.
+    credit: float | None = None
+    provisional: float = 0.0
 
     def __str__(self) -> str:
         return f"{'PASS' if self.passed else 'FAIL'} {self.name}: {self.detail}"
+
+
+def worst_of(*values: float) -> float:
+    """The largest of `values`, NaN if any is NaN: `max(0.0, nan)` is 0.0, which would read
+    a NaN error as no error. Compare its result as `not (worst <= bound)`."""
+    values = [float(v) for v in values]
+    return float("nan") if any(v != v for v in values) else max(values)
 
 
 def image_checked(name: str):
@@ -66,11 +79,13 @@ GOLDEN_TEST_SPP = 64
 
 
 @image_checked("golden image")
-def check_golden(binary, scene: str, *, seed: int = 7, spp: int = GOLDEN_TEST_SPP,
+def check_golden(binary, scene: str, *, seed: int | None = None, spp: int = GOLDEN_TEST_SPP,
                  heatmap_dir: pathlib.Path | None = None, launcher=(), threads=None,
                  extra=()) -> CheckResult:
-    """Noise-aware comparison with the converged golden image (grading/compare.py)."""
+    """Noise-aware comparison with the converged golden image (grading/compare.py), rendered
+    at a seed drawn from the grading secret (grading/draws.py)."""
     g = golden(scene)
+    seed = draws.seed(f"golden-{scene}") if seed is None else seed
     run = run_lab(binary, g.scene, width=g.meta["width"], height=g.meta["height"], spp=spp,
                   bounces=g.meta["bounces"], seed=seed, launcher=launcher, threads=threads,
                   extra=extra)
@@ -103,11 +118,18 @@ def stored_golden_copied(image: np.ndarray) -> str | None:
 INTERIOR = dict(albedo=0.6, radius=2.0, intensity=3.0)
 
 
-def render_interior(binary, runs: dict) -> dict:
+def drawn_interior() -> dict:
+    """The graded sphere interior's albedo, radius and intensity, drawn from the secret."""
+    return dict(albedo=draws.uniform("interior-albedo", 0.3, 0.8),
+                radius=draws.uniform("interior-radius", 0.5, 4.0),
+                intensity=draws.uniform("interior-intensity", 0.5, 6.0))
+
+
+def render_interior(binary, runs: dict, interior: dict = INTERIOR) -> dict:
     """Renders the sphere interior once per entry of `runs` (key -> run_lab settings)."""
     with tempfile.TemporaryDirectory() as tmp:
-        path = scenes.write_scene(pathlib.Path(tmp) / "interior.json",
-                                  scenes.sphere_interior(**INTERIOR))
+        path = scenes.write_scene(pathlib.Path(tmp) / "scene.json",
+                                  scenes.sphere_interior(**interior))
         return {label: run_lab(binary, path, **how).image for label, how in runs.items()}
 
 
@@ -127,13 +149,15 @@ def black_pixels(image: np.ndarray) -> str:
 def check_sphere_interior(binary, bounces=(1, 2, 4)) -> CheckResult:
     """Closed form: camera and light inside a diffuse sphere (grading/scenes.py)."""
     worst, symptom = 0.0, ""
-    images = render_interior(binary, {b: dict(width=16, height=16, spp=4, bounces=b)
-                                      for b in bounces})
+    interior = drawn_interior()
+    images = render_interior(binary, {b: dict(width=16, height=16, spp=4, bounces=b,
+                                              seed=draws.seed("interior"))
+                                      for b in bounces}, interior)
     for b, image in images.items():
-        want = scenes.sphere_interior_radiance(**INTERIOR, bounces=b)
-        worst = max(worst, float(np.max(np.abs(image / want - 1.0))))
+        want = scenes.sphere_interior_radiance(**interior, bounces=b)
+        worst = worst_of(worst, np.max(np.abs(image.astype(np.float64) / want - 1.0)))
         symptom = symptom or black_pixels(image)
-    ok = worst < 3e-4
+    ok = worst <= 3e-4
     return CheckResult("analytic sphere interior", ok,
                        f"largest relative error {worst:.2e} over bounces {list(bounces)}"
                        f" (allowed 3e-4)" + ("" if ok else symptom))
@@ -162,16 +186,20 @@ def check_million_samples(binary, spp: int = 1 << 22) -> CheckResult:
 def check_lit_plane(binary) -> CheckResult:
     """Closed form: a diffuse floor lit by a point light, one bounce, per-pixel integral."""
     w = h = 24
-    scene = scenes.lit_plane(albedo=0.5, height=1.0, intensity=2.0, vfov=70)
+    scene = scenes.lit_plane(albedo=draws.uniform("plane-albedo", 0.3, 0.8),
+                             height=draws.uniform("plane-height", 0.5, 2.0),
+                             intensity=draws.uniform("plane-intensity", 1.0, 4.0),
+                             vfov=draws.uniform("plane-vfov", 60.0, 80.0))
     with tempfile.TemporaryDirectory() as tmp:
-        path = scenes.write_scene(pathlib.Path(tmp) / "plane.json", scene)
-        image = run_lab(binary, path, width=w, height=h, spp=256, bounces=1).image
+        path = scenes.write_scene(pathlib.Path(tmp) / "scene.json", scene)
+        image = run_lab(binary, path, width=w, height=h, spp=256, bounces=1,
+                        seed=draws.seed("plane")).image
     want = scenes.lit_plane_expected(scene, w, h)
     # The only noise is where the jitter lands inside a pixel: ~0.2% at 256 spp here.
     def right(gray):
         err = np.abs(gray / want - 1.0)
-        return float(err.mean()) < 3e-3 and float(err.max()) < 2e-2, err
-    ok, err = right(image.mean(axis=2))
+        return float(err.mean()) <= 3e-3 and float(err.max()) <= 2e-2, err
+    ok, err = right(image.astype(np.float64).mean(axis=2))
     symptom = ""
     if not ok:
         # The light stands off the axes, so the image has no symmetry: a flipped or transposed
@@ -184,20 +212,31 @@ def check_lit_plane(binary) -> CheckResult:
 
 
 @image_checked("analytic glass pane (Fresnel)")
-def check_glass_slab(binary) -> CheckResult:
-    """Closed form: Fresnel reflectance of a glass pane at normal incidence."""
-    scene = scenes.glass_slab(ior=1.5, albedo=0.8, intensity=4.0)
-    worst = 0.0
+def check_glass_slab(binary, angles=None, ior: float | None = None) -> CheckResult:
+    """Closed form: a glass pane's Fresnel reflectance, head-on and at an oblique angle
+    (35-55 degrees, drawn from the grading secret, as is the index of refraction, 1.4-1.7),
+    where the reflectance is that of the exact Fresnel equations and the refracted path
+    follows Snell's law through the pane and back (grading/scenes.py, glass_slab)."""
+    angles = angles or (0.0, round(draws.uniform("pane-angle", 35.0, 55.0), 3))
+    ior = ior or round(draws.uniform("pane-ior", 1.4, 1.7), 4)
+    worst, where = 0.0, ""
     with tempfile.TemporaryDirectory() as tmp:
-        path = scenes.write_scene(pathlib.Path(tmp) / "slab.json", scene)
-        for b in (2, 4):
-            # 32x32 pixels x 256 paths, each reflecting with probability ~4%: the mean has a
-            # relative standard error of about 1%, so 5% is a five-sigma bound.
-            image = run_lab(binary, path, width=32, height=32, spp=256, bounces=b, seed=5).image
-            want = scenes.glass_slab_radiance(scene, b)
-            worst = max(worst, abs(float(image.mean()) / want - 1.0))
-    return CheckResult("analytic glass pane (Fresnel)", worst < 0.05,
-                       f"largest relative error of the mean {worst:.2%} (allowed 5%)")
+        for angle in angles:
+            scene = scenes.glass_slab(ior=ior, albedo=draws.uniform("pane-albedo", 0.6, 0.9),
+                                      intensity=draws.uniform("pane-intensity", 2.0, 6.0),
+                                      angle_deg=angle)
+            path = scenes.write_scene(pathlib.Path(tmp) / "scene.json", scene)
+            for b in (2, 4):
+                # 32x32 pixels x 256 paths, each reflecting with probability ~4-7%: the mean
+                # has a relative standard error of about 1%, so 5% is a five-sigma bound.
+                image = run_lab(binary, path, width=32, height=32, spp=256, bounces=b,
+                                seed=draws.seed(f"pane-{angle}-{b}")).image
+                want = scenes.glass_slab_radiance(scene, b, angle)
+                err = abs(float(image.astype(np.float64).mean()) / want - 1.0)
+                if not (err <= worst):
+                    worst, where = err, f"at {angle:g} degrees, {b} interactions, ior {ior:g}"
+    return CheckResult("analytic glass pane (Fresnel)", worst <= 0.05,
+                       f"largest relative error of the mean {worst:.2%} {where} (allowed 5%)")
 
 
 SCALE_FACTORS = (1e-4, 1e-2, 1e3, 1e5)
@@ -213,17 +252,19 @@ def check_scale_invariance(binary, scene: str = "cornell", factors=SCALE_FACTORS
     with tempfile.TemporaryDirectory() as tmp:
         def render(s, name):
             path = scenes.write_scene(pathlib.Path(tmp) / name, s)
-            return run_lab(binary, path, width=w, height=h, spp=16, bounces=4, seed=3).image
-        base = render(base_scene, "base.json")
+            return run_lab(binary, path, width=w, height=h, spp=16, bounces=4,
+                           seed=draws.seed("scale")).image
+        base = render(base_scene, "a.json")
         for f in factors:
-            img = render(scenes.scaled(base_scene, f), f"scaled-{f:g}.json")
-            mean_err = abs(float(img.mean()) / float(base.mean()) - 1.0)
-            rel = np.abs(img - base) / (np.abs(base) + 1e-3)
-            bad_fraction = float((rel > 0.05).mean())
-            if (mean_err, bad_fraction) > worst[:2]:
+            img = render(scenes.scaled(base_scene, f), f"b{factors.index(f)}.json")
+            ours, plain = img.astype(np.float64), base.astype(np.float64)
+            mean_err = abs(float(ours.mean()) / float(plain.mean()) - 1.0)
+            rel = np.abs(ours - plain) / (np.abs(plain) + 1e-3)
+            bad_fraction = float((~(rel <= 0.05)).mean())
+            if not ((mean_err, bad_fraction) <= worst[:2]):  # a NaN counts as the worst
                 worst = (mean_err, bad_fraction, f)
     mean_err, bad_fraction, factor = worst
-    ok = mean_err < 0.01 and bad_fraction < 0.02
+    ok = mean_err <= 0.01 and bad_fraction <= 0.02
     return CheckResult("scale invariance 1e-4..1e5", ok,
                        f"worst factor {factor:g}: image mean off by {mean_err:.2%}, "
                        f"{bad_fraction:.2%} of pixel values off by > 5% (allowed 1%, 2%)")
@@ -233,9 +274,10 @@ def check_scale_invariance(binary, scene: str = "cornell", factors=SCALE_FACTORS
 def check_reproducible(binary, **kwargs) -> CheckResult:
     """Same seed, same bits; another seed, another image."""
     args = dict(width=32, height=32, spp=8, **kwargs)
-    a = run_lab(binary, seed=11, **args).image
-    b = run_lab(binary, seed=11, **args).image
-    c = run_lab(binary, seed=12, **args).image
+    seed = draws.seed("reproducible")
+    a = run_lab(binary, seed=seed, **args).image
+    b = run_lab(binary, seed=seed, **args).image
+    c = run_lab(binary, seed=seed + 1, **args).image
     same = a.tobytes() == b.tobytes()
     differs = a.tobytes() != c.tobytes()
     return CheckResult("reproducible", same and differs,
@@ -272,7 +314,7 @@ def timed_settings(spp: int, scale: int = 1) -> dict:
     """The golden Cornell view at `scale` times the golden image's width and height."""
     g = golden(TIMED_SCENE)
     return dict(scene=g.scene, width=g.meta["width"] * scale, height=g.meta["height"] * scale,
-                bounces=g.meta["bounces"], seed=1, spp=spp)
+                bounces=g.meta["bounces"], seed=draws.seed("timed"), spp=spp)
 
 
 def box_filtered(image: np.ndarray, scale: int) -> np.ndarray:
@@ -291,38 +333,106 @@ def wrong_timed_image(image, spp: int, scale: int = 1) -> str | None:
     graded only for correct work, on the very runs that were timed."""
     g = golden(TIMED_SCENE)
     report = compare(box_filtered(image, scale) if scale > 1 else image, spp * scale * scale,
-                     g.mean, g.variance, g.meta["golden_spp"])
+                     g.mean, g.variance, g.meta["golden_spp"], per_pixel=scale == 1)
     return None if report.passed else f"the timed render is wrong ({report.summary()})"
+
+
+# Speed earns partial credit: full points at or above the bar, falling linearly to none at
+# ZERO_CREDIT_AT times the bar (grading/README.md). For a parallel lab on two cores (bar
+# 1.46x) that is 1.10x, where a serial program is; the CPU-time evidence below stops a serial
+# program from earning anything by noise.
+ZERO_CREDIT_AT = 0.75
+
+
+def speed_credit(measured: float, bar: float) -> float:
+    """The fraction of a speed check's points for `measured` against `bar` (NaN earns 0)."""
+    floor = ZERO_CREDIT_AT * bar
+    if not (measured > floor):
+        return 0.0
+    return min(1.0, (measured - floor) / (bar - floor))
+
+
+def credit_note(credit: float, bar: float) -> str:
+    if credit >= 1.0:
+        return ""
+    return (f"; {credit:.0%} of the points (full at {bar:.2f}x, none at or below "
+            f"{ZERO_CREDIT_AT * bar:.2f}x)")
+
+
+def cores_used(run) -> float:
+    """CPU time over wall time of a run's whole process tree, both measured by the grader."""
+    if run.cpu_seconds is None or not run.wall_seconds > 0:
+        return float("nan")
+    return run.cpu_seconds / run.wall_seconds
+
+
+def one_cpu() -> list[str]:
+    """A launcher confining a run to one CPU (lab 02's lesson is SIMD, not threads). A program
+    may widen its own affinity again, so the timed runs' CPU time is checked as well."""
+    cpu = min(os.sched_getaffinity(0))
+    return [shutil.which("taskset") or "taskset", "-c", str(cpu)]
+
+
+# A program whose tree never used more CPU time than this many times its wall time did not
+# run in parallel (a serial renderer measures 0.95-1.0 cores on a quiet machine; a correct
+# parallel one on two cores ~1.9, ~1.3 beside a process burning one of them). On a machine
+# others load, every thread gets a share of a core: there the parallel check compares the
+# cores a program used with those the serial reference used in the same round.
+SERIAL_CORES = 1.1
+# On a busy machine a program whose threads escaped lab 02's one CPU may use under 1.1 cores
+# and still get more than the reference pinned to one: its share of the machine, over the
+# reference's in the same rounds (the median), shows it (~1.0 for one thread; 1.5-2 for two).
+ONE_CORE_SHARE = 1.3
 
 
 @image_checked("speedup")
 def check_speedup(binary, baseline, min_speedup: float, *, threads=None, launcher=(),
                   repeat: int = 3, spp: int = 256, scale: int = 1,
-                  overhead_reference=None) -> CheckResult:
+                  overhead_reference=None, one_core: bool = False) -> CheckResult:
     """Wall-clock time against a baseline binary (the lab-01 reference; a GPU lab's own
     reference), measured by the grader around each whole process (never the `seconds` a
     program reports about itself), interleaved, best of `repeat`: a ratio, so a busy machine
     slows both sides alike. Every timed image must match the golden image, or there is no
     speed to grade. `scale` renders the golden view that many times larger (checked box-
     filtered down to the golden size); `overhead_reference` (a trusted binary) measures a
-    start-up cost, rendering one pixel, that is subtracted from both sides (launch_overhead)."""
+    start-up cost, rendering one pixel, that is subtracted from both sides (launch_overhead).
+    `one_core` (lab 02): both sides run confined to one CPU, and a program whose timed runs
+    used more than SERIAL_CORES cores' worth of CPU time earns nothing (threads are not the
+    lesson). Points: speed_credit of the speedup."""
     name = f"speedup >= {min_speedup:g}x"
     settings = timed_settings(spp, scale)
+    pinned = one_cpu() if one_core else []
     overhead = launch_overhead(overhead_reference, launcher) if overhead_reference else 0.0
-    base, fast = [], []
+    base, fast, used, base_used = [], [], [], []
     for _ in range(repeat):
-        base.append(max(run_lab(baseline, **settings).wall_seconds - overhead, 1e-3))
-        run = run_lab(binary, threads=threads, launcher=launcher, **settings)
+        base_run = run_lab(baseline, launcher=pinned, **settings)
+        base.append(max(base_run.wall_seconds - overhead, 1e-3))
+        base_used.append(cores_used(base_run))
+        run = run_lab(binary, threads=threads, launcher=[*pinned, *launcher], **settings)
         wrong = wrong_timed_image(run.image, spp, scale)
         if wrong:
-            return CheckResult(name, False, f"{wrong}: speed is graded only for a correct image")
+            return CheckResult(name, False, f"{wrong}: speed is graded only for a correct image",
+                               credit=0.0)
         fast.append(max(run.wall_seconds - overhead, 1e-3))
+        used.append(cores_used(run))
+    ratios = sorted(y / b for y, b in zip(used, base_used) if b > 0)
+    share = ratios[len(ratios) // 2] if ratios else float("nan")
+    if one_core and not (max(used) <= SERIAL_CORES and share <= ONE_CORE_SHARE):
+        return CheckResult(name, False,
+                           f"the timed runs used up to {max(used):.2f} cores' worth of CPU time, "
+                           f"{share:.2f}x the share of the reference on one CPU (measured by the "
+                           f"grader; allowed {SERIAL_CORES:g} and {ONE_CORE_SHARE:g}x): lab 02 is "
+                           f"timed on one core, its speed must come from SIMD, not threads",
+                           credit=0.0)
     speedup = min(base) / min(fast)
+    credit = speed_credit(speedup, min_speedup)
     note = (f", less {overhead:.3f} s of start-up measured on the reference rendering one pixel"
             if overhead else "")
-    return CheckResult(name, speedup >= min_speedup,
+    where = ", both on one CPU" if one_core else ""
+    return CheckResult(name, credit > 0,
                        f"{speedup:.2f}x ({min(base):.3f} s -> {min(fast):.3f} s wall clock "
-                       f"measured by the grader{note}, best of {repeat})")
+                       f"measured by the grader{note}{where}, best of {repeat})"
+                       + credit_note(credit, min_speedup), credit=credit)
 
 
 def launch_overhead(reference, launcher, rounds: int = 3) -> float:
@@ -337,10 +447,13 @@ def launch_overhead(reference, launcher, rounds: int = 3) -> float:
 # gives 1.9-2.0) a missed bar may be the machine's fault: under bursts of other load the
 # reference measured 0.95x with 1.79x capacity measured in the same rounds, and ~1x under a
 # steady load of 9 on two cores. Such a result is measured again and, failing that, marked
-# for regrade. On a quiet machine a speedup below VISIBLY_PARALLEL is a serial program (a
-# serial renderer measures 0.95-1.05x against the serial reference) and fails at once.
-VISIBLY_PARALLEL = 1.1
+# for regrade, with only the points measured in the score. Whether the program runs in
+# parallel at all is told apart from the load by its CPU time over its wall time: where the
+# machine gave at least SERIAL_TELLABLE cores' worth, a parallel program uses more than
+# SERIAL_CORES of them (CFS shares the CPUs by thread), a serial one cannot.
 BUSY = 1.9
+SERIAL_TELLABLE = 1.25
+QUOTA_TOO_SMALL = 1.5  # cores' worth of CPU (count or cgroup quota) below which nothing is timed
 
 
 @image_checked("parallel speedup")
@@ -350,55 +463,111 @@ def check_parallel_speedup(binary, baseline, *, threads=None, launcher=(),
     """Speedup of a parallel lab over the serial baseline, in wall-clock time measured by the
     grader, against the machine's capacity measured alongside (grading.harness.
     measure_parallel). Every timed image must be the baseline's, bit for bit (what labs 03 and
-    04 promise). A machine too busy to measure is retried; if it stays too busy the test is
-    marked for regrade (points provisional), never failed: that is not the student's doing."""
-    from grading.harness import measure_parallel
+    04 promise). It fails closed:
+    - a program whose timed runs never used more than SERIAL_CORES cores' worth of CPU time
+      (the grader's own measurement of the sandboxed tree) nor more than SERIAL_CORES times
+      the serial reference's share in the same rounds, on a machine giving at least
+      SERIAL_TELLABLE, is serial: no points, not a regrade, whatever its speedup looked like;
+    - points follow speed_credit of the speedup against the bar; where the machine stays too
+      busy to reach a verdict, the test is marked for regrade and only the points measured
+      count: the rest is shown apart, never in the score."""
+    import threading
+    from grading.harness import cpu_capacity, measure_parallel
+    capacity_here = cpu_capacity()
+    if capacity_here < QUOTA_TOO_SMALL:
+        # Nothing to time: no program can show a speedup here. Correctness is graded (the
+        # checks gated on this one open), the speed is left to a regrade on a course machine.
+        return CheckResult("parallel speedup", True,
+                           f"not timed: this machine gives {capacity_here:g} cores' worth of CPU "
+                           f"time (CPU count, cgroup cpu.max), too few to show a parallel "
+                           f"speedup; correctness graded, speed marked for regrade on a machine "
+                           f"with 2 or more", regrade=True, credit=0.0, provisional=1.0)
     settings = timed_settings(spp)
     want: list[bytes] = []
     wrong: list[str] = []
+    used: list[float] = []       # cores' worth of CPU time of each of your timed runs
+    base_used: list[float] = []  # the same of the serial reference run alone, same rounds
     overhead = launch_overhead(overhead_reference, launcher) if overhead_reference else 0.0
 
     def base() -> float:
         run = run_lab(baseline, **settings)
         if not want:
             want.append(run.image.tobytes())
+        if threading.current_thread() is threading.main_thread():  # alone, not the capacity's
+            base_used.append(cores_used(run))
         return run.wall_seconds
 
     def yours() -> float:
         run = run_lab(binary, threads=threads, launcher=launcher, **settings)
         if want and run.image.tobytes() != want[0] and not wrong:
             wrong.append("the timed render differs from the serial reference's image")
+        used.append(cores_used(run))
         return max(run.wall_seconds - overhead, 1e-3)
 
-    best = None  # the measurable attempt closest to the bar
+    def copies(n: int) -> float:
+        """n copies of the baseline at once as one process tree (one session, as a parallel
+        program is: measure_parallel says why)."""
+        run = run_lab(baseline, launcher=together_launcher(n), check=False, **settings)
+        return run.wall_seconds
+
+    def share() -> float:
+        """Cores your runs used over the cores the serial reference used in the same rounds
+        (the median over rounds): ~1 for a serial program whatever the load, NaN unknown."""
+        ratios = sorted(y / b for y, b in zip(used, base_used) if b > 0)
+        return ratios[len(ratios) // 2] if ratios else float("nan")
+
+    def parallel() -> bool:
+        """Shown to run on more than one core: a run used more than SERIAL_CORES cores' worth
+        of CPU time (one thread cannot use more than one core, whatever the load), or the runs
+        got more than SERIAL_CORES times the serial reference's share of a busy machine."""
+        return max(used, default=0.0) > SERIAL_CORES or share() > SERIAL_CORES
+
+    note = f" (launch overhead {overhead:.3f} s subtracted)" if overhead else ""
+    best = None  # (credit, timing) of the attempt closest to the bar
+    capacity = 0.0
     for attempt in range(1, attempts + 1):
-        timing = measure_parallel(base, {"yours": yours})
+        timing = measure_parallel(base, {"yours": yours}, together=copies)
+        capacity = max(capacity, timing.capacity)
         if wrong:
             return CheckResult("parallel speedup", False,
-                               f"{wrong[0]}: speed is graded only for a correct image")
+                               f"{wrong[0]}: speed is graded only for a correct image", credit=0.0)
+        if not parallel() and capacity >= SERIAL_TELLABLE:
+            return CheckResult("parallel speedup", False,
+                               f"serial: the timed runs used at most {max(used):.2f} cores' "
+                               f"worth of CPU time, {share():.2f}x the serial reference's share "
+                               f"(measured by the grader), on a machine giving {capacity:.2f} "
+                               f"cores' worth; a parallel program uses more than "
+                               f"{SERIAL_CORES:g} ({timing.describe('yours')}{note})", credit=0.0)
         if timing.capacity >= 1.5:
-            margin = timing.speedup("yours") / timing.required(fraction)
-            if best is None or margin > best[0]:
-                best = (margin, timing)
-            if margin >= 1:
-                break
-            if timing.speedup("yours") < VISIBLY_PARALLEL and timing.capacity >= BUSY:
-                break  # serial on a quiet machine: measuring again would not change that
+            credit = speed_credit(timing.speedup("yours"), timing.required(fraction))
+            if best is None or credit > best[0]:
+                best = (credit, timing)
+            if credit >= 1 or timing.capacity >= BUSY:
+                break  # reached the bar, or measured on a machine quiet enough to judge
         if attempt < attempts:
             time.sleep(2.0 * attempt)  # let the other load pass
-    note = f" (launch overhead {overhead:.3f} s subtracted)" if overhead else ""
     if best is None:
-        return CheckResult("parallel speedup", True,
-                           f"not measurable: the machine gave only {timing.capacity:.2f} cores' "
-                           f"worth of throughput in {attempts} attempts; points provisional, "
-                           f"marked for regrade", regrade=True)
-    margin, timing = best
-    if margin < 1 and timing.capacity < BUSY:
-        return CheckResult("parallel speedup", True,
-                           f"not measurable: short of the bar on a machine too busy to judge "
-                           f"({timing.describe('yours')}{note}); points provisional, "
-                           f"marked for regrade", regrade=True)
-    return CheckResult("parallel speedup", margin >= 1, timing.describe("yours") + note)
+        return CheckResult("parallel speedup", parallel(),
+                           f"not measurable: the machine gave only {capacity:.2f} cores' worth "
+                           f"of throughput in {attempts} attempts (the timed runs used "
+                           f"{share():.2f}x the serial reference's CPU share); no points now, "
+                           f"marked for regrade",
+                           regrade=True, credit=0.0, provisional=1.0)
+    credit, timing = best
+    bar = timing.required(fraction)
+    detail = timing.describe("yours") + note + credit_note(credit, bar)
+    if credit < 1 and timing.capacity < BUSY:
+        return CheckResult("parallel speedup", credit > 0 or parallel(),
+                           f"short of the bar on a machine too busy to judge ({detail}); "
+                           f"marked for regrade", regrade=True, credit=credit,
+                           provisional=1.0 - credit)
+    return CheckResult("parallel speedup", credit > 0, detail, credit=credit)
+
+
+def together_launcher(n: int) -> list[str]:
+    """A launcher running its command n times at once and waiting for all of them."""
+    return ["/bin/sh", "-c", f'i=0; while [ $i -lt {n} ]; do "$@" & i=$((i + 1)); done; wait',
+            "copies"]
 
 
 @image_checked("bit-identical to lab 01")
@@ -407,7 +576,7 @@ def check_bitwise_equal(binary, baseline, *, runs=None) -> CheckResult:
     rank counts): what a counter-based RNG and a race-free parallel loop guarantee. `runs`
     maps a label to run_lab keyword arguments; default: 1, 2, 3 and 7 threads."""
     runs = runs or {f"{t} threads": {"threads": t} for t in (1, 2, 3, 7)}
-    settings = dict(width=48, height=40, spp=8, seed=3)
+    settings = dict(width=48, height=40, spp=8, seed=draws.seed("bitwise"))
     want = run_lab(baseline, **settings).image.tobytes()
     differing = [label for label, how in runs.items()
                  if run_lab(binary, **settings, **how).image.tobytes() != want]

@@ -82,6 +82,32 @@ Assumptions, and what happens when they are violated
    paths never seen in the K samples) turns a block deterministic; a render that does see
    such a path there fails with z = inf -- golden references need enough samples.
 
+Noise and structure: the per-pixel test
+---------------------------------------
+Block means see only averages: an image rendered with a quarter of the paths, or one blurred,
+flattened into blocks or denoised, keeps the right block means.  So each pixel channel with
+s2 > 0 also gives q = d^2 / s2, which for a correct render is approximately chi-square with
+one degree of freedom (d/sqrt(s2) ~ N(0, 1) per pixel): its mean is 1 and its median
+0.455.  Too much noise (fewer paths: q grows by the ratio of the path counts) raises the
+mean; too little (an image smoothed across pixels) lowers the median, which, unlike the
+mean, a few wrong pixels cannot hold up.  The mean is of min(q, ``CHI_CAP``): a pixel
+whose rare paths the golden data never saw has an underestimated variance and a huge q,
+which alone must not decide (chi-square(1) exceeds 16 with probability 6e-5, so the cap
+costs a correct render nothing; four times too noisy still averages ~3.7).  The test fails
+when that mean exceeds ``CHI_MEAN_MAX`` or the median falls below ``CHI_MEDIAN_MIN``.  Measured on lab 01's
+reference at 64 spp against the stored golden data (6 seeds each): mean 1.00-1.07 (cornell)
+and 0.95-1.10 (showcase), median 0.45-0.49; at 16 spp mean 4.0-4.2; blurred over 3x3 pixels
+median 0.10-0.18; flattened into 8x8 blocks mean 36-149 (uncapped).  On the hidden scene
+(grading/hidden.py, with its glass and mirror balls; 40 secrets): capped mean 1.01-1.16,
+median 0.33-0.51; blurred, capped mean 2.7-6.7.  Glass makes a pixel's mean of 64 paths
+skewed, which lowers the median of a correct render: hence the lower bound's margin.  For chi-square(1) values the
+standard error of the mean over P values is sqrt(2/P) and of the median ~0.5/(0.47 sqrt(P)),
+i.e. 0.02 and 0.01 for a 64x64 image and 0.03 and 0.02 for 32x32: both bounds are more than
+10 standard errors from 1 and 0.455, and a variance estimated from K renders moves the mean
+only by (K-1)/(K-3) (1.07 for K = 32).  Images with fewer than ``CHI_MIN_VALUES`` pixel
+channels of non-zero variance skip this test.  Every statistic is computed in float64 and
+compared as ``not (value <= bound)``, so a NaN fails.
+
 Power: a bias delta per pixel over a block of P pixels is found once
 delta > c * sqrt(mean s2 / P); the global test finds delta > c * sqrt(mean s2 / (H W)).
 """
@@ -118,6 +144,11 @@ __all__ = [
 ]
 
 CHANNEL_NAMES = ("R", "G", "B")
+# The per-pixel test (module docstring): a correct render gives a mean d^2/s2 of about 1 and
+# a median of about 0.455.
+CHI_MEAN_MAX = 1.5
+CHI_MEDIAN_MIN = 0.25
+CHI_MIN_VALUES = 256
 MAX_LISTED_FAILURES = 20
 
 
@@ -286,6 +317,22 @@ class Report:
     first_nonfinite: tuple | None = None          # (x, y) of the first NaN/Inf pixel
     heatmap_path: str | None = None
     z_maps: dict = field(default_factory=dict, repr=False)  # block size -> (by, bx, C) z
+    chi_mean: float | None = None    # mean of d^2/s2 over pixel channels with s2 > 0
+    chi_median: float | None = None  # its median (None: too few values, test skipped)
+
+    def noise_problem(self) -> str | None:
+        """Why the per-pixel noise is not a correct render's, or None."""
+        if self.chi_mean is None:
+            return None
+        if not (self.chi_median >= CHI_MEDIAN_MIN):
+            return (f"too smooth: the median per-pixel d^2/sigma^2 is {self.chi_median:.3f} "
+                    f"(a render gives ~0.455, allowed >= {CHI_MEDIAN_MIN:g}): an image blurred, "
+                    f"flattened or denoised, not a render at the asked paths")
+        if not (self.chi_mean <= CHI_MEAN_MAX):
+            return (f"too noisy: per-pixel d^2/sigma^2 averages {self.chi_mean:.2f} (a render "
+                    f"with the asked paths gives ~1, allowed <= {CHI_MEAN_MAX:g}): fewer paths "
+                    f"than asked, or pixels wrong in ways block means hide")
+        return None
 
     def summary(self) -> str:
         """One line: verdict, worst test, and the headline numbers."""
@@ -305,6 +352,12 @@ class Report:
                 f" z={_fmt_z(worst.z)}{rel_s};")
         parts.append(f"RMSE {self.rmse:.4g}, relMSE {self.relmse:.4g},"
                      f" bias {self.bias:+.3g} +- {self.bias_se:.2g}")
+        noise = self.noise_problem()
+        if noise:
+            parts.append(f"; {noise}")
+        elif self.chi_mean is not None:
+            parts.append(f"; per-pixel d^2/sigma^2 mean {self.chi_mean:.2f}, median "
+                         f"{self.chi_median:.3f}")
         return " ".join(parts)
 
     def table(self) -> str:
@@ -327,6 +380,10 @@ class Report:
         if self.mean_golden > 0:
             bias_line += f" = {self.bias / self.mean_golden * 100:+.2f}% of the mean golden value"
         L.append(bias_line)
+        if self.chi_mean is not None:
+            L.append(f"  per-pixel d^2/sigma^2: mean {self.chi_mean:.3f} (allowed <= {CHI_MEAN_MAX:g}),"
+                     f" median {self.chi_median:.3f} (allowed >= {CHI_MEDIAN_MIN:g})"
+                     + ("" if self.noise_problem() is None else "   <- FAIL"))
         gz = "  ".join(f"{CHANNEL_NAMES[c] if c < 3 else c} {_fmt_z(z)}" for c, z in enumerate(self.global_z))
         L.append(f"  global mean z: {gz}")
         if self.worst_block is not None:
@@ -497,13 +554,15 @@ def _statistics(image, test_spp, golden, variance, golden_spp, alpha, block_size
 
 def compare(image, test_spp, golden, variance, golden_spp, alpha: float = 1e-4,
             block_sizes: Sequence[int] = (8, 16), heatmap_path: str | os.PathLike | None = None,
-            zero_var_rtol: float = 1e-6) -> Report:
+            zero_var_rtol: float = 1e-6, per_pixel: bool = True) -> Report:
     """Compares a render (`test_spp` paths per pixel) with the golden mean (`golden_spp`
     paths per pixel) given the per-path variance image.  Images are (H, W, 3) arrays, top
     row first.  The comparison passes when every z test stays within the Bonferroni limit
     and the render has no NaN/Inf; the family-wise false-failure rate is then <= alpha (see
     the module docstring).  When it fails and `heatmap_path` is given, a PNG heatmap of the
-    per-block |z| (smallest block size) is written there.  Raises InputError (a ValueError)
+    per-block |z| (smallest block size) is written there.  `per_pixel=False` skips the
+    per-pixel noise test (for an image averaged from a larger stratified render, whose pixels
+    are smoother than `test_spp` independent paths give).  Raises InputError (a ValueError)
     for mismatched sizes or an invalid reference."""
     st = _statistics(image, test_spp, golden, variance, golden_spp, alpha, block_sizes,
                      zero_var_rtol)
@@ -563,6 +622,14 @@ def compare(image, test_spp, golden, variance, golden_spp, alpha: float = 1e-4,
                                       float(gold[:, :, c][finite[:, :, c]].sum() / npx)))
     candidates.sort(key=lambda f: (-abs(f.z), f.block_size, f.y0, f.x0, f.channel))
 
+    # The per-pixel test (module docstring), float64 throughout; NaN/Inf values are already
+    # a failure and are left out here.
+    usable = finite & (s2 > 0)
+    chi_mean = chi_median = None
+    if per_pixel and int(usable.sum()) >= CHI_MIN_VALUES:
+        q = (d[usable] ** 2) / s2[usable]
+        chi_mean, chi_median = float(np.mean(q)), float(np.median(q))
+
     passed = bool(not nonfinite_px.any() and not candidates)
     report = Report(
         passed=passed, rmse=rmse, relmse=relmse, bias=bias, bias_se=bias_se,
@@ -572,7 +639,9 @@ def compare(image, test_spp, golden, variance, golden_spp, alpha: float = 1e-4,
         block_sizes=tuple(st.z_maps), global_z=tuple(float(z) for z in st.global_z),
         mean_golden=mean_golden, n_failed=len(candidates),
         failures=candidates[:MAX_LISTED_FAILURES], first_nonfinite=first_nonfinite,
-        z_maps=st.z_maps)
+        z_maps=st.z_maps, chi_mean=chi_mean, chi_median=chi_median)
+    if report.noise_problem():
+        report.passed = passed = False
     if not passed and heatmap_path is not None and st.z_maps:
         b = min(st.z_maps)
         heatmap.write_heatmap(os.fspath(heatmap_path), st.z_maps[b], crit, b, h, w,

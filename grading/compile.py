@@ -1,61 +1,75 @@
-"""Compiling a submission's sources in the sandbox. The compiler reads what it is told to:
-a render.cpp with `#include "/path/to/labs/01-serial/solution/render.cpp"` would otherwise
-hand in the solution, and compile errors would print any file the grader can read. So the
-build runs under bubblewrap too, seeing of the repository only what building a lab variant
-needs: the Makefile and the labs' make fragments, common/ (the shared sources and headers),
-the lab folders' own top-level files and the built driver objects in build/, read-only; no
-solutions, no references, no golden data, no grader.
+"""Compiling a submission's sources in the sandbox, in the students' tree.
 
-The Makefile stays the one place that knows how a lab is built (`make variant`); the driver
-objects must be up to date beforehand (building lab01-ref, and lab04-ref for lab 04, does
-that), as the sandbox cannot write build/.
+The compiler reads what it is told to: a render.cpp with `#include "/path/to/labs/01-serial/
+solution/render.cpp"` would otherwise hand in the solution, and compile errors would print any
+file the grader can read. So the build runs in the sandbox too, seeing only a copy of the
+students' tree of its lab (grading/students_tree.py: the skeleton forms of the shared files the
+lab's students write, the drivers built from them, never a solution or the references' build/)
+with the submission's files in it; the tree is read-only there but for the submission's folder.
+
+The Makefile stays the one place that knows how a lab is built (`make variant`). Every folder
+the build used is removed; the binary is kept in a folder of its own until the grader exits.
 """
 from __future__ import annotations
 
+import atexit
 import pathlib
 import shutil
+import tempfile
 
-from grading import gpu
-from grading.harness import ROOT
+from grading import gpu, students_tree
 from grading.sandbox import Limits, Runner
 
 COMPILE_LIMITS = Limits(wall_seconds=300, cpu_seconds=600, output_bytes=1 << 20)
 
-
-# Solutions a lab's own build reads (its lab.mk puts them on the include path): lab 07 is
-# lab 06's reference wavefront with the student's pool, so its students are given lab 06's
-# queue and stage loop. Only that lab's builds see them.
-SHARED_SOLUTIONS = {"07-soa": ("labs/06-cuda-split/solution",)}
+_kept: list[pathlib.Path] = []
 
 
-def visible_tree(variant_lab: str = "") -> list[pathlib.Path]:
-    """The parts of the repository a variant build of `variant_lab` reads."""
-    paths = [ROOT / "Makefile", ROOT / "cuda.mk", ROOT / "grading" / "grading.mk",
-             ROOT / "common", ROOT / "build"]
-    for lab in sorted((ROOT / "labs").iterdir()):
-        paths += [f for f in sorted(lab.iterdir()) if f.is_file()]  # lab.mk, shared drivers
-    paths += [ROOT / folder for folder in SHARED_SOLUTIONS.get(variant_lab, ())]
-    return [p for p in paths if p.exists()]
+@atexit.register
+def _remove_kept() -> None:
+    for folder in _kept:
+        shutil.rmtree(folder, ignore_errors=True)
 
 
-def build_in_sandbox(variant_lab: str, src: pathlib.Path,
-                     target: str = "variant") -> tuple[pathlib.Path | None, str]:
-    """Build the sources in `src` as `variant_lab` (e.g. 01-serial) into src/lab with
-    `make target` (cuda-variant for a CUDA lab): (binary, "") or (None, the compiler's
-    output)."""
-    # nvcc is found by its absolute path: the sandbox's PATH holds only the system's folders,
-    # and the toolkit (under /usr/local) is visible but not on it.
-    nvcc = shutil.which("nvcc")
-    extra = [f"NVCC={nvcc}"] if target == "cuda-variant" and nvcc else []
-    if target == "cuda-variant" and (arch := gpu.cuda_arch_flags()):
-        extra.append(f"CUDA_ARCH={arch}")  # the GPU here only (gpu.cuda_arch_flags says why)
-    with Runner(trusted=False) as r:
-        for path in visible_tree(variant_lab):
-            r.bind(path)
-        r.bind(src, writable=True)
-        out = r.run(["make", "-s", "-C", str(ROOT), target, f"VARIANT_LAB={variant_lab}",
-                     f"VARIANT={src.resolve()}", *extra], COMPILE_LIMITS)
-    binary = src / "lab"
-    if out.failure is None and binary.is_file():
-        return binary, ""
-    return None, f"{out.failure}\n{out.stdout}{out.stderr}"
+def keep_binary(binary: pathlib.Path) -> pathlib.Path:
+    """A copy of `binary` in a folder removed when the grader exits."""
+    folder = pathlib.Path(tempfile.mkdtemp(prefix="graded-binary-"))
+    folder.chmod(0o755)
+    _kept.append(folder)
+    kept = folder / "lab"
+    shutil.copyfile(binary, kept)
+    kept.chmod(0o755)
+    return kept
+
+
+def build_in_sandbox(variant_lab: str, handin: pathlib.Path, target: str = "variant",
+                     trusted: bool = False) -> tuple[pathlib.Path | None, str, str]:
+    """Build the hand-in folder `handin` as `variant_lab` (e.g. 01-serial) with `make target`
+    (cuda-variant for a CUDA lab): (binary, "", note) or (None, why, note). `why` is one line
+    for a hand-in refused before compiling, else the compiler's output; `note` says which
+    expected files the skeleton's stubs stood in for."""
+    try:
+        files, missing = students_tree.collect(handin, variant_lab)
+    except students_tree.HandInError as e:
+        return None, f"refused: {e}", ""
+    note = (f"not handed in, the skeleton's copy used: {', '.join(missing)}" if missing else "")
+    work = students_tree.stage(variant_lab, files, missing, target)
+    try:
+        tree, src = work / "tree", work / "tree" / "submission"
+        # nvcc is found by its absolute path: the sandbox's PATH holds only the system's
+        # folders, and the toolkit (under /usr/local) is visible but not on it.
+        nvcc = shutil.which("nvcc")
+        extra = [f"NVCC={nvcc}"] if target == "cuda-variant" and nvcc else []
+        if target == "cuda-variant" and (arch := gpu.cuda_arch_flags()):
+            extra.append(f"CUDA_ARCH={arch}")  # the GPU here only (gpu.cuda_arch_flags says why)
+        with Runner(trusted=trusted) as r:
+            r.bind(tree)
+            r.bind(src, writable=True)
+            out = r.run(["make", "-s", "-C", str(tree), target, f"VARIANT_LAB={variant_lab}",
+                         f"VARIANT={src}", *extra], COMPILE_LIMITS)
+        binary = src / "lab"
+        if out.failure is None and binary.is_file() and not binary.is_symlink():
+            return keep_binary(binary), "", note
+        return None, f"{out.failure}\n{out.stdout}{out.stderr}", note
+    finally:
+        shutil.rmtree(work, ignore_errors=True)

@@ -22,11 +22,18 @@ from grading.grade import RUBRICS
 from grading.harness import ROOT
 
 SETUP = """#!/usr/bin/env bash
-# Gradescope runs this once, as root, when it builds the autograder image.
+# Gradescope runs this once, as root, when it builds the autograder image. The image is built
+# on one machine and run on others: the references are compiled for any x86-64-v2 CPU (the
+# same bits as a native build: -ffp-contract=off stays). Gradescope's containers refuse
+# namespaces (Docker's default seccomp profile), so the grader isolates submissions by user
+# there: the sandbox user is made here (grading/README.md).
 set -euo pipefail
 cd "$(dirname "$0")"
 bash tools/install_deps.sh
-make -s lab01-ref lab04-ref
+id -u prt-sandbox >/dev/null 2>&1 ||
+    useradd --system --no-create-home --home-dir /nonexistent --shell /usr/sbin/nologin prt-sandbox
+make -s lab01-ref lab04-ref \\
+    OPT="-O3 -march=x86-64-v2 -ffp-contract=off -fno-math-errno -fno-trapping-math"
 """
 
 RUN = """#!/usr/bin/env bash

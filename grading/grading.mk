@@ -21,3 +21,16 @@ release:
 	@test -f grading/release.py || \
 	    { echo "release: made from the course repository; this is a release" >&2; exit 2; }
 	@$(PYTHON) -m grading.release '$(LAB)' '$(OUT)'
+
+# The driver objects a variant of VARIANT_LAB links, and nothing else: the grader builds them
+# in a students' tree (grading/students_tree.py) before compiling a submission there.
+.PHONY: variant-driver cuda-variant-driver
+variant-driver: $(VARIANT_DRIVER_$(VARIANT_LAB))
+cuda-variant-driver: $(COMMON_OBJ)
+
+# make test-gradescope: the lab-01 Gradescope bundle built into a Docker image on a debootstrap
+# Debian base and graded in containers with Docker's default seccomp at 0.5 CPU and 768 MB
+# (grading/gradescope/test_gradescope.py). Needs Docker and debootstrap; not part of make test.
+.PHONY: test-gradescope
+test-gradescope:
+	$(PYTHON) grading/gradescope/test_gradescope.py

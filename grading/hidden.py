@@ -4,7 +4,7 @@ from a secret (a random one per grade unless the instructor fixes it to regrade)
 data rendered there and then by the trusted lab-01 reference, so there is nothing to copy.
 
 The scene is the Cornell box with its light moved and dimmed or brightened, its camera
-nudged and its colours changed, all drawn from the secret. Its golden data follow
+nudged, its colours changed and a glass and a mirror ball added, all drawn from the secret. Its golden data follow
 tools/make_golden.py (K renders with distinct seeds: their mean, and their spread times n as
 the variance of one path), only smaller, so that it takes about a second on two cores; with
 K = 32 estimated variances, grading/compare.py's false-failure bound grows by about 1.1x.
@@ -51,6 +51,17 @@ def hidden_scene(secret: str) -> dict:
     for m in s["materials"].values():
         if m.get("type") == "diffuse":
             m["albedo"] = [float(np.clip(a * rng.uniform(0.6, 1.4), 0.02, 0.9)) for a in m["albedo"]]
+    # A glass ball and a mirror ball at drawn places, sizes and (for glass) index: a renderer
+    # without glass or mirrors cannot pass here by printing the stored showcase image.
+    s["materials"]["clear"] = {"type": "glass", "ior": float(rng.uniform(1.3, 1.8))}
+    s["materials"]["polished"] = {"type": "mirror",
+                                  "albedo": [float(rng.uniform(0.6, 0.95))] * 3}
+    glass_r, mirror_r = float(rng.uniform(0.1, 0.16)), float(rng.uniform(0.08, 0.13))
+    s["spheres"] = s.get("spheres", []) + [
+        {"center": [float(rng.uniform(0.17, 0.3)), glass_r, float(rng.uniform(-0.7, -0.5))],
+         "radius": glass_r, "material": "clear"},
+        {"center": [float(rng.uniform(0.7, 0.85)), mirror_r, float(rng.uniform(-0.75, -0.6))],
+         "radius": mirror_r, "material": "polished"}]
     return s
 
 

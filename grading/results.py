@@ -28,7 +28,8 @@ class Test:
     seconds: float = 0.0
     finished: bool = False
     ok: bool = False       # the check passed (a 0-point gate passes without points)
-    regrade: bool = False  # the machine could not measure it: points provisional
+    regrade: bool = False  # the machine could not measure it: marked for regrade
+    provisional: int = 0   # points a regrade may add; never in `score` or the total
     # Gradescope's: "visible", or "after_published" for a hidden test, whose outcome the
     # top-level output states in one line meanwhile (Results.complete)
     visibility: str = "visible"
@@ -38,17 +39,23 @@ class Test:
         return self.finished and self.ok
 
     def finish(self, score: int, output: str, seconds: float = 0.0, regrade: bool = False,
-               ok: bool = False):
+               ok: bool = False, provisional: int = 0):
         """`ok`: the check ran and passed; a test not graded (refused, interrupted, gated) is
-        never ok, whatever its points."""
+        never ok, whatever its points. `provisional`: points a regrade may add (shown in the
+        output and extra_data, never in the score)."""
+        if provisional:
+            output = f"{output} (+{provisional} if the regrade confirms)"
         self.score, self.output, self.seconds = score, clip(output), seconds
         self.finished, self.regrade, self.ok = True, regrade, ok
+        self.provisional = provisional if regrade else 0
 
     def as_dict(self) -> dict:
         return {"name": self.label, "score": self.score, "max_score": self.max_score,
-                "status": "passed" if self.passed else "failed", "output": self.output,
+                "status": "passed" if self.passed and not self.regrade else "failed",
+                "output": self.output,
                 "execution_time": round(self.seconds, 3), "visibility": self.visibility,
-                "extra_data": {"check": self.id, "regrade": self.regrade}}
+                "extra_data": {"check": self.id, "regrade": self.regrade,
+                               "provisional": self.provisional}}
 
 
 def clip(text: str, limit: int = MAX_OUTPUT_CHARS) -> str:
@@ -62,6 +69,7 @@ class Results:
         self.notes: list[str] = []
         self.refused = False
         self.start = time.perf_counter()
+        self.sandbox = "none (--trusted)"  # which sandbox ran the submission (grading/sandbox.py)
 
     def add(self, test: Test) -> None:
         if not any(t.id == test.id for t in self.tests):
@@ -102,8 +110,11 @@ class Results:
                                   f"are shown once the grades are published)")
         regrade = [t.label for t in self.tests if t.regrade]
         if regrade:
-            self.notes.append("marked for regrade (the machine was too busy to measure; points "
-                              "provisional): " + ", ".join(regrade))
+            score = sum(t.score for t in self.tests)
+            most = sum(t.max_score for t in self.tests)
+            extra = sum(t.provisional for t in self.tests)
+            self.notes.append(f"{score}/{most}, +{extra} if the regrade confirms; marked for "
+                              f"regrade (the machine could not measure them): " + ", ".join(regrade))
         self.changed()
 
     def as_dict(self) -> dict:
@@ -111,6 +122,7 @@ class Results:
                 "max_score": sum(t.max_score for t in self.tests),
                 "execution_time": round(time.perf_counter() - self.start, 3),
                 "output": "\n".join(self.notes), "visibility": "visible",
+                "sandbox": self.sandbox,
                 "tests": [t.as_dict() for t in self.tests]}
 
     def changed(self) -> None:

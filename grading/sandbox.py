@@ -59,9 +59,11 @@ class Outcome:
     stdout: str                 # decoded leniently: a stray byte is U+FFFD, never an error
     stderr: str
     wall_seconds: float         # measured by the grader around the whole tree
-    cpu_seconds: float | None   # user + system time of the tree, when the grader can know
-                                # it: trusted runs only (bubblewrap's monitor does not reap
-                                # the sandbox, so its rusage holds nothing of it)
+    cpu_seconds: float | None   # user + system time of the whole tree: in trusted runs the
+                                # rusage of the reaped tree; in the sandbox (whose monitor does
+                                # not reap it, so its rusage holds nothing of it) sampled by the
+                                # grader from /proc every SAMPLE_SECONDS, so it misses at most
+                                # the last interval of each process (TreeClock)
     killed: str | None = None   # why the grader killed it, e.g. "timed out after 60 s"
     cut: tuple[str, ...] = ()   # streams cut at the output cap
 
@@ -104,29 +106,205 @@ def bwrap_path() -> str | None:
     return shutil.which("bwrap")
 
 
+# The two isolations (grading/README.md): bubblewrap's namespaces where they can be had, else
+# a dedicated unprivileged user (setpriv, prlimit, a seccomp filter: grading/confine.py), which
+# works where a container's seccomp profile refuses namespaces (Docker's default, Gradescope).
+BUBBLEWRAP, USER = "bubblewrap", "user"
+DESCRIPTIONS = {
+    BUBBLEWRAP: "bubblewrap (user, PID, network, IPC and mount namespaces)",
+    USER: "a dedicated user (setpriv, prlimit, seccomp filter{landlock}; no namespaces here)",
+}
+SANDBOX_USER = "prt-sandbox"   # made by setup.sh (or the grader, as root) for the user sandbox
+SYSTEM_PYTHON = "/usr/bin/python3"  # runs grading/confine.py: python3-seccomp is its module
+
 _probe_result: list[str | None] = []
+_isolation: list[str] = []
 
 
 def probe() -> str | None:
-    """None when the sandbox works here, else one line saying why not (checked once)."""
+    """None when a sandbox works here, else one line saying why neither can be had (checked
+    once). GRADING_SANDBOX=bubblewrap or =user asks for one of them only."""
     if not _probe_result:
         _probe_result.append(_probe())
     return _probe_result[0]
 
 
+def isolation() -> str:
+    """Which sandbox untrusted runs use (after a successful probe())."""
+    return _isolation[0] if _isolation else BUBBLEWRAP
+
+
+def description() -> str:
+    return DESCRIPTIONS[isolation()].format(
+        landlock=", Landlock" if landlock_available() else "; no Landlock on this kernel")
+
+
+def landlock_available() -> bool:
+    """Whether the kernel (and a container's seccomp profile) offers Landlock (x86-64)."""
+    import ctypes
+    import platform
+    if platform.machine() != "x86_64":
+        return False
+    libc = ctypes.CDLL(None, use_errno=True)
+    libc.syscall.restype = ctypes.c_long
+    return libc.syscall(444, None, ctypes.c_size_t(0), ctypes.c_uint32(1)) >= 1
+
+
 def _probe() -> str | None:
+    wanted = os.environ.get("GRADING_SANDBOX", "")
+    if not shutil.which("prlimit"):
+        return "prlimit (util-linux) is not installed: run `make deps`"
+    reasons = []
+    for kind, check in ((BUBBLEWRAP, _probe_bubblewrap), (USER, _probe_user)):
+        if wanted and wanted != kind:
+            continue
+        reason = check()
+        if reason is None:
+            _isolation[:] = [kind]
+            return None
+        reasons.append(reason)
+    return "; and ".join(reasons) or f"GRADING_SANDBOX={wanted} is neither bubblewrap nor user"
+
+
+def _seccomp_active() -> bool:
+    try:
+        status = pathlib.Path("/proc/self/status").read_text()
+    except OSError:
+        return False
+    return any(line.split() == ["Seccomp:", "2"] for line in status.splitlines())
+
+
+def _probe_bubblewrap() -> str | None:
     if not bwrap_path():
         return "bubblewrap (bwrap) is not installed: run `make deps`"
-    if not shutil.which("prlimit"):
-        return "prlimit (util-linux) is not installed"
+    _isolation[:] = [BUBBLEWRAP]
     try:
         with Runner(trusted=False) as r:
             out = r.run(["/bin/sh", "-c", "exit 0"], Limits(wall_seconds=20))
     except OSError as e:
         return f"bubblewrap cannot start: {e}"
+    finally:
+        _isolation.clear()
     if out.returncode != 0:
+        if _seccomp_active():
+            return ("namespaces are refused here by a seccomp filter (as in a Docker container "
+                    f"with its default profile), so bubblewrap cannot run "
+                    f"({out.stderr.strip()[:120]})")
         return f"bubblewrap cannot create its namespaces here: {out.stderr.strip()[:200]}"
     return None
+
+
+def sandbox_user() -> tuple[int, int] | None:
+    import pwd
+    try:
+        entry = pwd.getpwnam(SANDBOX_USER)
+    except KeyError:
+        return None
+    return entry.pw_uid, entry.pw_gid
+
+
+def _probe_user() -> str | None:
+    if os.geteuid() != 0:
+        return "the user sandbox needs the grader to run as root (to switch to its user)"
+    for tool in ("setpriv", "prlimit"):
+        if not shutil.which(tool):
+            return f"{tool} (util-linux) is not installed: run `make deps`"
+    if not os.path.exists(SYSTEM_PYTHON):
+        return f"{SYSTEM_PYTHON} is missing (the user sandbox's seccomp filter runs on it)"
+    check = subprocess.run([SYSTEM_PYTHON, "-I", "-c", "import seccomp"], capture_output=True)
+    if check.returncode != 0:
+        return "python3-seccomp is not installed: run `make deps`"
+    if sandbox_user() is None:
+        subprocess.run(["useradd", "--system", "--no-create-home", "--home-dir", "/nonexistent",
+                        "--shell", "/usr/sbin/nologin", SANDBOX_USER], capture_output=True)
+        if sandbox_user() is None:
+            return (f"there is no sandbox user '{SANDBOX_USER}' and it cannot be made "
+                    f"(useradd failed; setup.sh makes it)")
+    _isolation[:] = [USER]
+    try:
+        with Runner(trusted=False) as r:
+            out = r.run(["/bin/sh", "-c", "exit 0"], Limits(wall_seconds=20))
+    except OSError as e:
+        return f"the user sandbox cannot start: {e}"
+    finally:
+        _isolation.clear()
+    if out.returncode != 0:
+        return f"the user sandbox cannot start: {(out.stderr.strip() or out.failure)[:200]}"
+    return None
+
+
+def unreachable(folder: pathlib.Path, uid: int, gid: int) -> pathlib.Path | None:
+    """The first folder on the way to `folder` that user uid/gid cannot pass (no x), or None."""
+    path = pathlib.Path(folder).resolve()
+    for part in [*reversed(path.parents), path]:
+        st = os.stat(part)
+        bits = (stat.S_IXUSR if st.st_uid == uid else stat.S_IXGRP if st.st_gid == gid
+                else stat.S_IXOTH)
+        if not st.st_mode & bits:
+            return part
+    return None
+
+
+def hide_from_sandbox(folder: pathlib.Path) -> None:
+    """In the user sandbox, nothing shows the grader's files but their permissions: a
+    repository the sandbox user can reach is closed (mode 700) when the grader owns it."""
+    ids = sandbox_user()
+    if isolation() != USER or ids is None or unreachable(folder, *ids):
+        return
+    st = os.stat(folder)
+    if st.st_uid == os.geteuid():
+        os.chmod(folder, stat.S_IMODE(st.st_mode) & 0o700)
+
+
+def _confine_script() -> str:
+    """grading/confine.py copied where the sandbox user can read it (the repository is closed
+    to it), once per grader process."""
+    if not _confine_copy:
+        folder = pathlib.Path(tempfile.mkdtemp(prefix="grading-confine-"))
+        folder.chmod(0o755)
+        target = folder / "confine.py"
+        shutil.copyfile(pathlib.Path(__file__).with_name("confine.py"), target)
+        target.chmod(0o444)
+        import atexit
+        atexit.register(shutil.rmtree, folder, True)
+        _confine_copy.append(str(target))
+    return _confine_copy[0]
+
+
+_confine_copy: list[str] = []
+
+
+def kill_user_processes(uid: int) -> None:
+    """SIGKILL every process of the sandbox user until none is left (a fork bomb included:
+    each pass kills what the last one missed)."""
+    for _ in range(50):
+        alive = user_processes(uid)
+        for pid in alive:
+            try:
+                os.kill(pid, signal.SIGKILL)
+            except OSError:
+                pass
+        if not alive:
+            return
+        time.sleep(0.01)
+
+
+def user_processes(uid: int) -> list[int]:
+    """Live processes (not zombies: those are dead, waiting for a parent to reap them) of
+    `uid`."""
+    found = []
+    for entry in os.scandir("/proc"):
+        if entry.name.isdigit():
+            try:
+                if entry.stat().st_uid != uid:
+                    continue
+                with open(f"/proc/{entry.name}/stat", "rb") as f:
+                    line = f.read()
+            except OSError:
+                continue
+            if line[line.rfind(b")") + 2:][:1] not in (b"Z", b"X"):
+                found.append(int(entry.name))
+    return found
 
 
 def system_mounts() -> list[str]:
@@ -171,12 +349,15 @@ class Runner:
     def __init__(self, trusted: bool, gpu: bool = False):
         self.trusted = trusted
         self.gpu = gpu  # a GPU lab's runs: the sandbox shows the GPU (grading/gpu.py)
+        self.user_mode = not trusted and isolation() == USER
         self.root = pathlib.Path(tempfile.mkdtemp(prefix="grading-"))
         os.chmod(self.root, 0o755)  # the unprivileged sandbox user must reach staged inputs
         self.inputs: dict[str, pathlib.Path] = {}
         self.binds: list[tuple[str, bool]] = []  # (path, writable), mounted at the same path
         self._scratch: pathlib.Path | None = None
-        self.drop_to_nobody = not trusted and os.geteuid() == 0
+        self.drop_to_nobody = not trusted and not self.user_mode and os.geteuid() == 0
+        # whom the submission's files belong to: the sandbox user, or nobody under bubblewrap
+        self.owner = (sandbox_user() or (NOBODY, NOBODY)) if self.user_mode else (NOBODY, NOBODY)
 
     def __enter__(self):
         return self
@@ -192,11 +373,15 @@ class Runner:
         path = pathlib.Path(path).resolve()
         if self.trusted:
             return str(path)
-        name = f"{len(self.inputs)}-{path.name}"
+        # A neutral name: a submission must not tell which check runs it from a file's name.
+        name = f"{len(self.inputs)}{path.suffix if path.suffix in ('.json', '.pfm') else ''}"
         staged = self.root / "inputs" / name
         staged.parent.mkdir(mode=0o755, exist_ok=True)
         shutil.copyfile(path, staged)
         os.chmod(staged, 0o555 if os.access(path, os.X_OK) else 0o444)
+        if self.user_mode:  # no mounts: the staged copy is read where it lies
+            self.inputs[str(staged)] = staged
+            return str(staged)
         self.inputs[f"{JOB}/{name}"] = staged
         return f"{JOB}/{name}"
 
@@ -204,24 +389,24 @@ class Runner:
         """Show a file or folder at its own path, without copying (a build needs the tree's
         layout). Read-only unless `writable`; a writable one is handed to the sandbox user."""
         path = str(pathlib.Path(path).resolve())
-        if writable and self.drop_to_nobody:
+        if writable and (self.drop_to_nobody or self.user_mode):
             for dirpath, dirs, files in os.walk(path):
                 for name in [dirpath, *(os.path.join(dirpath, f) for f in dirs + files)]:
-                    os.lchown(name, NOBODY, NOBODY)
+                    os.lchown(name, *self.owner)
         self.binds.append((path, writable))
         return path
 
     def scratch(self, name: str = "") -> str:
         """A path in the run's scratch folder, as the command sees it."""
-        base = SCRATCH if not self.trusted else str(self._scratch_dir())
+        base = SCRATCH if not (self.trusted or self.user_mode) else str(self._scratch_dir())
         return f"{base}/{name}" if name else base
 
     def _scratch_dir(self) -> pathlib.Path:
         if self._scratch is None:
             self._scratch = self.root / "scratch"
             self._scratch.mkdir(mode=0o700)
-            if self.drop_to_nobody:
-                os.chown(self._scratch, NOBODY, NOBODY)
+            if self.drop_to_nobody or self.user_mode:
+                os.chown(self._scratch, *self.owner)
         return self._scratch
 
     def output(self, name: str, limit: int = 256 << 20) -> bytes | None:
@@ -250,6 +435,16 @@ class Runner:
         inner += ["--", *argv]
         if self.trusted:
             return inner
+        if self.user_mode:
+            uid, gid = self.owner
+            paths = ["--ro", str(pathlib.Path(_confine_script()).parent),
+                     "--ro", str(self.root / "inputs"), "--rw", str(self._scratch_dir())]
+            for path, writable in self.binds:
+                paths += ["--rw" if writable else "--ro", path]
+            return [shutil.which("setpriv") or "setpriv", f"--reuid={uid}", f"--regid={gid}",
+                    "--clear-groups", "--no-new-privs", "--inh-caps=-all", "--",
+                    *inner[:inner.index("--") + 1],
+                    SYSTEM_PYTHON, "-I", _confine_script(), *paths, "--", *argv]
         scratch = self._scratch_dir()
         cmd = [bwrap_path() or "bwrap", "--unshare-all", "--unshare-user",
                "--uid", str(NOBODY), "--gid", str(NOBODY), "--die-with-parent", "--new-session",
@@ -274,6 +469,11 @@ class Runner:
         env = dict(env or {})
         if self.trusted:  # as before the sandbox: the caller's environment and folder
             full_env, cwd = {**os.environ, **env}, None
+        elif self.user_mode:  # nothing of the grader's environment
+            scratch = str(self._scratch_dir())
+            full_env = {"PATH": "/usr/local/bin:/usr/bin:/bin", "HOME": scratch,
+                        "TMPDIR": scratch, "LANG": "C.UTF-8", **env}
+            cwd = scratch
         else:
             full_env, cwd = None, self.root
         cmd = self.command(argv, limits, env)
@@ -282,15 +482,59 @@ class Runner:
         p = subprocess.Popen(cmd, stdin=subprocess.DEVNULL, stdout=subprocess.PIPE,
                              stderr=subprocess.PIPE, env=full_env, cwd=cwd,
                              start_new_session=True, **user)
-        outcome = _supervise(p, start, limits)
-        if not self.trusted:
-            outcome.cpu_seconds = None
+        try:
+            outcome = _supervise(p, start, limits)
+        finally:
+            if self.user_mode:  # nothing of this run outlives it
+                kill_user_processes(self.owner[0])
         if outcome.killed is None and outcome.returncode == 0:
             used = _tree_size(self._scratch_dir())
             if used > limits.scratch_bytes:
                 outcome.killed = (f"left {used / 2**20:.0f} MiB in its scratch folder "
                                   f"(allowed {limits.scratch_bytes / 2**20:.0f} MiB)")
         return outcome
+
+
+SAMPLE_SECONDS = 0.05
+_CLOCK_TICKS = os.sysconf("SC_CLK_TCK")
+
+
+class TreeClock:
+    """CPU time of every process descended from one pid, read from /proc by the grader (the
+    processes cannot change what the kernel reports there): utime + stime of each process
+    (all its threads) plus cutime + cstime (its reaped children). A process that ends is
+    counted in its parent's cutime once reaped; `seconds` keeps the largest total seen."""
+
+    def __init__(self, pid: int):
+        self.pid = pid
+        self.seconds = 0.0
+
+    def sample(self) -> None:
+        parents: dict[int, int] = {}
+        times: dict[int, int] = {}
+        for entry in os.scandir("/proc"):
+            if not entry.name.isdigit():
+                continue
+            try:
+                with open(f"/proc/{entry.name}/stat", "rb") as f:
+                    stat_line = f.read()
+            except OSError:
+                continue
+            fields = stat_line[stat_line.rfind(b")") + 2:].split()
+            pid = int(entry.name)
+            parents[pid] = int(fields[1])
+            times[pid] = sum(int(v) for v in fields[11:15])  # utime stime cutime cstime
+        tree, frontier = {self.pid}, [self.pid]
+        children: dict[int, list[int]] = {}
+        for pid, ppid in parents.items():
+            children.setdefault(ppid, []).append(pid)
+        while frontier:
+            for child in children.get(frontier.pop(), []):
+                if child not in tree:
+                    tree.add(child)
+                    frontier.append(child)
+        total = sum(times.get(pid, 0) for pid in tree) / _CLOCK_TICKS
+        self.seconds = max(self.seconds, total)
 
 
 def _tree_size(folder: pathlib.Path) -> int:
@@ -321,6 +565,7 @@ def _supervise(p: subprocess.Popen, start: float, limits: Limits) -> Outcome:
     for fd in streams:
         os.set_blocking(fd, False)
     pidfd = os.pidfd_open(p.pid)
+    clock = TreeClock(p.pid)
     killed, cut, exited_at, status, usage = None, [], None, None, None
     try:
         open_fds = set(streams)
@@ -334,6 +579,9 @@ def _supervise(p: subprocess.Popen, start: float, limits: Limits) -> Outcome:
                 break
             # After the exit, give stragglers (trusted mode: children keep pipes open) 1 s.
             limit = max(timeout, 0.05) if exited_at is None else max(exited_at + 1 - time.perf_counter(), 0)
+            if exited_at is None:
+                clock.sample()
+                limit = min(limit, SAMPLE_SECONDS)
             ready, _, _ = select.select(wait_on, [], [], limit)
             if not ready and exited_at is not None:
                 _kill_tree(p)
@@ -369,7 +617,7 @@ def _supervise(p: subprocess.Popen, start: float, limits: Limits) -> Outcome:
         p.stderr.close()
     end = exited_at or time.perf_counter()
     p.returncode = os.waitstatus_to_exitcode(status) if status is not None else None
-    cpu = usage.ru_utime + usage.ru_stime if usage else 0.0
+    cpu = max(usage.ru_utime + usage.ru_stime if usage else 0.0, clock.seconds)
     (_, out), (_, err) = streams.values()
     return Outcome(p.returncode, decode(bytes(out)), decode(bytes(err)), end - start, cpu,
                    killed, tuple(cut))

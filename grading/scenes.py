@@ -79,40 +79,90 @@ def lit_plane_expected(scene: dict, width: int, height: int, subsamples: int = 8
     return per_pixel
 
 
-def glass_slab(ior: float, albedo: float, intensity: float) -> dict:
-    """A camera looking straight at a thick glass pane, a lit diffuse wall behind the camera.
+def glass_slab(ior: float, albedo: float, intensity: float, angle_deg: float = 0.0) -> dict:
+    """A camera looking at a thick glass pane at `angle_deg` from its normal, and a small lit
+    diffuse wall where the pane's reflection of the camera ray lands.
 
-    The pane sends the camera only what it reflects of the wall. With a narrow field of view
-    every ray meets the pane at normal incidence, reflectance R = ((n-1)/(n+1))^2, so with two
-    interactions (pane, wall) the pixel's expected radiance is R * L_wall; with four, light
-    that refracts in, reflects off the back face and refracts out adds R (1-R)^2 L_wall.
-    """
+    The pane is two quads 0.1 apart, each wound so that its front face points out of the
+    glass (the core's rule: a glass triangle's medium lies behind its front face, the side
+    (v1-v0) x (v2-v0) points to), so a ray inside the glass meets the back face from behind
+    and leaves with eta = ior. The camera sees only the pane (a 0.5 degree field of view);
+    the pane sends it what it reflects of the wall, with the Fresnel reflectance at that
+    angle, and, with four interactions, what refracts in, reflects off the back face and
+    refracts out (glass_slab_radiance). The wall is small so that light it scatters back to
+    the pane rarely returns to it (a term the closed form leaves out: below 0.2%)."""
     big = 50.0
-    def quad(z):
-        return [[-big, -big, z], [big, -big, z], [big, big, z], [-big, big, z]]
+    a = math.radians(angle_deg)
+    sin_a, cos_a = math.sin(a), math.cos(a)
+    p1 = _slab_points(ior, angle_deg)["front"]
+    wall_centre = [0.0, (p1[1] + _slab_points(ior, angle_deg)["back"][1]) / 2, 1.0]
+    def pane(z, front_towards_camera):
+        quad = [[-big, -big, z], [big, -big, z], [big, big, z], [-big, big, z]]
+        return quad if front_towards_camera else quad[::-1]
+    w = 0.6
+    cx, cy = wall_centre[0], wall_centre[1]
     return {
-        "camera": {"position": [0, 0, 0], "look_at": [0, 0, -1], "up": [0, 1, 0], "vfov": 0.5},
-        "light": {"position": [0, 0.3, 0.5], "intensity": [intensity] * 3},
+        "camera": {"position": [0, 0, 0], "look_at": [0, -sin_a, -cos_a], "up": [0, 1, 0],
+                   "vfov": 0.5},
+        "light": {"position": [0, cy + 0.9, 0.4], "intensity": [intensity] * 3},
         "materials": {"glass": {"type": "glass", "ior": ior},
                       "wall": {"type": "diffuse", "albedo": [albedo] * 3}},
-        "quads": [{"vertices": quad(-1.0), "material": "glass"},
-                  {"vertices": quad(-1.1), "material": "glass"},
-                  {"vertices": quad(1.0), "material": "wall"}],
+        "quads": [{"vertices": pane(-1.0, True), "material": "glass"},     # normal +z
+                  {"vertices": pane(-1.1, False), "material": "glass"},    # normal -z
+                  {"vertices": [[cx - w, cy - w, 1.0], [cx - w, cy + w, 1.0],
+                                [cx + w, cy + w, 1.0], [cx + w, cy - w, 1.0]],
+                   "material": "wall"}],
     }
 
 
-def glass_slab_radiance(scene: dict, bounces: int) -> float:
+def _slab_points(ior: float, angle_deg: float) -> dict:
+    """Where the central camera ray's reflected path (front) and its refracted, back-reflected
+    path (back) meet the wall plane z = 1."""
+    a = math.radians(angle_deg)
+    sin_a, cos_a = math.sin(a), math.cos(a)
+    tan_a = sin_a / cos_a
+    y1 = -tan_a                                   # the pane's front face, z = -1
+    sin_t = sin_a / ior
+    tan_t = sin_t / math.sqrt(1 - sin_t * sin_t)
+    y_out = y1 - 2 * 0.1 * tan_t                  # out through the front after the back face
+    return {"front": [0.0, y1 - 2 * tan_a, 1.0], "back": [0.0, y_out - 2 * tan_a, 1.0]}
+
+
+def fresnel(cos_i: float, eta: float) -> float:
+    """Unpolarised Fresnel reflectance, eta = n_incident / n_transmitted."""
+    sin2_t = eta * eta * (1 - cos_i * cos_i)
+    if sin2_t >= 1:
+        return 1.0
+    cos_t = math.sqrt(1 - sin2_t)
+    rs = (eta * cos_i - cos_t) / (eta * cos_i + cos_t)
+    rp = (cos_i - eta * cos_t) / (cos_i + eta * cos_t)
+    return 0.5 * (rs * rs + rp * rp)
+
+
+def glass_slab_radiance(scene: dict, bounces: int, angle_deg: float = 0.0) -> float:
+    """The pixels' expected radiance: R L(front) with two interactions (pane, wall), plus
+    T R T L(back) with four (in, back face, out, wall); R at the back face, seen from inside
+    at the refracted angle, equals R outside (Snell and Fresnel are reciprocal)."""
     ior = scene["materials"]["glass"]["ior"]
     albedo = scene["materials"]["wall"]["albedo"][0]
     intensity = scene["light"]["intensity"][0]
     light = scene["light"]["position"]
-    # The reflected ray meets the wall (z = 1) at the origin's mirror image: (0, 0, 1).
-    to_light = [light[0], light[1], light[2] - 1.0]
-    d2 = sum(c * c for c in to_light)
-    cos = abs(to_light[2]) / math.sqrt(d2)
-    wall = albedo / math.pi * intensity * cos / d2
-    r = ((ior - 1) / (ior + 1)) ** 2
-    return wall * (r + (r * (1 - r) ** 2 if bounces >= 4 else 0.0))
+
+    def wall(point):
+        to_light = [light[i] - point[i] for i in range(3)]
+        d2 = sum(c * c for c in to_light)
+        cos = abs(to_light[2]) / math.sqrt(d2)
+        return albedo / math.pi * intensity * cos / d2
+
+    points = _slab_points(ior, angle_deg)
+    cos_i = math.cos(math.radians(angle_deg))
+    r = fresnel(cos_i, 1.0 / ior)
+    sin_t = math.sin(math.radians(angle_deg)) / ior
+    r_inside = fresnel(math.sqrt(1 - sin_t * sin_t), ior)
+    value = r * wall(points["front"])
+    if bounces >= 4:
+        value += (1 - r) * r_inside * (1 - r_inside) * wall(points["back"])
+    return value
 
 
 def scaled(scene: dict, factor: float) -> dict:

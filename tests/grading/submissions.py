@@ -21,10 +21,12 @@ def script(folder: pathlib.Path, body: str, name: str = "lab") -> pathlib.Path:
     return path
 
 
-def carrying_reference(folder: pathlib.Path, body: str, name: str = "lab") -> pathlib.Path:
-    """A script whose payload is the lab-01 reference: `body` runs after `./ref` (the
-    unpacked reference) exists in the working folder, with the script's arguments in "$@"."""
-    payload = REFERENCE.read_bytes()
+def carrying_reference(folder: pathlib.Path, body: str, name: str = "lab",
+                       reference: pathlib.Path = REFERENCE) -> pathlib.Path:
+    """A script whose payload is the lab-01 reference (or `reference`): `body` runs after
+    `./ref` (the unpacked binary) exists in the working folder, with the script's arguments
+    in "$@"."""
+    payload = reference.read_bytes()
     head = (f"tail -c {len(payload)} \"$0\" > ./ref && chmod +x ./ref || exit 99\n"
             f"{body}\nexit $?\n")
     path = folder / name
@@ -50,8 +52,9 @@ printf '\\000\\000\\300\\177' | dd of="$pfm" bs=1 seek="$offset" conv=notrunc 2>
 
 def nan_pixel(folder, only_in_scaled_scenes=False) -> pathlib.Path:
     """The reference with one NaN pixel in its image (in every run, or only in the scaled scenes
-    of the scale-invariance check, whose files are named scaled-*.json)."""
-    condition = 'case "$scene" in *scaled-*) true;; *) false;; esac' if only_in_scaled_scenes \
+    of the scale-invariance check: the staged files have neutral names, so it looks for the
+    tiny or huge numbers of a scene scaled by 1e-4, 1e3 or 1e5)."""
+    condition = "grep -Eq '[0-9]e-|[0-9]{6,}[.]' \"$scene\"" if only_in_scaled_scenes \
         else "true"
     return carrying_reference(folder, f"""{FIND_ARGS}./ref "$@" || exit $?
 if {condition}; then
@@ -169,5 +172,62 @@ def altered_reference(folder: pathlib.Path, change: str,
     path = folder / "lab"
     path.write_text(ALTERED.format(python=sys.executable, root=str(ROOT),
                                    reference=str(reference), change=change))
+    path.chmod(0o755)
+    return path
+
+
+def fewer_samples(folder, divisor: int = 4) -> pathlib.Path:
+    """The reference asked for N paths per pixel renders N / divisor: cheaper, and its block
+    means are still right."""
+    return carrying_reference(folder, f"""prev=""
+for a in "$@"; do
+  shift
+  if [ "$prev" = "--spp" ]; then set -- "$@" $(( (a + {divisor - 1}) / {divisor} )); else set -- "$@" "$a"; fi
+  prev="$a"
+done
+./ref "$@" """)
+
+
+# Image changes for altered_reference: a 3x3 box blur, 8x8 blocks flattened to their mean
+# (where the image divides into them), and a few finite values at the float limit.
+BLUR = ("__import__('numpy').lib.stride_tricks.sliding_window_view("
+        "__import__('numpy').pad(image, ((1, 1), (1, 1), (0, 0)), mode='edge'), (3, 3), "
+        "axis=(0, 1)).mean(axis=(-1, -2)).astype('float32')")
+FLATTEN = ("(image.reshape(image.shape[0] // 8, 8, image.shape[1] // 8, 8, 3).mean(axis=(1, 3))"
+           ".repeat(8, 0).repeat(8, 1).astype('float32') if image.shape[0] % 8 == 0 == "
+           "image.shape[1] % 8 else image)")
+FLOAT_LIMIT = "__import__('numpy').where(image == image.max(), 3.3e38, image).astype('float32')"
+
+
+def threads_on_every_cpu(folder, parallel_reference: pathlib.Path) -> pathlib.Path:
+    """Lab 03's scalar OpenMP reference handed in for lab 02, widening its CPU affinity to
+    every CPU of the machine before it starts (undoing a confinement to one)."""
+    import os
+    cpus = ",".join(str(c) for c in sorted(os.sched_getaffinity(0)))
+    return carrying_reference(folder, f'exec taskset -c {cpus} ./ref "$@"',
+                              reference=parallel_reference)
+
+
+# Prints, for every render, the published closed-form answer of the analytic scenes as they
+# were before their parameters came from the grading secret (sphere interior: albedo 0.6,
+# radius 2, intensity 3, the bounces asked), at the size asked: no renderer at all.
+PUBLISHED_ANSWER = """#!{python}
+import sys
+sys.path.insert(0, {root!r})
+import numpy as np
+from grading import scenes
+from grading.pfm import write_pfm
+args = sys.argv[1:]
+value = lambda flag, default: int(args[args.index(flag) + 1]) if flag in args else default
+w, h, b = value("--width", 8), value("--height", 8), value("--bounces", 4)
+radiance = scenes.sphere_interior_radiance(0.6, 2.0, 3.0, b)
+write_pfm(args[args.index("--pfm") + 1], np.full((h, w, 3), radiance, dtype=np.float32))
+print('{{"lab": "answers", "seconds": 0.001}}')
+"""
+
+
+def published_answers(folder: pathlib.Path) -> pathlib.Path:
+    path = folder / "lab"
+    path.write_text(PUBLISHED_ANSWER.format(python=sys.executable, root=str(ROOT)))
     path.chmod(0o755)
     return path

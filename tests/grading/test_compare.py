@@ -434,3 +434,53 @@ def test_cli_exit_codes(tmp_path):
 
     p = run_cli(good, "--golden", tmp_path / "missing-dir", "--spp", 16)
     assert p.returncode == 2 and "not found" in p.stderr
+
+
+# ---------------------------------------------------------------------------------------
+# The per-pixel test: noise the block means cannot see
+
+
+def test_per_pixel_statistics_are_calibrated():
+    """A correct render: mean d^2/s2 near 1, median near chi-square(1)'s 0.455."""
+    rng = np.random.default_rng(21)
+    truth, var = scene(rng)
+    image, golden = golden_and_render(rng, truth, var, 64, 16384)
+    r = compare(image, 64, golden, var, 16384)
+    assert r.passed, r.table()
+    assert r.chi_mean == pytest.approx(1.0, abs=0.1)
+    assert r.chi_median == pytest.approx(0.455, abs=0.05)
+
+
+def test_a_quarter_of_the_paths_is_too_noisy():
+    """Rendered with 16 paths, claimed as 64: the block means of a smooth image still pass at
+    this size, the per-pixel test does not."""
+    rng = np.random.default_rng(22)
+    truth, var = scene(rng)
+    image, golden = golden_and_render(rng, truth, var, 16, 16384)
+    r = compare(image, 64, golden, var, 16384)
+    assert not r.passed and "too noisy" in r.summary(), r.summary()
+    assert r.chi_mean > 3
+
+
+def test_a_denoised_image_is_too_smooth():
+    """The truth plus a tenth of the noise (a denoiser's output): every block passes, the
+    median d^2/s2 is far too small."""
+    rng = np.random.default_rng(23)
+    truth, var = scene(rng)
+    golden = draw(rng, truth, var, 16384)
+    image = truth + 0.1 * rng.standard_normal(truth.shape) * np.sqrt(var / 64)
+    r = compare(image, 64, golden, var, 16384)
+    assert r.n_failed == 0 and not r.passed and "too smooth" in r.summary(), r.summary()
+
+
+def test_values_near_the_float_limit_do_not_pass():
+    """Finite float32 values near 3.4e38 would overflow a float32 sum into inf and a NaN
+    difference reads as no error through max(0, nan); the statistics are float64 and a NaN
+    fails."""
+    rng = np.random.default_rng(24)
+    truth, var = scene(rng)
+    image, golden = golden_and_render(rng, truth, var, 64, 16384)
+    image = image.astype(np.float32)
+    image[::2, ::2] = 3.3e38
+    r = compare(image, 64, golden, var, 16384)
+    assert not r.passed, r.summary()

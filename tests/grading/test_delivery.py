@@ -46,7 +46,9 @@ def test_batch_grades_each_student_into_csv_and_html(tmp_path):
 
 def test_gradescope_bundle_grades_a_submission(tmp_path, request):
     """The zip, unpacked where Gradescope unpacks it, grades lab 01's solution handed in as a
-    student's render.cpp: 100 points in /autograder/results/results.json."""
+    student's render.cpp and path_tracer.h: 100 points in /autograder/results/results.json.
+    The render.cpp alone is built against the skeleton's path_tracer.h (the students' tree),
+    as a student's own would be, and scores what the skeleton scores."""
     from grading.gradescope import bundle
     # Gradescope's /autograder is open to all; pytest's tmp_path is not (0700 above it), and
     # the sandboxed build runs as an unprivileged user that must read the unpacked tree.
@@ -70,8 +72,17 @@ def test_gradescope_bundle_grades_a_submission(tmp_path, request):
         shutil.copytree(src, dst) if src.is_dir() else shutil.copy2(src, dst)
     (root / "submission").mkdir()
     shutil.copy(ROOT / "labs" / "01-serial" / "solution" / "render.cpp", root / "submission")
-    p = subprocess.run(["bash", str(root / "source" / "run_autograder")], capture_output=True,
-                       text=True, timeout=900, env={**os.environ, "AUTOGRADER_ROOT": str(root)})
-    assert p.returncode == 0, p.stdout + p.stderr
-    results = json.loads((root / "results" / "results.json").read_text())
-    assert results["score"] == 100, p.stdout + json.dumps(results, indent=1)[:3000]
+
+    def run_autograder() -> dict:
+        p = subprocess.run(["bash", str(root / "source" / "run_autograder")],
+                           capture_output=True, text=True, timeout=900,
+                           env={**os.environ, "AUTOGRADER_ROOT": str(root)})
+        assert p.returncode == 0, p.stdout + p.stderr
+        return json.loads((root / "results" / "results.json").read_text())
+
+    alone = run_autograder()
+    assert alone["score"] <= 10, json.dumps(alone, indent=1)[:3000]
+    assert "not handed in, the skeleton's copy used: path_tracer.h" in alone["output"]
+    shutil.copy(ROOT / "common" / "core" / "path_tracer.h", root / "submission")
+    results = run_autograder()
+    assert results["score"] == 100, json.dumps(results, indent=1)[:3000]

@@ -249,6 +249,8 @@ def test_sandboxed_cuda_builds_target_the_gpu_here(monkeypatch, tmp_path):
                                    cpu_seconds=None)
 
     monkeypatch.setattr(grading_compile, "Runner", Recorder)
+    (tmp_path / "render.cu").write_text("// a hand-in\n")
+    (tmp_path / "render.cpp").write_text("// a hand-in\n")
     monkeypatch.setattr(gpu, "cuda_arch_flags", lambda: "-gencode arch=compute_90,code=sm_90")
     grading_compile.build_in_sandbox("05-cuda-mega", tmp_path, target="cuda-variant")
     assert "CUDA_ARCH=-gencode arch=compute_90,code=sm_90" in seen[-1], seen[-1]

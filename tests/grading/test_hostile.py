@@ -276,3 +276,230 @@ def test_no_sandbox_is_one_line_from_the_command_line(tmp_path):
     assert p.returncode == 2, p.stderr
     assert p.stderr.count("\n") == 1 and "bubblewrap (bwrap) is not installed" in p.stderr, p.stderr
     assert json.loads(out.read_text())["output"].startswith("refusing")
+
+
+# ---- hand-ins built in the students' tree (grading/students_tree.py) ----------------------
+
+def handin(folder: pathlib.Path, files: dict[str, str]) -> pathlib.Path:
+    for name, text in files.items():
+        (folder / name).parent.mkdir(parents=True, exist_ok=True)
+        (folder / name).write_text(text)
+    return folder
+
+
+def solution_text(lab_folder: str, name: str) -> str:
+    path = ROOT / "labs" / lab_folder / "solution" / name
+    return (path if path.exists() else ROOT / "common" / "core" / name).read_text()
+
+
+def grade_sources(lab: str, folder: pathlib.Path, tmp_path: pathlib.Path) -> dict:
+    from grading.grade import build_lab
+    binary, errors = build_lab(lab, folder, trusted=False)
+    assert binary is not None, errors
+    return grade(lab, binary, tmp_path)
+
+
+def test_a_missing_shared_file_is_the_skeletons_not_the_solution(tmp_path):
+    """Lab 01's render.cpp done, its path_tracer.h left out: in the course repository the
+    shared path_tracer.h is the solution; a student's tree has the skeleton's, and so does the
+    grader's build. At most what the skeleton earns."""
+    folder = handin(tmp_path / "in", {"render.cpp": solution_text("01-serial", "render.cpp")})
+    results = grade_sources("01", folder, tmp_path)
+    assert results["score"] <= 10, describe(results)
+
+
+def test_lab02_skeleton_without_its_header_scores_as_the_skeleton(tmp_path):
+    from grading.harness import cpu_has_avx2
+    from grading.students_tree import pristine_skeleton
+    if not cpu_has_avx2():
+        pytest.skip("this CPU has no AVX2/FMA: lab 02's Part B cannot run")
+    files = {n: t for n, t in pristine_skeleton("02-simd").items() if n.endswith(".cpp")}
+    results = grade_sources("02", handin(tmp_path / "in", files), tmp_path)
+    assert results["score"] <= 10, describe(results)
+
+
+@pytest.mark.parametrize("target", ["solution", "proc"])
+def test_a_link_is_refused_in_one_line(tmp_path, target):
+    """A link to the solution would hand it in; one into /proc would read the grader's
+    environment (and its secret) as root. Either is refused before anything is read."""
+    folder = handin(tmp_path / "in", {"render.cpp": solution_text("01-serial", "render.cpp")})
+    linked = (ROOT / "common" / "core" / "path_tracer.h" if target == "solution"
+              else pathlib.Path("/proc/self/environ"))
+    (folder / "path_tracer.h").symlink_to(linked)
+    out = tmp_path / "results.json"
+    p = subprocess.run([sys.executable, "-m", "grading.grade", "01", "--sources", str(folder),
+                        "--results", str(out)], cwd=ROOT, capture_output=True, text=True,
+                       timeout=300, env={**os.environ, "GRADING_SECRET": "leak-me-4711"})
+    results = json.loads(out.read_text())
+    assert p.returncode == 1 and results["score"] == 0, describe(results)
+    assert "path_tracer.h is a symbolic link" in results["output"], results["output"]
+    assert "\n" not in results["output"] and "leak-me-4711" not in out.read_text()
+
+
+def test_no_expected_file_is_one_line_naming_them(tmp_path):
+    folder = handin(tmp_path / "in", {"notes.txt": "I did it", "main.cpp": "int main(){}"})
+    from grading.grade import build_lab
+    binary, errors = build_lab("01", folder, trusted=False)
+    assert binary is None and "\n" not in errors, errors
+    assert "expected path_tracer.h, render.cpp" in errors, errors
+
+
+def test_a_nested_checkout_is_found_and_the_reference_scores_100(tmp_path):
+    """The files in a folder of a repository checkout (or a zipped folder): the folder with
+    the expected files is taken, not a stray copy higher up."""
+    folder = handin(tmp_path / "in", {
+        "lab01/labs/01-serial/skeleton/render.cpp": solution_text("01-serial", "render.cpp"),
+        "lab01/labs/01-serial/skeleton/path_tracer.h": solution_text("01-serial", "path_tracer.h"),
+        "lab01/common/core/vec3.h": (ROOT / "common" / "core" / "vec3.h").read_text()})
+    results = grade_sources("01", folder, tmp_path)
+    assert results["score"] == 100, describe(results)
+
+
+def test_the_sandbox_environment_is_empty(tmp_path, monkeypatch):
+    """Nothing of the grader's environment (its secret) reaches a submitted process."""
+    monkeypatch.setenv("GRADING_SECRET", "leak-me-4712")
+    binary = sub.script(tmp_path, "env\n")
+    with sandbox.Runner(trusted=False) as r:
+        out = r.run([r.input(binary)])
+    names = {line.split("=", 1)[0] for line in out.stdout.splitlines() if "=" in line}
+    assert "leak-me-4712" not in out.stdout, out.stdout
+    assert names <= {"PATH", "HOME", "TMPDIR", "LANG", "PWD", "SHLVL", "_", "OLDPWD"}, names
+
+
+def test_build_folders_are_removed(tmp_path):
+    """A graded hand-in leaves nothing behind in the temporary folder."""
+    folder = handin(tmp_path / "in", {"render.cpp": "int broken( {\n"})
+    tmp = tmp_path / "tmp"
+    tmp.mkdir()
+    subprocess.run([sys.executable, "-m", "grading.grade", "01", "--sources", str(folder),
+                    "--results", str(tmp_path / "r.json")], cwd=ROOT, capture_output=True,
+                   timeout=300, env={**os.environ, "TMPDIR": str(tmp)})
+    good = handin(tmp_path / "good", {"render.cpp": solution_text("01-serial", "render.cpp"),
+                                      "path_tracer.h": solution_text("01-serial", "path_tracer.h")})
+    subprocess.run([sys.executable, "-m", "grading.grade", "01", "--sources", str(good),
+                    "--results", str(tmp_path / "r2.json"), "--budget-seconds", "0"], cwd=ROOT,
+                   capture_output=True, timeout=300, env={**os.environ, "TMPDIR": str(tmp)})
+    assert not list(tmp.iterdir()), list(tmp.iterdir())
+
+
+# ---- images that block means alone would pass (grading/compare.py, the per-pixel test) ----
+
+def golden_points(results) -> int:
+    return sum(t["score"] for t in results["tests"] if t["extra_data"]["check"] in
+               ("hidden", "golden-cornell", "golden-showcase", "scale"))
+
+
+def test_a_quarter_of_the_samples_fails_the_images(tmp_path):
+    """The analytic scenes are nearly noise-free by design (they test the light transport's
+    values, not its noise), so a renderer of fewer paths keeps their 40 points and the
+    reproducibility's 10; every image check fails."""
+    results = grade("01", sub.fewer_samples(tmp_path), tmp_path)
+    assert not passed_by_check(results)["hidden"], describe(results)
+    assert golden_points(results) == 0 and results["score"] <= 50, describe(results)
+    assert "too noisy" in describe(results), describe(results)
+
+
+@pytest.mark.parametrize("change", [sub.BLUR, sub.FLATTEN], ids=["blurred", "flattened"])
+def test_blurred_or_flattened_images_fail(tmp_path, change):
+    """Trusted: the stand-in runs the repository's Python (grading is the same). Where an
+    image's structure also moved (edges blurred across), the per-pixel test says too noisy
+    rather than too smooth: either way it names the per-pixel test."""
+    results = grade("01", sub.altered_reference(tmp_path, change), tmp_path, trusted=True)
+    assert golden_points(results) == 0 and results["score"] <= 40, describe(results)
+    assert "too smooth" in describe(results) or "too noisy" in describe(results), \
+        describe(results)
+
+
+def test_too_smooth_is_named_on_the_golden_image():
+    """The golden Cornell box rendered by the reference and blurred over 3x3 pixels: its block
+    means pass, its per-pixel noise is too small."""
+    import numpy as np
+    from grading.compare import compare
+    from grading.harness import build, golden, run_lab
+    reference, = build("lab01-ref")
+    g = golden("cornell")
+    image = run_lab(reference, g.scene, width=g.meta["width"], height=g.meta["height"], spp=64,
+                    bounces=g.meta["bounces"], seed=7).image
+    assert compare(image, 64, g.mean, g.variance, g.meta["golden_spp"]).passed
+    padded = np.pad(image, ((1, 1), (1, 1), (0, 0)), mode="edge")
+    blurred = np.lib.stride_tricks.sliding_window_view(padded, (3, 3), axis=(0, 1)).mean(axis=(-1, -2))
+    report = compare(blurred, 64, g.mean, g.variance, g.meta["golden_spp"])
+    assert not report.passed and "too smooth" in report.summary(), report.summary()
+
+
+def test_values_at_the_float_limit_fail_every_image_check(tmp_path):
+    results = grade("01", sub.altered_reference(tmp_path, sub.FLOAT_LIMIT), tmp_path,
+                    trusted=True)
+    assert results["score"] <= 10, describe(results)
+    assert "radiance is never negative and no test scene gives more" in describe(results)
+
+
+# ---- speed that fails closed (grading/checks.py) -------------------------------------------
+
+def test_threads_in_the_simd_lab_earn_no_speed(tmp_path):
+    """Scalar code on every core, handed in for lab 02: the timed runs are confined to one
+    CPU and their CPU time is measured, so widening the affinity again earns nothing."""
+    from grading.harness import build
+    lab03_ref, = build("lab03-ref")
+    results = grade("02", sub.threads_on_every_cpu(tmp_path, lab03_ref), tmp_path)
+    speed = next(t for t in results["tests"] if t["extra_data"]["check"] == "speedup")
+    assert speed["score"] == 0, describe(results)
+    assert results["score"] <= 70, describe(results)
+
+
+@pytest.fixture
+def cpu_burner():
+    """A process burning one core, in a session of its own (as another user's job would)."""
+    p = subprocess.Popen(["/bin/sh", "-c", "while :; do :; done"], start_new_session=True)
+    yield p
+    p.kill()
+    p.wait()
+
+
+def test_serial_lab03_beside_a_cpu_burner_earns_nothing(tmp_path, cpu_burner):
+    """The unmodified lab 03 skeleton renders lab 01's bits on one core (lab01-ref stands in
+    for it): beside a process burning one core noise once made it look 1.1-1.4x faster than
+    the serial reference. Its CPU time over its wall time shows it serial; where the machine
+    is so busy that even that cannot be told, the test is marked for regrade with no points
+    in the score, the possible ones shown apart."""
+    results = grade("03", sub.REFERENCE, tmp_path)
+    speed = next(t for t in results["tests"] if t["extra_data"]["check"] == "parallel-speedup")
+    assert speed["score"] == 0 and results["score"] <= 10, describe(results)
+    if speed["extra_data"]["regrade"]:
+        assert "if the regrade confirms" in results["output"], results["output"]
+        assert results["score"] == sum(t["score"] for t in results["tests"])
+    else:
+        assert speed["output"].startswith("serial:"), describe(results)
+
+
+# ---- nothing precomputable (grading/draws.py) -----------------------------------------------
+
+def test_printing_the_published_analytic_answers_earns_nothing(tmp_path):
+    """The analytic scenes' parameters come from the grading secret: the answers printed for
+    the published ones are wrong (trusted: the stand-in runs the repository's Python)."""
+    results = grade("01", sub.published_answers(tmp_path), tmp_path, trusted=True)
+    assert results["score"] <= 10, describe(results)
+
+
+def test_the_secret_draws_the_timed_and_tested_renders():
+    from grading import checks, draws
+    with draws.secret("one"):
+        one = (checks.timed_settings(64)["seed"], checks.drawn_interior())
+    with draws.secret("two"):
+        two = (checks.timed_settings(64)["seed"], checks.drawn_interior())
+    assert one[0] != two[0] and one[1] != two[1]
+    with draws.secret("one"):
+        assert checks.timed_settings(64)["seed"] == one[0]  # a regrade draws the same
+
+
+def test_the_reference_objects_are_out_of_the_compilers_reach(tmp_path):
+    """A render.cpp embedding the reference's binary or objects (.incbin) to run them: the
+    students' tree has no references, the repository is out of the sandbox's view."""
+    from grading.grade import build_lab
+    for target in (ROOT / "lab01-ref", ROOT / "build" / "common" / "host" / "lab_main.o"):
+        folder = handin(tmp_path / target.name, {
+            "render.cpp": f'__asm__(".section .rodata\\n.incbin \\"{target}\\"\\n.text");\n'
+                          + solution_text("01-serial", "render.cpp"),
+            "path_tracer.h": solution_text("01-serial", "path_tracer.h")})
+        binary, errors = build_lab("01", folder, trusted=False)
+        assert binary is None and "file not found" in errors, errors

@@ -1,0 +1,233 @@
+"""The tree a submission is compiled in: exactly what a student of the lab holds, never more.
+
+In the course repository (and in the Gradescope bundle, which is that repository) the shared
+files students write, such as lab 01's common/core/path_tracer.h, are the solutions: a
+hand-in that leaves its copy out would be built against the solution, and the objects in
+build/ are the references'. So a submission is compiled in a students' tree made for its lab:
+
+- the Makefile, cuda.mk, grading/grading.mk, every lab's lab.mk and top-level files (the
+  drivers a lab links), and common/ with every shared file whose solution regions belong to
+  this lab or a later one in its skeleton form (what a student release holds:
+  grading/release.py), and the earlier-lab solutions a lab's own build reads (lab 07 reads
+  lab 06's);
+- in its own build/, the driver objects compiled from those files, by the grader, outside the
+  sandbox (course code), once per content: cached under build/students-trees/ and copied for
+  each grade into a fresh folder the sandbox user may read, wherever the repository lives;
+- the submission's files, read without following links (`collect`), above the pristine
+  skeleton: a file the lab expects that the hand-in lacks is the skeleton's stub, and a
+  hand-in holding none of the expected files is refused in one line that names them.
+"""
+from __future__ import annotations
+
+import hashlib
+import importlib.util
+import os
+import pathlib
+import shutil
+import stat
+import subprocess
+import tempfile
+
+from grading.harness import ROOT
+
+SOURCE_SUFFIXES = (".cpp", ".h", ".hpp", ".cu", ".cuh")
+MAX_FILE_BYTES = 1 << 20      # a source file of a lab is tens of KiB
+MAX_FILES = 64                # source files taken from the chosen folder
+MAX_WALK_ENTRIES = 20000      # entries looked at while searching a hand-in
+
+# Earlier labs' solutions a lab's own build reads (its lab.mk puts them on the include path):
+# lab 07 is lab 06's reference wavefront with the student's pool. A lab-07 release ships them.
+SHARED_SOLUTIONS = {"07-soa": ("labs/06-cuda-split/solution",)}
+
+
+class HandInError(Exception):
+    """A hand-in that cannot be built as it is: one line for the student."""
+
+
+def _skeletons():
+    spec = importlib.util.spec_from_file_location("skeletons", ROOT / "tools" / "skeletons.py")
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    return module
+
+
+def lab_number(lab_folder: str) -> str:
+    return lab_folder.split("-")[0]
+
+
+def skeleton_form(lab_folder: str) -> set[str]:
+    """Shared files (paths from the root) that a student of `lab_folder` holds as skeletons:
+    those of this lab and of every later one, as in a release (grading/release.py)."""
+    shared = _skeletons().SHARED_SOURCES
+    return {path for name, paths in shared.items() if name >= lab_folder for path in paths}
+
+
+def pristine_skeleton(lab_folder: str) -> dict[str, str]:
+    """The skeleton's top-level files as tools/skeletons.py makes them from the solutions
+    (not the checkout's skeleton/ folder, which an instructor may have edited)."""
+    base = ROOT / "labs" / lab_folder / "skeleton"
+    return {path.relative_to(base).as_posix(): text
+            for path, text in _skeletons().generated_files()
+            if path.is_relative_to(base) and "/" not in path.relative_to(base).as_posix()}
+
+
+def expected_files(lab_folder: str) -> list[str]:
+    return sorted(pristine_skeleton(lab_folder))
+
+
+# ---- reading a hand-in --------------------------------------------------------------------
+
+def read_regular(path: pathlib.Path, shown: str) -> bytes:
+    """A regular file's bytes, never through a link (O_NOFOLLOW on the file; its folders were
+    reached by a walk that does not follow links either)."""
+    try:
+        fd = os.open(path, os.O_RDONLY | os.O_NOFOLLOW | os.O_NONBLOCK | os.O_CLOEXEC)
+    except OSError as e:
+        if os.path.islink(path):
+            raise HandInError(f"{shown} is a symbolic link: hand in the file itself") from None
+        raise HandInError(f"{shown} cannot be read: {e.strerror}") from None
+    with os.fdopen(fd, "rb") as f:
+        if not stat.S_ISREG(os.fstat(fd).st_mode):
+            raise HandInError(f"{shown} is not a regular file")
+        data = f.read(MAX_FILE_BYTES + 1)
+    if len(data) > MAX_FILE_BYTES:
+        raise HandInError(f"{shown} is larger than {MAX_FILE_BYTES >> 10} KiB")
+    return data
+
+
+def _candidates(root: pathlib.Path) -> dict[pathlib.Path, list[str]]:
+    """Folder (relative) -> the names of source files and links in it, found by a walk that
+    follows no link. Build products, version control and hidden folders are skipped."""
+    found: dict[pathlib.Path, list[str]] = {}
+    seen = 0
+    for dirpath, dirs, files in os.walk(root, followlinks=False):
+        # A link to a folder is listed among dirs (and not entered): a source-named one is
+        # a link handed in as a file, refused when its folder is taken.
+        links = [d for d in dirs if os.path.islink(os.path.join(dirpath, d))]
+        dirs[:] = sorted(d for d in dirs if d not in links and not d.startswith(".")
+                         and d not in ("build", "__MACOSX"))
+        seen += len(dirs) + len(files)
+        if seen > MAX_WALK_ENTRIES:
+            raise HandInError(f"the hand-in holds more than {MAX_WALK_ENTRIES} files and folders")
+        names = [n for n in files + links if n_is_source(n)]
+        if names:
+            found[pathlib.Path(dirpath).relative_to(root)] = sorted(set(names))
+    return found
+
+
+def n_is_source(name: str) -> bool:
+    return name.endswith(SOURCE_SUFFIXES) and not name.startswith(".")
+
+
+def collect(handin: pathlib.Path, lab_folder: str) -> tuple[dict[str, bytes], list[str]]:
+    """The submission's source files by name, and the expected names it did not hand in.
+
+    The files may sit in a folder (a zipped folder, a repository checkout): the folder holding
+    the most of the lab's expected files is taken, the shallowest on a tie. A link or anything
+    but a regular file there is refused; so is a hand-in holding none of the expected files."""
+    expected = expected_files(lab_folder)
+    listing = _candidates(handin)
+    ranked = sorted(listing.items(),
+                    key=lambda kv: (-len(set(kv[1]) & set(expected)), len(kv[0].parts), str(kv[0])))
+    if not ranked or not set(ranked[0][1]) & set(expected):
+        raise HandInError(f"no file of lab {lab_number(lab_folder)} was handed in: "
+                          f"expected {', '.join(expected)}")
+    folder, names = ranked[0]
+    if len(names) > MAX_FILES:
+        raise HandInError(f"{folder.as_posix() or 'the hand-in'} holds {len(names)} source "
+                          f"files; at most {MAX_FILES} are built")
+    files = {}
+    for name in names:
+        shown = (folder / name).as_posix()
+        files[name] = read_regular(handin / folder / name, shown)
+    return files, [n for n in expected if n not in files]
+
+
+# ---- the tree -----------------------------------------------------------------------------
+
+def _tree_files(lab_folder: str) -> dict[str, bytes]:
+    """Path -> content of the students' tree's sources."""
+    picked = [ROOT / "Makefile", ROOT / "cuda.mk", ROOT / "grading" / "grading.mk"]
+    for lab in sorted((ROOT / "labs").iterdir()):
+        if lab.is_dir():
+            picked += [f for f in sorted(lab.iterdir()) if f.is_file() and not f.is_symlink()]
+    picked += sorted(p for p in (ROOT / "common").rglob("*") if p.is_file())
+    for folder in SHARED_SOLUTIONS.get(lab_folder, ()):
+        picked += sorted(p for p in (ROOT / folder).rglob("*") if p.is_file())
+    as_skeleton = skeleton_form(lab_folder)
+    skeletons = _skeletons()
+    files = {}
+    for path in picked:
+        rel = path.relative_to(ROOT).as_posix()
+        if rel in as_skeleton:
+            files[rel] = skeletons.skeleton_text(path.read_text(), rel).encode()
+        else:
+            files[rel] = path.read_bytes()
+    return files
+
+
+def _driver_target(variant_target: str) -> str:
+    return "cuda-variant-driver" if variant_target == "cuda-variant" else "variant-driver"
+
+
+def cached_tree(lab_folder: str, target: str = "variant") -> pathlib.Path:
+    """The students' tree of `lab_folder` with its driver objects built (once per content and
+    compiler: build/students-trees/<lab>-<digest>/)."""
+    files = _tree_files(lab_folder)
+    digest = hashlib.sha256()
+    for rel, data in sorted(files.items()):
+        digest.update(rel.encode() + b"\0" + hashlib.sha256(data).digest())
+    digest.update(subprocess.run(["c++", "--version"], capture_output=True).stdout)
+    digest.update(target.encode())
+    cache = ROOT / "build" / "students-trees"
+    tree = cache / f"{lab_folder}-{digest.hexdigest()[:16]}"
+    if (tree / ".complete").exists():
+        return tree
+    cache.mkdir(parents=True, exist_ok=True)
+    partial = pathlib.Path(tempfile.mkdtemp(prefix=f".{lab_folder}-", dir=cache))
+    try:
+        for rel, data in files.items():
+            (partial / rel).parent.mkdir(parents=True, exist_ok=True)
+            (partial / rel).write_bytes(data)
+        p = subprocess.run(["make", "-s", "-j2", "-C", str(partial), _driver_target(target),
+                            f"VARIANT_LAB={lab_folder}"], capture_output=True, text=True,
+                           errors="replace", env={**os.environ, "MAKEFLAGS": ""})
+        if p.returncode != 0:
+            raise RuntimeError(f"the students' tree of {lab_folder} does not build its "
+                               f"driver: {(p.stdout + p.stderr)[-1500:]}")
+        # The tree is never built again: its make dependency files would only reach the
+        # repository's own make, which includes every *.d under build/.
+        for dep in partial.rglob("*.d"):
+            dep.unlink()
+        (partial / ".complete").write_text("")
+        try:
+            partial.rename(tree)
+        except OSError:  # another grader made it meanwhile
+            pass
+    finally:
+        shutil.rmtree(partial, ignore_errors=True)
+    return tree
+
+
+def stage(lab_folder: str, handin_files: dict[str, bytes], missing: list[str],
+          target: str = "variant") -> pathlib.Path:
+    """A fresh copy of the students' tree (mode 755, outside the repository, so the sandbox
+    user reaches it wherever the repository lives) with the submission in `submission/` above
+    the stubs of what it lacks. The caller removes the folder."""
+    tree = cached_tree(lab_folder, target)
+    work = pathlib.Path(tempfile.mkdtemp(prefix="students-tree-"))
+    work.chmod(0o755)
+    root = work / "tree"
+    shutil.copytree(tree, root, symlinks=False)  # copy2: the objects stay newer than sources
+    for dirpath, dirs, files in os.walk(root):
+        os.chmod(dirpath, 0o755)
+        for f in files:
+            os.chmod(os.path.join(dirpath, f), 0o644)
+    src = root / "submission"
+    src.mkdir(mode=0o755)
+    stubs = pristine_skeleton(lab_folder)
+    for name in missing:
+        (src / name).write_text(stubs[name])
+    for name, data in handin_files.items():
+        (src / name).write_bytes(data)
+    return work

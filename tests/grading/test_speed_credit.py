@@ -1,0 +1,63 @@
+"""Speed grading's partial credit and its provisional points (grading/checks.py,
+grading/results.py): the curve, and points a regrade may add kept out of every total."""
+import math
+
+import pytest
+
+from grading.checks import ZERO_CREDIT_AT, CheckResult, speed_credit
+from grading.results import Results, Test
+
+
+def test_credit_is_full_at_the_bar_and_none_at_its_documented_fraction():
+    assert speed_credit(1.5, 1.5) == 1.0 and speed_credit(9.0, 1.5) == 1.0
+    assert speed_credit(ZERO_CREDIT_AT * 1.5, 1.5) == 0.0
+    assert speed_credit(1.0, 1.5) == 0.0  # a serial program against a 1.5x bar
+    middle = (1 + ZERO_CREDIT_AT) / 2 * 1.5
+    assert speed_credit(middle, 1.5) == pytest.approx(0.5)
+    assert speed_credit(math.nan, 1.5) == 0.0
+
+
+def test_credit_falls_linearly():
+    values = [speed_credit(x, 2.0) for x in (1.5, 1.6, 1.7, 1.8, 1.9, 2.0)]
+    steps = [b - a for a, b in zip(values, values[1:])]
+    assert all(s == pytest.approx(0.2) for s in steps), values
+
+
+def test_provisional_points_are_never_in_the_score():
+    results = Results()
+    results.add_all([Test("images", "images", 60), Test("speed", "speed", 40)])
+    results.test("images").finish(60, "fine", ok=True)
+    results.test("speed").finish(10, "short of the bar on a busy machine", regrade=True,
+                                 ok=True, provisional=30)
+    results.complete(1.0)
+    data = results.as_dict()
+    assert data["score"] == 70
+    speed = data["tests"][1]
+    assert speed["score"] == 10 and speed["extra_data"]["provisional"] == 30
+    assert speed["status"] == "failed" and "+30 if the regrade confirms" in speed["output"]
+    assert "70/100, +30 if the regrade confirms" in data["output"]
+
+
+def test_check_result_defaults_to_all_or_nothing():
+    assert CheckResult("x", True, "").credit is None
+
+
+def test_a_cpu_quota_below_two_cores_times_nothing(monkeypatch):
+    """Gradescope's default container (--cpus=0.5) sees every CPU of the host, but may use
+    half of one: the capacity is the cgroup's quota, and a parallel lab is not timed there:
+    correctness is graded, the speed marked for regrade with its points shown apart."""
+    from grading import checks, harness
+    monkeypatch.setattr(harness, "cpu_quota", lambda: 0.5)
+    assert harness.cpu_capacity() == 0.5 and harness.available_cores() == 1
+    result = checks.check_parallel_speedup("/nonexistent", "/nonexistent")
+    assert result.regrade and result.passed and result.credit == 0 and result.provisional == 1
+    assert result.detail.startswith("not timed: this machine gives 0.5 cores"), result.detail
+
+
+def test_the_quota_is_read_from_the_cgroup():
+    """Whatever this machine's quota, the capacity never exceeds the CPUs it may run on."""
+    import os
+    from grading import harness
+    quota = harness.cpu_quota()
+    assert quota is None or quota > 0
+    assert 0 < harness.cpu_capacity() <= len(os.sched_getaffinity(0))

@@ -1,0 +1,117 @@
+"""The grader where namespaces cannot be had (a Docker container with Docker's default
+seccomp profile, as on Gradescope): bubblewrap fails there, and the grader isolates by user
+instead (grading/sandbox.py, grading/confine.py). The grader runs here under a seccomp filter
+refusing namespace creation (tests/grading/no_namespaces.py), as such a container would."""
+import json
+import os
+import pathlib
+import subprocess
+import sys
+
+import pytest
+
+from grading import sandbox
+from grading.harness import GOLDEN, ROOT, build
+from tests.grading import submissions as sub
+
+NO_NAMESPACES = [sandbox.SYSTEM_PYTHON, "-I", str(ROOT / "tests" / "grading" / "no_namespaces.py"), "--"]
+
+
+@pytest.fixture(scope="module", autouse=True)
+def system_seccomp():
+    p = subprocess.run([sandbox.SYSTEM_PYTHON, "-I", "-c", "import seccomp"], capture_output=True)
+    if p.returncode != 0:  # make deps installs python3-seccomp
+        pytest.fail("python3-seccomp is not installed for /usr/bin/python3: run `make deps`")
+
+
+def grade_without_namespaces(binary, tmp_path, lab="01", extra_env=None) -> tuple[int, dict, str]:
+    out = tmp_path / "results.json"
+    p = subprocess.run([*NO_NAMESPACES, sys.executable, "-m", "grading.grade", lab, "--binary",
+                        str(binary), "--results", str(out), "--heatmaps", str(tmp_path / "maps")],
+                       cwd=ROOT, capture_output=True, text=True, timeout=600,
+                       env={**os.environ, **(extra_env or {})})
+    return p.returncode, json.loads(out.read_text()), p.stderr
+
+
+def test_namespaces_are_refused_under_the_filter():
+    """The stand-in for Docker's profile works: bubblewrap cannot start under it."""
+    p = subprocess.run([*NO_NAMESPACES, "bwrap", "--unshare-all", "--ro-bind", "/", "/", "true"],
+                       capture_output=True, text=True)
+    assert p.returncode != 0, p.stderr
+
+
+def test_reference_scores_100_without_namespaces(tmp_path):
+    build("lab01-ref")
+    status, results, stderr = grade_without_namespaces(sub.REFERENCE, tmp_path)
+    if os.geteuid() != 0:  # the user sandbox switches users: only root can
+        assert status == 2 and stderr.count("\n") == 1, stderr
+        assert "seccomp filter" in results["output"] and "\n" not in results["output"]
+        assert all(t["extra_data"]["regrade"] for t in results["tests"]), results
+        return
+    assert status == 0, stderr
+    assert "dedicated user" in results["sandbox"], results["sandbox"]
+    assert results["score"] == 100, json.dumps(results, indent=1)[:3000]
+
+
+def test_skeleton_scores_at_most_10_without_namespaces(tmp_path, lab01_pristine_skeleton):
+    if os.geteuid() != 0:
+        pytest.skip("the user sandbox needs root")
+    status, results, stderr = grade_without_namespaces(lab01_pristine_skeleton, tmp_path)
+    assert status == 0 and results["score"] <= 10, json.dumps(results, indent=1)[:3000]
+
+
+@pytest.fixture
+def user_sandbox(monkeypatch):
+    """This process's runs in the user sandbox."""
+    if os.geteuid() != 0:
+        pytest.skip("the user sandbox needs root")
+    monkeypatch.setenv("GRADING_SANDBOX", "user")
+    monkeypatch.setattr(sandbox, "_probe_result", [])
+    monkeypatch.setattr(sandbox, "_isolation", [])
+    assert sandbox.probe() is None and sandbox.isolation() == sandbox.USER
+    sandbox.hide_from_sandbox(ROOT)
+
+
+def test_user_sandbox_walls(user_sandbox, tmp_path):
+    """No network, no namespaces, no reading the grader's files or the grader's environment,
+    nothing left running after a run."""
+    import socket
+    client = sub.socket_client(tmp_path)
+    spy = sub.script(tmp_path, f"""cat "{ROOT / 'labs' / '01-serial' / 'solution' / 'render.cpp'}" >/dev/null 2>&1 && echo SPY solution
+cat "{GOLDEN / 'cornell' / 'meta.json'}" >/dev/null 2>&1 && echo SPY golden
+unshare -U true 2>/dev/null && echo SPY namespace
+echo "SECRET=$GRADING_SECRET"
+(sleep 987653 &)
+""", name="spy")
+    os.environ["GRADING_SECRET"] = "leak-me-4713"
+    try:
+        with socket.socket() as server:
+            server.bind(("127.0.0.1", 0))
+            server.listen()
+            with sandbox.Runner(trusted=False) as r:
+                net = r.run([r.input(client), str(server.getsockname()[1])])
+                out = r.run([r.input(spy)])
+    finally:
+        del os.environ["GRADING_SECRET"]
+    assert net.returncode == 3, (net.returncode, net.stderr)
+    assert "SPY" not in out.stdout and "leak-me-4713" not in out.stdout, out.stdout
+    left = sandbox.user_processes(sandbox.sandbox_user()[0])
+    assert not left, left
+
+
+def test_a_private_temporary_folder_is_refused_in_one_line(tmp_path):
+    """The sandbox user must enter the folder where inputs and builds are staged: a private
+    one (mode 700, as a fresh temporary folder is) is one line naming it, marked for regrade."""
+    if os.geteuid() != 0:
+        pytest.skip("only a grader running as root hands runs to another user")
+    private = tmp_path / "private"
+    private.mkdir(mode=0o700)
+    out = tmp_path / "results.json"
+    p = subprocess.run([sys.executable, "-m", "grading.grade", "01", "--binary",
+                        str(sub.REFERENCE), "--results", str(out)], cwd=ROOT, capture_output=True,
+                       text=True, timeout=300, env={**os.environ, "TMPDIR": str(private)})
+    results = json.loads(out.read_text())
+    assert p.returncode == 2 and p.stderr.count("\n") == 1, p.stderr
+    named = p.stderr.split("cannot enter ")[1].split(" (mode")[0]
+    assert str(private).startswith(named), p.stderr
+    assert all(t["extra_data"]["regrade"] for t in results["tests"]), results
