@@ -436,8 +436,16 @@ def main(argv=None) -> int:
                 results.refuse(f"no binary to grade: {binary} does not exist")
                 return 2
         else:
-            binary, errors = build_lab(a.lab, pathlib.Path(a.sources) if a.sources else None,
-                                       trusted=a.trusted)
+            sources = None
+            if a.sources:  # where the hand-in's files are (grading/handin.py), or why not
+                from grading.handin import HandinError, locate
+                try:
+                    sources = locate(a.lab, pathlib.Path(a.sources))
+                except HandinError as e:
+                    print(f"error: {e}", file=sys.stderr)
+                    results.refuse(str(e))
+                    return 2
+            binary, errors = build_lab(a.lab, sources, trusted=a.trusted)
             if binary is None:
                 results.refuse("the code does not compile", detail=errors)
                 print_table(a.lab, pathlib.Path(f"lab{a.lab}"), results.as_dict())

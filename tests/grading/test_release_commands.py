@@ -1,0 +1,194 @@
+"""Every command a student is told to run works in a fresh release (`make release LAB=NN`) of
+each CPU lab: the release's README and that lab's handout are read, their shell commands
+extracted, and each run in the release, after the lab's solution has been copied over the
+skeleton (a student who has finished). Then the release's `make render`, `make test`,
+`make handin` and `make grade` (which defaults to its lab) pass there.
+
+What counts as a command (`commands`): every ```sh block of the two files, run as one bash
+script with `set -e`, and every inline code span that starts with `make ` or `python3 `.
+Nothing is dropped silently: each command is either run as written, run at a reduced size
+(REDUCED: the documented size flags below, for full-size renders and benchmarks that take
+minutes), or not run for a reason named in NOT_HERE (several hosts, root); the test prints
+every command and what it did with it, and fails on an entry of REDUCED or NOT_HERE that no
+document names any more.
+
+    RT_RELEASE_LABS=01,03  only those labs' releases (default: 01-04)
+"""
+from __future__ import annotations
+
+import os
+import pathlib
+import re
+import shutil
+import subprocess
+
+import pytest
+
+from grading import leaks
+from grading.harness import ROOT
+
+LABS = os.environ.get("RT_RELEASE_LABS", "01,02,03,04").split(",")
+FOLDERS = leaks.lab_folders(ROOT)
+CLEAN_ENV = {k: v for k, v in os.environ.items()
+             if k not in ("MAKEFLAGS", "MFLAGS", "MAKELEVEL", "PYTHONPATH", "GRADING_SECRET")}
+if os.geteuid() == 0:  # OpenMPI refuses root unless told
+    CLEAN_ENV.update(OMPI_ALLOW_RUN_AS_ROOT="1", OMPI_ALLOW_RUN_AS_ROOT_CONFIRM="1")
+
+# The size flags that stand in for a full-size run: lab binaries take --width/--height/--spp
+# (the last of a repeated flag counts), the benchmark tools their own options.
+SMALL = "--width 48 --height 48 --spp 4"
+REDUCED = {
+    "make bench-serial": "make bench-serial BENCH_ARGS='--repeat 1 --small'",
+    "make tradeoff": "make tradeoff QUICK=1 PLOTS=0",
+    "make grade": None,  # run by test_grade_defaults_to_the_lab (about a minute)
+    "make grade LAB=01": None,
+    "make test": None,  # run by test_render_and_test_pass
+    "./lab01 --out mine.ppm": f"./lab01 --out mine.ppm {SMALL}",
+    "mpirun -np 2 ./lab04 --out mine.ppm": f"mpirun -np 2 ./lab04 --out mine.ppm {SMALL}",
+    "python3 tools/bench_openmp.py --min-capacity 1.8":
+        "python3 tools/bench_openmp.py --repeat 1 --width 48 --height 48 --spp 2 --threads 1,2",
+    "python3 tools/bench_openmp.py --mine --no-rng":
+        "python3 tools/bench_openmp.py --mine --no-rng --repeat 1 --width 48 --height 48 "
+        "--spp 2 --threads 1,2",
+    "python3 tools/bench_openmp.py --mine":
+        "python3 tools/bench_openmp.py --mine --repeat 1 --width 48 --height 48 --spp 2 "
+        "--threads 1,2",
+    "python3 tools/bench_simd.py": "python3 tools/bench_simd.py --size 32 --spp 8 --repeat 1",
+    "python3 tools/bench_simd.py --full --only lab02":
+        "python3 tools/bench_simd.py --size 32 --spp 8 --repeat 1 --only lab02",
+    "python3 tools/bench_mpi.py table":
+        "python3 tools/bench_mpi.py table --width 48 --height 48 --spp 4 --repeat 1 "
+        "--ranks 1,2 --hybrid 1x2 --no-capacity",
+}
+# Commands that cannot run on one test machine, and why.
+NOT_HERE = {
+    "mpirun --hostfile hosts -np 16 ./lab04-ref --out cornell.ppm  # several hosts: see the handout":
+        "needs several hosts",
+}
+
+
+def blocks(text: str) -> list[str]:
+    """The ```sh blocks of a Markdown text."""
+    return [m.group(1).strip() for m in re.finditer(r"^```sh\n(.*?)^```", text, re.S | re.M)]
+
+
+def inline(text: str) -> list[str]:
+    """Inline code spans that are whole commands: `make ...` or `python3 ...`."""
+    outside = re.sub(r"^```.*?^```", "", text, flags=re.S | re.M)
+    return [c for c in re.findall(r"`([^`\n]+)`", outside)
+            if c.startswith(("make ", "python3 ")) and c != "make"]
+
+
+def commands(release: pathlib.Path, lab: str) -> list[str]:
+    found = []
+    for doc in (release / "README.md", release / "handouts" / f"{FOLDERS[lab]}.md"):
+        text = doc.read_text()
+        for block in blocks(text):
+            lines = [line for line in block.splitlines() if line.strip()]
+            # A block of one-line commands runs line by line (each is named on its own);
+            # a block with a loop or continuation lines runs whole.
+            if any(line.rstrip().endswith(("\\", "do", "then")) for line in lines):
+                found.append(block)
+            else:
+                found.extend(lines)
+        found.extend(inline(text))
+    return list(dict.fromkeys(found))
+
+
+def finish_lab(release: pathlib.Path, lab: str) -> None:
+    """Copy lab `lab`'s solution over its skeleton, as a student who finished would have it."""
+    name = FOLDERS[lab]
+    skeleton = release / "labs" / name / "skeleton"
+    for src in (ROOT / "labs" / name / "solution").rglob("*"):
+        if src.is_file():
+            dst = skeleton / src.relative_to(ROOT / "labs" / name / "solution")
+            dst.parent.mkdir(parents=True, exist_ok=True)
+            shutil.copy(src, dst)
+    for shared in leaks.skeletons.SHARED_SOURCES.get(name, []):
+        shutil.copy(ROOT / shared, skeleton / pathlib.Path(shared).name)
+
+
+@pytest.fixture(scope="module", params=LABS)
+def finished(request, tmp_path_factory):
+    lab = request.param
+    out = tmp_path_factory.mktemp(f"release{lab}") / f"lab{lab}"
+    p = subprocess.run(["make", "-s", "-C", str(ROOT), "release", f"LAB={lab}", f"OUT={out}"],
+                       capture_output=True, text=True, timeout=1800, env=CLEAN_ENV)
+    assert p.returncode == 0, p.stdout + p.stderr
+    finish_lab(out, lab)
+    return lab, out
+
+
+def run(release, command, timeout=600):
+    return subprocess.run(["bash", "-c", f"set -eo pipefail\n{command}"], cwd=release,
+                          capture_output=True, text=True, timeout=timeout, env=CLEAN_ENV)
+
+
+def test_every_command_of_readme_and_handout_runs(finished):
+    lab, release = finished
+    found = commands(release, lab)
+    assert len(found) >= 5, found
+    done, failed = [], []
+    for command in found:
+        if command in NOT_HERE:
+            done.append(f"not run ({NOT_HERE[command]}): {command}")
+            continue
+        actual = REDUCED.get(command, command)
+        if actual is None:
+            done.append(f"run by another test: {command}")
+            continue
+        p = run(release, actual)
+        what = "ran" if actual == command else f"ran reduced as `{actual}`:"
+        done.append(f"{what} {command} -> exit {p.returncode}")
+        if p.returncode != 0:
+            failed.append(f"{command}\n  exit {p.returncode}: "
+                          f"{(p.stdout + p.stderr).strip()[-1500:]}")
+    print(f"lab {lab} release, {len(found)} commands:\n  " + "\n  ".join(done))
+    assert not failed, "\n".join(failed)
+
+
+def test_no_stale_allowlist_entry():
+    """Every entry of REDUCED and NOT_HERE is a command some shipped document names."""
+    text = "\n".join(p.read_text() for p in (ROOT / "handouts").glob("0*.md"))
+    text += "\n".join(p.read_text() for p in (ROOT / "labs").glob("0*/README.md"))
+    from grading import release
+    for lab in FOLDERS:
+        if lab in release.TRY:
+            text += "\n" + release.TRY[lab]
+    text += "\nmake grade\nmake test\n"
+    stale = [c for c in [*REDUCED, *NOT_HERE] if c not in text]
+    assert not stale, stale
+
+
+def test_release_is_a_repository_with_one_commit(finished):
+    lab, release = finished
+    log = subprocess.run(["git", "log", "--format=%s"], cwd=release, capture_output=True,
+                         text=True, check=True).stdout.splitlines()
+    assert log == [f"Lab {lab} release"]
+    shown = subprocess.run(["git", "show", "HEAD:README.md"], cwd=release, capture_output=True,
+                           text=True, check=True).stdout
+    assert shown.startswith(f"# Lab {lab}") and "make handin" in shown
+
+
+def test_render_and_test_pass(finished):
+    lab, release = finished
+    for command in ("make render", "make test"):
+        p = run(release, command, timeout=1200)
+        assert p.returncode == 0, f"{command}: " + (p.stdout + p.stderr)[-3000:]
+    assert (release / "cornell.ppm").is_file()
+
+
+def test_grade_defaults_to_the_lab_and_handin_packs_what_it_grades(finished):
+    lab, release = finished
+    p = run(release, "make handin")
+    assert p.returncode == 0 and (release / f"handin-lab{lab}.zip").is_file(), p.stderr
+    p = run(release, "make -s grade", timeout=1200)
+    assert f"Lab {lab} " in p.stdout, p.stdout + p.stderr
+    # the zip, unpacked into a folder inside a folder, grades as lab NN's sources
+    sub = release / "submission" / "nested"
+    sub.mkdir(parents=True)
+    shutil.unpack_archive(release / f"handin-lab{lab}.zip", sub)
+    p = run(release, f"python3 -m grading.grade {lab} --trusted --sources submission "
+                     f"--results sub.json", timeout=1200)
+    assert f"Lab {lab} " in p.stdout and "does not compile" not in p.stdout, \
+        p.stdout + p.stderr
