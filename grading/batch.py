@@ -5,9 +5,15 @@ with the same hidden scene; a CSV for the gradebook and an HTML page to read.
     python3 -m grading.batch 01 SUBMISSIONS --out REPORT
     make grade-batch LAB=01 SUBMISSIONS=DIR REPORT=DIR
 
-SUBMISSIONS/<student>/ holds either a lab binary named `lab` or the student's sources
-(render.cpp...). REPORT/<student>/results.json is each student's results.json;
-REPORT/grades.csv and REPORT/report.html sum them up.
+SUBMISSIONS/<student>/ holds either a lab binary named `lab` or the student's hand-in (its
+files, at the top or in one folder below: grading/handin.py finds them); SUBMISSIONS/
+<student>.zip is a hand-in zip as `make handin` writes it. REPORT/<student>/results.json is
+each student's results.json; REPORT/grades.csv and REPORT/report.html sum them up: per
+student the points, the provisional points apart (a check the machine was too busy to
+measure), the timed seconds, speedup and capacity, and the cause of a failure (compile
+error, crash, timeout, race, which image check); a last row sums up the class and counts
+the flagged (provisional, or not graded for the machine's sake: regrade those on a quiet
+machine). Progress goes to stdout as `[k/N] name ...` with an estimate of the time left.
 """
 from __future__ import annotations
 
@@ -17,8 +23,13 @@ import html
 import json
 import os
 import pathlib
+import re
+import shutil
 import subprocess
 import sys
+import tempfile
+import time
+import zipfile
 
 from grading import hidden
 from grading.grade import RUBRICS
@@ -41,16 +52,120 @@ def grade_one(lab: str, folder: pathlib.Path, out: pathlib.Path, extra: list[str
         return {"score": 0, "output": f"the grader left no results.json: {e}", "tests": []}
 
 
+SPEED_CHECKS = ("parallel-speedup", "speedup", "speed")
+# What the speed checks print (grading/checks.py): "... 1.85x over the serial reference
+# (0.600 s -> 0.324 s) on 2 cores giving 1.98x capacity ..." and "1.62x (0.412 s -> 0.254 s
+# wall clock ...)". Structured numbers in a test's extra_data, where the grader gives them,
+# come first.
+SPEED = re.compile(r"(?P<speedup>\d+(?:\.\d+)?)x (?:over the serial reference )?"
+                   r"\((?P<reference>\d+(?:\.\d+)?) s -> (?P<yours>\d+(?:\.\d+)?) s")
+CAPACITY = re.compile(r"giving (?P<capacity>\d+(?:\.\d+)?)x capacity|"
+                      r"gave only (?P<busy>\d+(?:\.\d+)?) cores")
+# The cause of a failure, from what the failing check or the grader said: first match wins.
+CAUSES = [
+    ("no results", re.compile(r"left no results\.json")),
+    ("incomplete hand-in", re.compile(r"the hand-in (lacks|holds lab)")),
+    ("compile error", re.compile(r"does not compile")),
+    ("timeout", re.compile(r"timed out")),
+    ("race", re.compile(r"nondeterministic|data race|differs? for|differs from the serial")),
+    ("signal", re.compile(r"killed by|signal|SIG[A-Z]+")),
+    ("crash", re.compile(r"exit status|exited with|could not run")),
+    ("no sandbox", re.compile(r"without a sandbox")),
+    ("no GPU", re.compile(r"NVIDIA GPU|cannot render on this machine's GPU")),
+]
+
+
+def speed_numbers(results: dict) -> dict[str, str]:
+    """Times, speedup and capacity of the speed check, as strings ("" where not measured)."""
+    found = dict(reference_s="", yours_s="", speedup="", capacity="")
+    for t in results.get("tests", []):
+        if t.get("extra_data", {}).get("check") not in SPEED_CHECKS:
+            continue
+        extra = t.get("extra_data", {})
+        m = SPEED.search(t.get("output", ""))
+        if m:
+            found.update(reference_s=m["reference"], yours_s=m["yours"], speedup=m["speedup"])
+        c = CAPACITY.search(t.get("output", ""))
+        if c:
+            found["capacity"] = c["capacity"] or c["busy"]
+        for key, name in (("reference_seconds", "reference_s"), ("seconds_reference", "reference_s"),
+                          ("yours_seconds", "yours_s"), ("seconds_yours", "yours_s"),
+                          ("speedup", "speedup"), ("capacity", "capacity")):
+            if isinstance(extra.get(key), (int, float)):
+                found[name] = f"{extra[key]:.3f}"
+    return found
+
+
+def provisional_points(results: dict) -> int:
+    """Points given without a measurement (a machine too busy): the regrade decides them."""
+    return sum(t.get("score", 0) for t in results.get("tests", [])
+               if t.get("extra_data", {}).get("regrade"))
+
+
+def flagged(results: dict) -> bool:
+    """To be graded again on a quiet machine: provisional points, or refused for the
+    machine's sake (no GPU), or no results at all."""
+    return (any(t.get("extra_data", {}).get("regrade") for t in results.get("tests", []))
+            or not results.get("tests"))
+
+
+def failure_cause(results: dict) -> str:
+    """Why points were lost, in a few words, with the first failing check's words: the
+    compiler's first error, a signal, a timeout, a race, which image check."""
+    tests = results.get("tests", [])
+    top = results.get("output", "")
+    failing = [t for t in tests if t.get("status") != "passed"
+               and not t.get("output", "").startswith("not graded until")]
+    texts = [top] + [f"{t['name']}: {t.get('output', '')}" for t in failing]
+    for cause, pattern in CAUSES:
+        for text in texts:
+            if pattern.search(text):
+                if cause == "compile error":
+                    lines = [line for line in top.splitlines()[1:] if line.strip()]
+                    return f"compile error: {lines[0][:200] if lines else ''}".rstrip(": ")
+                return f"{cause}: {text.splitlines()[0][:200]}"
+    if failing:
+        t = failing[0]
+        kind = "image check" if t.get("extra_data", {}).get("check", "").startswith(
+            ("golden", "hidden", "sphere", "lit", "glass", "scale")) else "check"
+        return f"{kind} {t['name']}: {t.get('output', '').splitlines()[0][:200] if t.get('output') else ''}"
+    return ""
+
+
+COLUMNS = ["student", "score", "max_score", "provisional_points", "flagged", "reference_s",
+           "yours_s", "speedup", "capacity", "cause"]
+
+
 def write_csv(path: pathlib.Path, lab: str, rows: dict[str, dict]) -> None:
+    """One row per student, then a summary row ("(class)": mean score, flagged count). The
+    cause column is the instructor's: the check's own words, not the student hints."""
     labels = [i.label for i in RUBRICS[lab]]
     with path.open("w", newline="") as f:
         w = csv.writer(f)
-        w.writerow(["student", "score", "max_score", "regrade", *labels])
+        w.writerow([*COLUMNS, *labels])
         for student, r in rows.items():
             by_name = {t["name"]: t for t in r.get("tests", [])}
-            regrade = [t["name"] for t in r.get("tests", []) if t.get("extra_data", {}).get("regrade")]
-            w.writerow([student, r.get("score", 0), r.get("max_score", ""), ";".join(regrade),
+            numbers = speed_numbers(r)
+            w.writerow([student, r.get("score", 0), r.get("max_score", ""), provisional_points(r),
+                        "yes" if flagged(r) else "", numbers["reference_s"], numbers["yours_s"],
+                        numbers["speedup"], numbers["capacity"], failure_cause(r),
                         *(by_name.get(label, {}).get("score", "") for label in labels)])
+        w.writerow(summary_row(lab, rows, labels))
+
+
+def summary_row(lab: str, rows: dict[str, dict], labels: list[str]) -> list:
+    n = len(rows)
+    scores = [r.get("score", 0) for r in rows.values()]
+    mean = f"{sum(scores) / n:.1f}" if n else ""
+    count = sum(flagged(r) for r in rows.values())
+    passed = []
+    for label in labels:
+        ok = sum(any(t["name"] == label and t.get("status") == "passed" for t in r.get("tests", []))
+                 for r in rows.values())
+        passed.append(f"{ok}/{n} passed")
+    return [f"(class: {n} students)", f"mean {mean}", max((r.get("max_score", 0) for r in rows.values()), default=""),
+            sum(provisional_points(r) for r in rows.values()), f"{count} flagged", "", "", "", "",
+            f"{sum(bool(failure_cause(r)) for r in rows.values())} lost points", *passed]
 
 
 def write_html(path: pathlib.Path, lab: str, rows: dict[str, dict]) -> None:
@@ -75,17 +190,81 @@ def write_html(path: pathlib.Path, lab: str, rows: dict[str, dict]) -> None:
         page = path.parent / student / "heatmaps" / "report.html"
         name = (f'<a href="{e(student)}/heatmaps/report.html">{e(student)}</a>' if page.exists()
                 else e(student))
-        body.append(f"<tr><th>{name}</th><td>{r.get('score', 0)}</td>{''.join(cells)}"
-                    f"<td>{note}</td></tr>")
+        numbers = speed_numbers(r)
+        facts = "".join(f"<td>{e(numbers[k])}</td>" for k in ("yours_s", "speedup", "capacity"))
+        flag = " (flagged)" if flagged(r) else ""
+        body.append(f"<tr><th>{name}{flag}</th><td>{r.get('score', 0)}</td>"
+                    f"<td>{provisional_points(r) or ''}</td>{facts}{''.join(cells)}"
+                    f"<td>{e(failure_cause(r))}</td><td>{note}</td></tr>")
     path.write_text(f"""<!doctype html><meta charset="utf-8"><title>Lab {lab} grades</title>
 <style>body{{font-family:sans-serif}} td,th{{padding:2px 8px;border:1px solid #ccc}}
 .passed{{background:#cfc}} .failed{{background:#fcc}} .regrade{{background:#ffc}}
 table{{border-collapse:collapse}}</style>
-<h1>Lab {lab}: {len(rows)} submissions</h1>
+<h1>Lab {lab}: {len(rows)} submissions, {sum(flagged(r) for r in rows.values())} flagged</h1>
 <p>Hover a cell for what the check saw; yellow: marked for regrade (machine too busy).</p>
-<table><tr><th>student</th><th>score</th>{head}<th>note</th></tr>
+<table><tr><th>student</th><th>score</th><th>provisional</th><th>seconds</th><th>speedup</th>
+<th>capacity</th>{head}<th>cause</th><th>note</th></tr>
 {chr(10).join(body)}</table>
 """)
+
+
+SECRET_FILE = ".grading-secret"  # in REPORT: the batch's hidden-scene secret, for regrades
+
+
+def batch_secret(out: pathlib.Path) -> str:
+    """The batch's secret: the one saved in REPORT by an earlier run (a regrade must see the
+    same hidden scene as the first grade), else $GRADING_SECRET or a new one, saved there
+    (readable by its owner only)."""
+    saved = out / SECRET_FILE
+    if saved.is_file():
+        return saved.read_text().strip()
+    secret = hidden.secret_from_environment()
+    out.mkdir(parents=True, exist_ok=True)
+    fd = os.open(saved, os.O_WRONLY | os.O_CREAT | os.O_EXCL, 0o600)
+    with os.fdopen(fd, "w") as f:
+        f.write(secret + "\n")
+    return secret
+
+
+def submissions(folder: pathlib.Path, unpacked: pathlib.Path) -> dict[str, pathlib.Path]:
+    """Student -> the folder to grade: SUBMISSIONS/<student>/, or SUBMISSIONS/<student>.zip
+    unpacked under `unpacked` (a zip that cannot be read becomes an empty folder, which the
+    grader then refuses, naming the files it lacks)."""
+    found = {}
+    for entry in sorted(folder.iterdir()):
+        if entry.is_dir():
+            found[entry.name] = entry
+        elif entry.suffix == ".zip" and entry.is_file():
+            target = unpacked / entry.stem
+            target.mkdir(parents=True, exist_ok=True)
+            try:
+                with zipfile.ZipFile(entry) as z:
+                    for member in z.infolist():  # no absolute paths, no "..": stay inside
+                        name = pathlib.PurePosixPath(member.filename)
+                        if member.is_dir() or name.is_absolute() or ".." in name.parts:
+                            continue
+                        dest = target / name
+                        dest.parent.mkdir(parents=True, exist_ok=True)
+                        with z.open(member) as src, dest.open("wb") as dst:
+                            shutil.copyfileobj(src, dst, 1 << 20)
+            except (zipfile.BadZipFile, OSError):
+                pass
+            found.setdefault(entry.stem, target)
+    return found
+
+
+def previous(out: pathlib.Path, student: str) -> dict | None:
+    try:
+        return json.loads((out / student / "results.json").read_text())
+    except (OSError, ValueError):
+        return None
+
+
+def eta(done: int, total: int, elapsed: float) -> str:
+    if not done:
+        return ""
+    left = elapsed / done * (total - done)
+    return f", about {left / 60:.0f} min left" if left >= 90 else f", about {left:.0f} s left"
 
 
 def main(argv=None) -> int:
@@ -94,20 +273,43 @@ def main(argv=None) -> int:
     p.add_argument("submissions", type=pathlib.Path)
     p.add_argument("--out", type=pathlib.Path, default=pathlib.Path("grades"))
     p.add_argument("--run-seconds", type=float)
+    p.add_argument("--only", choices=["flagged"],
+                   help="regrade only the students an earlier run of this REPORT flagged, with "
+                        "its saved secret, and merge them into its grades")
     a = p.parse_args(argv)
     if not a.submissions.is_dir():
         print(f"error: {a.submissions}: not a folder of submissions", file=sys.stderr)
         return 2
-    # One secret for the batch: every student gets the same hidden scene.
-    env = {**os.environ, "GRADING_SECRET": hidden.secret_from_environment()}
+    if a.only and not (a.out / SECRET_FILE).is_file():
+        print(f"error: ONLY=flagged needs an earlier batch's report in {a.out} (its secret "
+              f"and results); none there", file=sys.stderr)
+        return 2
+    # One secret for the batch, saved for regrades: every student gets the same hidden scene.
+    env = {**os.environ, "GRADING_SECRET": batch_secret(a.out)}
     extra = ["--run-seconds", str(a.run_seconds)] if a.run_seconds else []
-    rows = {}
-    for folder in sorted(f for f in a.submissions.iterdir() if f.is_dir()):
-        rows[folder.name] = grade_one(a.lab, folder, a.out / folder.name, extra, env)
-        print(f"{folder.name}: {rows[folder.name].get('score', 0)}", flush=True)
+    with tempfile.TemporaryDirectory(prefix="grade-batch-") as unpacked:
+        found = submissions(a.submissions, pathlib.Path(unpacked))
+        rows = {student: previous(a.out, student) for student in found}
+        todo = [s for s in found if not a.only or rows[s] is None or flagged(rows[s])]
+        if a.only:
+            print(f"regrading {len(todo)} flagged of {len(found)} students with the batch's "
+                  f"saved secret", flush=True)
+        start = time.monotonic()
+        for k, student in enumerate(todo, 1):
+            print(f"[{k}/{len(todo)}] {student} ...{eta(k - 1, len(todo), time.monotonic() - start)}",
+                  flush=True)
+            rows[student] = grade_one(a.lab, found[student], a.out / student, extra, env)
+            r = rows[student]
+            note = " (flagged)" if flagged(r) else ""
+            print(f"[{k}/{len(todo)}] {student}: {r.get('score', 0)}/{r.get('max_score', '')}"
+                  f"{note} {failure_cause(r)}".rstrip(), flush=True)
+    rows = {s: r if r is not None else {"score": 0, "output": "not graded", "tests": []}
+            for s, r in rows.items()}
     write_csv(a.out / "grades.csv", a.lab, rows)
     write_html(a.out / "report.html", a.lab, rows)
-    print(f"wrote {a.out / 'grades.csv'} and {a.out / 'report.html'}")
+    count = sum(flagged(r) for r in rows.values())
+    print(f"wrote {a.out / 'grades.csv'} and {a.out / 'report.html'}: {len(rows)} students, "
+          f"{count} flagged{' (regrade them: make grade-batch ... ONLY=flagged)' if count else ''}")
     return 0
 
 

@@ -438,13 +438,18 @@ def main(argv=None) -> int:
         else:
             sources = None
             if a.sources:  # where the hand-in's files are (grading/handin.py), or why not
-                from grading.handin import HandinError, locate
+                import tempfile
+                from grading.handin import HandinError, prepare
                 try:
-                    sources = locate(a.lab, pathlib.Path(a.sources))
+                    sources, note = prepare(a.lab, pathlib.Path(a.sources),
+                                            pathlib.Path(tempfile.mkdtemp(prefix="handin-")))
                 except HandinError as e:
                     print(f"error: {e}", file=sys.stderr)
                     results.refuse(str(e))
                     return 2
+                if note:
+                    print(f"warning: {note}", file=sys.stderr)
+                    results.notes.append(note)
             binary, errors = build_lab(a.lab, sources, trusted=a.trusted)
             if binary is None:
                 results.refuse("the code does not compile", detail=errors)

@@ -7,11 +7,14 @@
 gradescope:
 	$(PYTHON) -m grading.gradescope $(LAB)
 
-# make grade-batch LAB=NN SUBMISSIONS=DIR [REPORT=DIR]: one folder per student, graded in the
-# sandbox; REPORT (default grades/) gets each results.json, grades.csv and report.html.
+# make grade-batch LAB=NN SUBMISSIONS=DIR [REPORT=DIR] [ONLY=flagged]: one folder or hand-in
+# zip per student, graded in the sandbox; REPORT (default grades/) gets each results.json,
+# grades.csv and report.html. ONLY=flagged regrades the students that REPORT flagged, with
+# its saved secret.
 grade-batch:
 	@test -n "$(SUBMISSIONS)" || { echo "grade-batch: needs SUBMISSIONS=DIR" >&2; exit 2; }
-	$(PYTHON) -m grading.batch $(LAB) $(SUBMISSIONS) --out $(or $(REPORT),grades)
+	@$(PYTHON) -m grading.batch $(LAB) $(SUBMISSIONS) --out $(or $(REPORT),grades) \
+	    $(if $(ONLY),--only $(ONLY))
 
 # make release LAB=NN OUT=DIR: the student repository for lab NN (grading/release.py). LAB and
 # OUT have defaults in the Makefiles (for make grade, make gpu-check); a release must name both.

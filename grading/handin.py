@@ -76,32 +76,49 @@ def unchanged(lab: str, files: list[str]) -> list[str]:
     return files
 
 
-def locate(lab: str, submission: pathlib.Path) -> pathlib.Path:
-    """The folder of `submission` that holds lab `lab`'s graded files: the submission itself,
-    else the one folder below it (at any depth, links not followed) that holds them all.
-    HandinError names what is missing, or the folders that compete."""
+def locate(lab: str, submission: pathlib.Path) -> tuple[pathlib.Path, list[str]]:
+    """(the folder of `submission` that holds lab `lab`'s graded files, those it lacks): the
+    submission itself when it holds any of them at the top, else the one folder below it (at
+    any depth, links not followed) holding the most. HandinError when none holds any, or
+    two folders compete."""
     wanted = graded_files(lab)
-    if all((submission / f).is_file() for f in wanted):
-        return submission
-    candidates, best, best_found = [], None, -1
-    for folder, dirs, names in os.walk(submission):
+
+    def held(folder: pathlib.Path) -> list[str]:
+        return [f for f in wanted if (folder / f).is_file() and not (folder / f).is_symlink()]
+
+    if held(submission):
+        return submission, [f for f in wanted if f not in held(submission)]
+    best: list[tuple[int, pathlib.Path]] = []
+    for folder, dirs, _names in os.walk(submission):
         dirs[:] = sorted(d for d in dirs if not d.startswith((".", "__MACOSX")))
-        found = [f for f in wanted if f in names]
-        if len(found) == len(wanted):
-            candidates.append(pathlib.Path(folder))
-        elif len(found) > best_found:
-            best, best_found = pathlib.Path(folder), len(found)
-    if len(candidates) == 1:
-        return candidates[0]
-    if len(candidates) > 1:
-        names = ", ".join(c.relative_to(submission).as_posix() for c in candidates[:3])
+        n = len(held(pathlib.Path(folder)))
+        if n:
+            best.append((n, pathlib.Path(folder)))
+    if not best:
+        raise HandinError(f"the hand-in holds none of lab {lab}'s files "
+                          f"({', '.join(wanted)}; make handin packs them)")
+    most = max(n for n, _ in best)
+    top = [folder for n, folder in best if n == most]
+    if len(top) > 1:
+        names = ", ".join(f.relative_to(submission).as_posix() for f in top[:3])
         raise HandinError(f"the hand-in holds lab {lab}'s files in more than one folder "
                           f"({names}); hand in one copy (make handin)")
-    missing = [f for f in wanted if best is None or not (best / f).is_file()]
-    hint = "" if best is None or best == submission else \
-        f" (found the others in {best.relative_to(submission).as_posix()}/)"
-    raise HandinError(f"the hand-in lacks {', '.join(missing)}{hint}: lab {lab} needs "
-                      f"{', '.join(wanted)} (make handin packs them)")
+    return top[0], [f for f in wanted if f not in held(top[0])]
+
+
+def prepare(lab: str, submission: pathlib.Path, workdir: pathlib.Path) -> tuple[pathlib.Path, str]:
+    """(the folder to build, a note or ""). A graded file the hand-in lacks is taken from the
+    skeleton, as the student was given it (never common/'s copy of a shared file, which in
+    the grader's repository is the solution), and the note names it in one line."""
+    folder, missing = locate(lab, submission)
+    if not missing:
+        return folder, ""
+    workdir.mkdir(parents=True, exist_ok=True)
+    for f in graded_files(lab):
+        source = skeleton(lab) / f if f in missing else folder / f
+        (workdir / f).write_bytes(source.read_bytes())
+    return workdir, (f"the hand-in lacks {', '.join(missing)}: graded with the skeleton's "
+                     f"(lab {lab} needs {', '.join(graded_files(lab))}; make handin packs them)")
 
 
 def main(argv=None) -> int:

@@ -46,7 +46,7 @@ def test_batch_grades_each_student_into_csv_and_html(tmp_path):
 
 def test_gradescope_bundle_grades_a_submission(tmp_path, request):
     """The zip, unpacked where Gradescope unpacks it, grades lab 01's solution handed in as a
-    student's render.cpp: 100 points in /autograder/results/results.json."""
+    student's render.cpp and path_tracer.h: 100 points in /autograder/results/results.json."""
     from grading.gradescope import bundle
     # Gradescope's /autograder is open to all; pytest's tmp_path is not (0700 above it), and
     # the sandboxed build runs as an unprivileged user that must read the unpacked tree.
@@ -70,6 +70,7 @@ def test_gradescope_bundle_grades_a_submission(tmp_path, request):
         shutil.copytree(src, dst) if src.is_dir() else shutil.copy2(src, dst)
     (root / "submission").mkdir()
     shutil.copy(ROOT / "labs" / "01-serial" / "solution" / "render.cpp", root / "submission")
+    shutil.copy(ROOT / "common" / "core" / "path_tracer.h", root / "submission")
     p = subprocess.run(["bash", str(root / "source" / "run_autograder")], capture_output=True,
                        text=True, timeout=900, env={**os.environ, "AUTOGRADER_ROOT": str(root)})
     assert p.returncode == 0, p.stdout + p.stderr
