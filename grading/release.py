@@ -145,7 +145,7 @@ make handin               # handin-lab{lab}.zip: the files to upload to Gradesco
 make help                 # every command
 ```
 
-`make grade` grades lab {lab} (`make grade LAB=NN` another); it builds `./lab{lab}` first and
+`make grade` grades lab {lab} (add `LAB=NN` for another); it builds `./lab{lab}` first and
 writes `results.json` and, where an image check fails, `grading-heatmaps/report.html`.
 
 What else is here:

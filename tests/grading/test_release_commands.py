@@ -34,37 +34,58 @@ CLEAN_ENV = {k: v for k, v in os.environ.items()
 if os.geteuid() == 0:  # OpenMPI refuses root unless told
     CLEAN_ENV.update(OMPI_ALLOW_RUN_AS_ROOT="1", OMPI_ALLOW_RUN_AS_ROOT_CONFIRM="1")
 
-# The size flags that stand in for a full-size run: lab binaries take --width/--height/--spp
-# (the last of a repeated flag counts), the benchmark tools their own options.
+# The size flags that stand in for a full-size run. A lab binary's command line (`./labNN`,
+# also under mpirun or with environment variables) that does not set both --width and --spp
+# renders the full baseline for a minute or more: it runs with SMALL appended (the last of a
+# repeated flag counts). Tools take their own options (REDUCED).
 SMALL = "--width 48 --height 48 --spp 4"
+LAB_BINARY = re.compile(r"^(\w+=\S+ )*(mpirun (-\S+ (\S+ )?)*)?\./lab0\d\S*( |$)")
+QUICK_OPENMP = "--repeat 1 --width 48 --height 48 --spp 2 --threads 1,2"
+QUICK_MPI = "--width 48 --height 48 --spp 4 --repeat 1 --no-capacity"
 REDUCED = {
     "make bench-serial": "make bench-serial BENCH_ARGS='--repeat 1 --small'",
     "make tradeoff": "make tradeoff QUICK=1 PLOTS=0",
-    "make grade": None,  # run by test_grade_defaults_to_the_lab (about a minute)
-    "make grade LAB=01": None,
-    "make test": None,  # run by test_render_and_test_pass
-    "./lab01 --out mine.ppm": f"./lab01 --out mine.ppm {SMALL}",
-    "mpirun -np 2 ./lab04 --out mine.ppm": f"mpirun -np 2 ./lab04 --out mine.ppm {SMALL}",
+    "python3 tools/bench_openmp.py": f"python3 tools/bench_openmp.py {QUICK_OPENMP}",
     "python3 tools/bench_openmp.py --min-capacity 1.8":
-        "python3 tools/bench_openmp.py --repeat 1 --width 48 --height 48 --spp 2 --threads 1,2",
+        f"python3 tools/bench_openmp.py {QUICK_OPENMP}",
+    "python3 tools/bench_openmp.py --mine": f"python3 tools/bench_openmp.py --mine {QUICK_OPENMP}",
     "python3 tools/bench_openmp.py --mine --no-rng":
-        "python3 tools/bench_openmp.py --mine --no-rng --repeat 1 --width 48 --height 48 "
-        "--spp 2 --threads 1,2",
-    "python3 tools/bench_openmp.py --mine":
-        "python3 tools/bench_openmp.py --mine --repeat 1 --width 48 --height 48 --spp 2 "
-        "--threads 1,2",
+        f"python3 tools/bench_openmp.py --mine --no-rng {QUICK_OPENMP}",
     "python3 tools/bench_simd.py": "python3 tools/bench_simd.py --size 32 --spp 8 --repeat 1",
+    "python3 tools/bench_simd.py --full --only lab02-ref":
+        "python3 tools/bench_simd.py --size 32 --spp 8 --repeat 1 --only lab02-ref",
     "python3 tools/bench_simd.py --full --only lab02":
         "python3 tools/bench_simd.py --size 32 --spp 8 --repeat 1 --only lab02",
-    "python3 tools/bench_mpi.py table":
-        "python3 tools/bench_mpi.py table --width 48 --height 48 --spp 4 --repeat 1 "
-        "--ranks 1,2 --hybrid 1x2 --no-capacity",
+    "python3 tools/bench_simd.py --only lab02 --only lab02a":
+        "python3 tools/bench_simd.py --size 32 --spp 8 --repeat 1 --only lab02 --only lab02a",
+    "python3 tools/bench_mpi.py table": f"python3 tools/bench_mpi.py table {QUICK_MPI} "
+                                       f"--ranks 1,2 --hybrid 1x2",
+    "python3 tools/bench_mpi.py table --repeat 5 --ranks 2 --hybrid 1x2":
+        f"python3 tools/bench_mpi.py table {QUICK_MPI} --ranks 2 --hybrid 1x2",
+    "python3 tools/bench_mpi.py table --ranks 1,2,4,8,16 --hybrid 1x16,2x8,4x4,8x2":
+        f"python3 tools/bench_mpi.py table {QUICK_MPI} --ranks 1,2,4 --hybrid 1x2,2x1",
+    "python3 tools/bench_mpi.py rows --bands 8 --width 600 --height 600 --spp 32":
+        "python3 tools/bench_mpi.py rows --bands 4 --width 48 --height 48 --spp 4 --repeat 1",
+    # run by the tests below, once each
+    "make grade": None, "make grade LAB=01": None, "make grade LAB=02": None,
+    "make grade LAB=03": None, "make grade LAB=04": None, "make test": None, "make render": None,
+    "make handin": None,
 }
-# Commands that cannot run on one test machine, and why.
+# Commands that cannot run on one test machine, and why (a block by its first line).
 NOT_HERE = {
-    "mpirun --hostfile hosts -np 16 ./lab04-ref --out cornell.ppm  # several hosts: see the handout":
-        "needs several hosts",
+    "mpirun --hostfile hosts -np 16 ./lab04-ref --out cornell.ppm": "needs several hosts",
+    "for h in node2 node3; do ssh $h mkdir -p $PWD/common/scenes; \\": "needs several hosts",
+    "sudo tools/netns_hosts.sh up rt": "creates network namespaces: root, and a test of its own "
+                                       "(tests/labs/test_lab04.py::test_two_hosts)",
+    "mpirun -np 2 --map-by slot:PE=4 ./lab04 --threads 4": "needs 8 cores",
 }
+# Commands that must fail, with this exit status (showing what an error looks like).
+EXPECTED_STATUS = {"RT_FORCE_NO_AVX2=1 ./lab02-ref": 2}
+
+
+def bare(line: str) -> str:
+    """A command without its trailing comment."""
+    return re.sub(r"\s+#.*$", "", line.strip())
 
 
 def blocks(text: str) -> list[str]:
@@ -73,10 +94,11 @@ def blocks(text: str) -> list[str]:
 
 
 def inline(text: str) -> list[str]:
-    """Inline code spans that are whole commands: `make ...` or `python3 ...`."""
-    outside = re.sub(r"^```.*?^```", "", text, flags=re.S | re.M)
+    """Inline code spans that are whole commands: `make ...` or `python3 ...` (not in HTML
+    comments, where the generated tables name their generator)."""
+    outside = re.sub(r"^```.*?^```|<!--.*?-->", "", text, flags=re.S | re.M)
     return [c for c in re.findall(r"`([^`\n]+)`", outside)
-            if c.startswith(("make ", "python3 ")) and c != "make"]
+            if c.startswith(("make ", "python3 "))]
 
 
 def commands(release: pathlib.Path, lab: str) -> list[str]:
@@ -84,15 +106,30 @@ def commands(release: pathlib.Path, lab: str) -> list[str]:
     for doc in (release / "README.md", release / "handouts" / f"{FOLDERS[lab]}.md"):
         text = doc.read_text()
         for block in blocks(text):
-            lines = [line for line in block.splitlines() if line.strip()]
+            lines = [line for line in block.splitlines()
+                     if line.strip() and not line.lstrip().startswith("#")]
             # A block of one-line commands runs line by line (each is named on its own);
             # a block with a loop or continuation lines runs whole.
-            if any(line.rstrip().endswith(("\\", "do", "then")) for line in lines):
-                found.append(block)
+            if any(bare(line).endswith(("\\", "do", "then")) for line in lines):
+                found.append("\n".join(lines))
             else:
-                found.extend(lines)
+                found.extend(bare(line) for line in lines)
         found.extend(inline(text))
     return list(dict.fromkeys(found))
+
+
+def planned(command: str) -> tuple[str | None, str]:
+    """(what to run, what the list says about it)."""
+    first = command.splitlines()[0].strip()
+    if first in NOT_HERE or bare(first) in NOT_HERE:
+        return None, f"not run ({NOT_HERE.get(first) or NOT_HERE[bare(first)]})"
+    if command in REDUCED:
+        actual = REDUCED[command]
+        return actual, "run by another test" if actual is None else f"reduced to `{actual}`"
+    if "\n" not in command and LAB_BINARY.match(command) and not re.search(r"[;&|]", command) \
+            and not ("--width" in command and "--spp" in command):
+        return f"{command} {SMALL}", f"run with {SMALL}"
+    return command, "run as written"
 
 
 def finish_lab(release: pathlib.Path, lab: str) -> None:
@@ -130,18 +167,15 @@ def test_every_command_of_readme_and_handout_runs(finished):
     assert len(found) >= 5, found
     done, failed = [], []
     for command in found:
-        if command in NOT_HERE:
-            done.append(f"not run ({NOT_HERE[command]}): {command}")
-            continue
-        actual = REDUCED.get(command, command)
+        actual, how = planned(command)
         if actual is None:
-            done.append(f"run by another test: {command}")
+            done.append(f"{how}: {command}")
             continue
         p = run(release, actual)
-        what = "ran" if actual == command else f"ran reduced as `{actual}`:"
-        done.append(f"{what} {command} -> exit {p.returncode}")
-        if p.returncode != 0:
-            failed.append(f"{command}\n  exit {p.returncode}: "
+        expected = EXPECTED_STATUS.get(command, 0)
+        done.append(f"{how}, exit {p.returncode}: {command}")
+        if p.returncode != expected:
+            failed.append(f"{command}\n  ({how}) exit {p.returncode}, expected {expected}: "
                           f"{(p.stdout + p.stderr).strip()[-1500:]}")
     print(f"lab {lab} release, {len(found)} commands:\n  " + "\n  ".join(done))
     assert not failed, "\n".join(failed)
@@ -156,7 +190,7 @@ def test_no_stale_allowlist_entry():
         if lab in release.TRY:
             text += "\n" + release.TRY[lab]
     text += "\nmake grade\nmake test\n"
-    stale = [c for c in [*REDUCED, *NOT_HERE] if c not in text]
+    stale = [c for c in [*REDUCED, *NOT_HERE, *EXPECTED_STATUS] if c not in text]
     assert not stale, stale
 
 
