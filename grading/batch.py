@@ -64,8 +64,8 @@ CAPACITY = re.compile(r"giving (?P<capacity>\d+(?:\.\d+)?)x capacity|"
 # The cause of a failure, from what the failing check or the grader said: first match wins.
 CAUSES = [
     ("no results", re.compile(r"left no results\.json")),
-    ("incomplete hand-in", re.compile(r"the hand-in (lacks|holds lab)")),
     ("compile error", re.compile(r"does not compile")),
+    ("no hand-in", re.compile(r"the hand-in holds (none|lab)")),
     ("timeout", re.compile(r"timed out")),
     ("race", re.compile(r"nondeterministic|data race|differs? for|differs from the serial")),
     ("signal", re.compile(r"killed by|signal|SIG[A-Z]+")),
@@ -120,9 +120,11 @@ def failure_cause(results: dict) -> str:
     for cause, pattern in CAUSES:
         for text in texts:
             if pattern.search(text):
-                if cause == "compile error":
-                    lines = [line for line in top.splitlines()[1:] if line.strip()]
-                    return f"compile error: {lines[0][:200] if lines else ''}".rstrip(": ")
+                if cause == "compile error":  # the compiler's first line after the note
+                    lines = top.splitlines()
+                    at = next((i for i, line in enumerate(lines) if "does not compile" in line), 0)
+                    after = [line for line in lines[at + 1:] if line.strip()]
+                    return f"compile error: {after[0][:200] if after else ''}".rstrip(": ")
                 return f"{cause}: {text.splitlines()[0][:200]}"
     if failing:
         t = failing[0]
