@@ -5,7 +5,10 @@ with the same hidden scene; a CSV for the gradebook and an HTML page to read.
     python3 -m grading.batch 01 SUBMISSIONS --out REPORT
     make grade-batch LAB=01 SUBMISSIONS=DIR REPORT=DIR
 
-SUBMISSIONS/<student>/ holds either a lab binary named `lab` or the student's hand-in (its
+SUBMISSIONS may be Gradescope's export of the assignment, unzipped as it comes
+(submission_<id>/ folders and submission_metadata.yml): grades.csv is then keyed by the
+export's submission ids and names each one's submitters. Otherwise SUBMISSIONS/<student>/
+holds either a lab binary named `lab` or the student's hand-in (its
 files, at the top or in one folder below: grading/handin.py finds them); SUBMISSIONS/
 <student>.zip is a hand-in zip as `make handin` writes it. REPORT/<student>/results.json is
 each student's results.json; REPORT/grades.csv and REPORT/report.html sum them up: per
@@ -138,21 +141,28 @@ COLUMNS = ["student", "score", "max_score", "provisional_points", "flagged", "re
            "yours_s", "speedup", "capacity", "cause"]
 
 
-def write_csv(path: pathlib.Path, lab: str, rows: dict[str, dict]) -> None:
+def write_csv(path: pathlib.Path, lab: str, rows: dict[str, dict],
+              submitters: dict[str, str] | None = None) -> None:
     """One row per student, then a summary row ("(class)": mean score, flagged count). The
-    cause column is the instructor's: the check's own words, not the student hints."""
+    cause column is the instructor's: the check's own words, not the student hints. For a
+    Gradescope export (`submitters`) each row is keyed by the export's submission id, and
+    names its submitters."""
     labels = [i.label for i in RUBRICS[lab]]
     with path.open("w", newline="") as f:
         w = csv.writer(f)
-        w.writerow([*COLUMNS, *labels])
+        head = ["submission_id", "submitters"] if submitters is not None else []
+        w.writerow([*head, *COLUMNS, *labels])
         for student, r in rows.items():
             by_name = {t["name"]: t for t in r.get("tests", [])}
             numbers = speed_numbers(r)
-            w.writerow([student, r.get("score", 0), r.get("max_score", ""), provisional_points(r),
+            key = [submission_id(student), submitters.get(student, "")] \
+                if submitters is not None else []
+            w.writerow([*key, student, r.get("score", 0), r.get("max_score", ""), provisional_points(r),
                         "yes" if flagged(r) else "", numbers["reference_s"], numbers["yours_s"],
                         numbers["speedup"], numbers["capacity"], failure_cause(r),
                         *(by_name.get(label, {}).get("score", "") for label in labels)])
-        w.writerow(summary_row(lab, rows, labels))
+        w.writerow([*(["", ""] if submitters is not None else []),
+                    *summary_row(lab, rows, labels)])
 
 
 def summary_row(lab: str, rows: dict[str, dict], labels: list[str]) -> list:
@@ -208,6 +218,54 @@ table{{border-collapse:collapse}}</style>
 <th>capacity</th>{head}<th>cause</th><th>note</th></tr>
 {chr(10).join(body)}</table>
 """)
+
+
+EXPORT_METADATA = "submission_metadata.yml"
+
+
+def parse_export_metadata(text: str) -> dict[str, list[dict[str, str]]]:
+    """Gradescope's submission_metadata.yml: folder -> its submitters (":name", ":sid",
+    ":email" without the colons). With PyYAML where installed; else this subset of YAML,
+    which is all the export writes for the fields read here."""
+    try:
+        import yaml
+        data = yaml.safe_load(text) or {}
+        return {str(folder): [{str(k).lstrip(":"): str(v) for k, v in person.items()}
+                              for person in (meta or {}).get(":submitters", []) or []]
+                for folder, meta in data.items()}
+    except ImportError:
+        pass
+    found: dict[str, list[dict[str, str]]] = {}
+    folder, person = None, None
+    for line in text.splitlines():
+        if re.match(r"^[^\s#][^:]*:\s*$", line):
+            folder, person = line.rstrip()[:-1].strip("'\""), None
+            found[folder] = []
+            continue
+        m = re.match(r"^\s*(- )?\s*:(name|sid|email):\s*(.*?)\s*$", line)
+        if folder is not None and m:
+            if m.group(1) or person is None:
+                person = {}
+                found[folder].append(person)
+            person[m.group(2)] = m.group(3).strip("'\"")
+    return found
+
+
+def export_submitters(folder: pathlib.Path) -> dict[str, str] | None:
+    """Gradescope's export of an assignment (its folder unzipped: submission_<id>/ folders and
+    submission_metadata.yml): submission folder -> "name <email> (sid)" of each submitter;
+    None for a plain folder of students."""
+    path = folder / EXPORT_METADATA
+    if not path.is_file():
+        return None
+    return {name: "; ".join(f"{p.get('name', '')} <{p.get('email', '')}> ({p.get('sid', '')})"
+                            for p in people)
+            for name, people in parse_export_metadata(path.read_text()).items()}
+
+
+def submission_id(folder_name: str) -> str:
+    """The export's id of a submission folder ("submission_123456" -> "123456")."""
+    return folder_name.removeprefix("submission_")
 
 
 SECRET_FILE = ".grading-secret"  # in REPORT: the batch's hidden-scene secret, for regrades
@@ -289,8 +347,11 @@ def main(argv=None) -> int:
     # One secret for the batch, saved for regrades: every student gets the same hidden scene.
     env = {**os.environ, "GRADING_SECRET": batch_secret(a.out)}
     extra = ["--run-seconds", str(a.run_seconds)] if a.run_seconds else []
+    submitters = export_submitters(a.submissions)
     with tempfile.TemporaryDirectory(prefix="grade-batch-") as unpacked:
         found = submissions(a.submissions, pathlib.Path(unpacked))
+        if submitters is not None:  # a Gradescope export: its submissions, by its metadata
+            found = {name: folder for name, folder in found.items() if name in submitters}
         rows = {student: previous(a.out, student) for student in found}
         todo = [s for s in found if not a.only or rows[s] is None or flagged(rows[s])]
         if a.only:
@@ -307,7 +368,7 @@ def main(argv=None) -> int:
                   f"{note} {failure_cause(r)}".rstrip(), flush=True)
     rows = {s: r if r is not None else {"score": 0, "output": "not graded", "tests": []}
             for s, r in rows.items()}
-    write_csv(a.out / "grades.csv", a.lab, rows)
+    write_csv(a.out / "grades.csv", a.lab, rows, submitters)
     write_html(a.out / "report.html", a.lab, rows)
     count = sum(flagged(r) for r in rows.values())
     print(f"wrote {a.out / 'grades.csv'} and {a.out / 'report.html'}: {len(rows)} students, "

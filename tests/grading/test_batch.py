@@ -112,3 +112,56 @@ def test_only_flagged_needs_an_earlier_report(tmp_path, capsys):
 @pytest.mark.parametrize("seconds,text", [(30, "about 30 s left"), (600, "about 10 min left")])
 def test_estimate(seconds, text):
     assert batch.eta(1, 2, seconds) == f", {text}"
+
+
+EXPORT_METADATA = """\
+---
+submission_123456:
+  :submitters:
+  - :name: Ada Lovelace
+    :sid: '1815'
+    :email: ada@example.edu
+  :created_at: 2026-11-30 10:00:00.000000000 -08:00
+  :score: 0.0
+submission_123457:
+  :submitters:
+  - :name: Alan Turing
+    :sid: '1912'
+    :email: alan@example.edu
+  - :name: Grace Hopper
+    :sid: '1906'
+    :email: grace@example.edu
+"""
+
+
+@pytest.mark.parametrize("with_yaml", [True, False])
+def test_export_metadata_parses_with_and_without_pyyaml(monkeypatch, with_yaml):
+    if not with_yaml:
+        import builtins
+        real = builtins.__import__
+
+        def no_yaml(name, *args, **kwargs):
+            if name == "yaml":
+                raise ImportError(name)
+            return real(name, *args, **kwargs)
+        monkeypatch.setattr(builtins, "__import__", no_yaml)
+    parsed = batch.parse_export_metadata(EXPORT_METADATA)
+    assert parsed["submission_123456"] == [
+        {"name": "Ada Lovelace", "sid": "1815", "email": "ada@example.edu"}]
+    assert [p["name"] for p in parsed["submission_123457"]] == ["Alan Turing", "Grace Hopper"]
+
+
+def test_a_gradescope_export_is_graded_and_keyed_by_submission_id(tmp_path, monkeypatch):
+    export, report = tmp_path / "assignment_99_export", tmp_path / "report"
+    for folder in ("submission_123456", "submission_123457"):
+        (export / folder).mkdir(parents=True)
+        (export / folder / "render.cpp").write_text("x")
+    (export / "submission_metadata.yml").write_text(EXPORT_METADATA)
+    calls = []
+    monkeypatch.setattr(batch, "grade_one", fake_grader(
+        calls, {"submission_123456": FAST, "submission_123457": RACY}))
+    assert batch.main(["03", str(export), "--out", str(report)]) == 0
+    rows = {r["submission_id"]: r for r in rows_of(report / "grades.csv") if r["submission_id"]}
+    assert rows["123456"]["submitters"] == "Ada Lovelace <ada@example.edu> (1815)"
+    assert rows["123457"]["submitters"].count("<") == 2 and rows["123457"]["score"] == "0"
+    assert rows["123456"]["speedup"] == "1.91"
