@@ -296,21 +296,33 @@ def submissions(folder: pathlib.Path, unpacked: pathlib.Path) -> dict[str, pathl
             found[entry.name] = entry
         elif entry.suffix == ".zip" and entry.is_file():
             target = unpacked / entry.stem
-            target.mkdir(parents=True, exist_ok=True)
-            try:
-                with zipfile.ZipFile(entry) as z:
-                    for member in z.infolist():  # no absolute paths, no "..": stay inside
-                        name = pathlib.PurePosixPath(member.filename)
-                        if member.is_dir() or name.is_absolute() or ".." in name.parts:
-                            continue
-                        dest = target / name
-                        dest.parent.mkdir(parents=True, exist_ok=True)
-                        with z.open(member) as src, dest.open("wb") as dst:
-                            shutil.copyfileobj(src, dst, 1 << 20)
-            except (zipfile.BadZipFile, OSError):
-                pass
+            if not target.is_dir():  # unpacked aside, then renamed: tasks running at once
+                partial = unpacked / f".{entry.stem}.partial-{os.getpid()}"
+                unzip(entry, partial)
+                try:
+                    os.rename(partial, target)
+                except OSError:  # another task's copy came first
+                    shutil.rmtree(partial, ignore_errors=True)
             found.setdefault(entry.stem, target)
     return found
+
+
+def unzip(archive: pathlib.Path, target: pathlib.Path) -> None:
+    """Unpack a hand-in zip into `target`: no absolute paths, no "..", nothing outside. A zip
+    that cannot be read leaves an empty folder, which the grader refuses, naming the files."""
+    target.mkdir(parents=True, exist_ok=True)
+    try:
+        with zipfile.ZipFile(archive) as z:
+            for member in z.infolist():
+                name = pathlib.PurePosixPath(member.filename)
+                if member.is_dir() or name.is_absolute() or ".." in name.parts:
+                    continue
+                dest = target / name
+                dest.parent.mkdir(parents=True, exist_ok=True)
+                with z.open(member) as src, dest.open("wb") as dst:
+                    shutil.copyfileobj(src, dst, 1 << 20)
+    except (zipfile.BadZipFile, OSError):
+        pass
 
 
 def previous(out: pathlib.Path, student: str) -> dict | None:
@@ -327,6 +339,17 @@ def eta(done: int, total: int, elapsed: float) -> str:
     return f", about {left / 60:.0f} min left" if left >= 90 else f", about {left:.0f} s left"
 
 
+def write_report(out: pathlib.Path, lab: str, rows: dict[str, dict | None],
+                 submitters: dict[str, str] | None) -> None:
+    rows = {s: r if r is not None else {"score": 0, "output": "not graded", "tests": []}
+            for s, r in rows.items()}
+    write_csv(out / "grades.csv", lab, rows, submitters)
+    write_html(out / "report.html", lab, rows)
+    count = sum(flagged(r) for r in rows.values())
+    print(f"wrote {out / 'grades.csv'} and {out / 'report.html'}: {len(rows)} students, "
+          f"{count} flagged{' (regrade them: make grade-batch ... ONLY=flagged)' if count else ''}")
+
+
 def main(argv=None) -> int:
     p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     p.add_argument("lab", choices=sorted(RUBRICS))
@@ -336,24 +359,43 @@ def main(argv=None) -> int:
     p.add_argument("--only", choices=["flagged"],
                    help="regrade only the students an earlier run of this REPORT flagged, with "
                         "its saved secret, and merge them into its grades")
+    p.add_argument("--task", type=int, metavar="K",
+                   help="grade only the K-th submission (from 0, in name order), with REPORT's "
+                        "saved secret: one task of a Slurm job array (grading/slurm.py)")
+    p.add_argument("--merge", action="store_true",
+                   help="grade nothing: write grades.csv and report.html from REPORT's results")
     a = p.parse_args(argv)
     if not a.submissions.is_dir():
         print(f"error: {a.submissions}: not a folder of submissions", file=sys.stderr)
         return 2
-    if a.only and not (a.out / SECRET_FILE).is_file():
-        print(f"error: ONLY=flagged needs an earlier batch's report in {a.out} (its secret "
-              f"and results); none there", file=sys.stderr)
+    if (a.only or a.task is not None) and not (a.out / SECRET_FILE).is_file():
+        print(f"error: {'ONLY=flagged' if a.only else '--task'} needs an earlier batch's "
+              f"report in {a.out} (its secret and results); none there", file=sys.stderr)
         return 2
     # One secret for the batch, saved for regrades: every student gets the same hidden scene.
     env = {**os.environ, "GRADING_SECRET": batch_secret(a.out)}
     extra = ["--run-seconds", str(a.run_seconds)] if a.run_seconds else []
     submitters = export_submitters(a.submissions)
-    with tempfile.TemporaryDirectory(prefix="grade-batch-") as unpacked:
-        found = submissions(a.submissions, pathlib.Path(unpacked))
+    # A task's zips are unpacked where every task and the merge see them; a whole batch's
+    # in a temporary folder.
+    keep = a.task is not None or a.merge
+    unpacked = a.out / ".unpacked" if keep else pathlib.Path(tempfile.mkdtemp(prefix="grade-batch-"))
+    try:
+        found = submissions(a.submissions, unpacked)
         if submitters is not None:  # a Gradescope export: its submissions, by its metadata
             found = {name: folder for name, folder in found.items() if name in submitters}
         rows = {student: previous(a.out, student) for student in found}
-        todo = [s for s in found if not a.only or rows[s] is None or flagged(rows[s])]
+        if a.merge:
+            write_report(a.out, a.lab, rows, submitters)
+            return 0
+        if a.task is not None:
+            if not 0 <= a.task < len(found):
+                print(f"error: --task {a.task}: there are {len(found)} submissions (0 to "
+                      f"{len(found) - 1})", file=sys.stderr)
+                return 2
+            todo = [list(found)[a.task]]
+        else:
+            todo = [s for s in found if not a.only or rows[s] is None or flagged(rows[s])]
         if a.only:
             print(f"regrading {len(todo)} flagged of {len(found)} students with the batch's "
                   f"saved secret", flush=True)
@@ -366,13 +408,11 @@ def main(argv=None) -> int:
             note = " (flagged)" if flagged(r) else ""
             print(f"[{k}/{len(todo)}] {student}: {r.get('score', 0)}/{r.get('max_score', '')}"
                   f"{note} {failure_cause(r)}".rstrip(), flush=True)
-    rows = {s: r if r is not None else {"score": 0, "output": "not graded", "tests": []}
-            for s, r in rows.items()}
-    write_csv(a.out / "grades.csv", a.lab, rows, submitters)
-    write_html(a.out / "report.html", a.lab, rows)
-    count = sum(flagged(r) for r in rows.values())
-    print(f"wrote {a.out / 'grades.csv'} and {a.out / 'report.html'}: {len(rows)} students, "
-          f"{count} flagged{' (regrade them: make grade-batch ... ONLY=flagged)' if count else ''}")
+    finally:
+        if not keep:
+            shutil.rmtree(unpacked, ignore_errors=True)
+    if a.task is None:
+        write_report(a.out, a.lab, rows, submitters)
     return 0
 
 

@@ -1,7 +1,7 @@
 # The grader's make targets (make grade, gradescope, release, grade-batch).
 # `make grade` itself is in the Makefile; grading/README.md explains the grader.
 
-.PHONY: gradescope grade-batch release
+.PHONY: gradescope grade-batch grade-slurm release
 
 # make gradescope LAB=NN: the Gradescope autograder zip for lab NN in build/.
 gradescope:
@@ -24,3 +24,11 @@ release:
 	@test -f grading/release.py || \
 	    { echo "release: made from the course repository; this is a release" >&2; exit 2; }
 	@$(PYTHON) -m grading.release '$(LAB)' '$(OUT)'
+
+# make grade-slurm LAB=NN SUBMISSIONS=DIR [REPORT=DIR] [PARTITION=P]: the same as a Slurm job
+# array, one task per submission, and a merge job for grades.csv and report.html
+# (grading/slurm.py).
+grade-slurm:
+	@test -n "$(SUBMISSIONS)" || { echo "grade-slurm: needs SUBMISSIONS=DIR" >&2; exit 2; }
+	@$(PYTHON) -m grading.slurm $(LAB) $(SUBMISSIONS) --out $(or $(REPORT),grades) \
+	    $(if $(PARTITION),--partition $(PARTITION))
