@@ -21,20 +21,23 @@ machine). Progress goes to stdout as `[k/N] name ...` with an estimate of the ti
 from __future__ import annotations
 
 import argparse
+import concurrent.futures
 import csv
 import html
 import json
 import os
 import pathlib
+import queue
 import re
 import shutil
 import subprocess
 import sys
 import tempfile
+import threading
 import time
 import zipfile
 
-from grading import hidden
+from grading import gpu, hidden
 from grading.grade import RUBRICS
 from grading.harness import ROOT
 
@@ -339,6 +342,61 @@ def eta(done: int, total: int, elapsed: float) -> str:
     return f", about {left / 60:.0f} min left" if left >= 90 else f", about {left:.0f} s left"
 
 
+def gpu_indices() -> list[str]:
+    """The GPUs to grade on, one submission each at once: CUDA_VISIBLE_DEVICES where set (a
+    scheduler's choice), else every GPU nvidia-smi lists; [] where there is none."""
+    visible = os.environ.get("CUDA_VISIBLE_DEVICES")
+    if visible is not None:
+        return [g for g in visible.split(",") if g.strip()]
+    try:
+        p = subprocess.run(["nvidia-smi", "--query-gpu=index", "--format=csv,noheader"],
+                           capture_output=True, text=True, timeout=30)
+    except (OSError, subprocess.TimeoutExpired):
+        return []
+    return [line.strip() for line in p.stdout.splitlines() if line.strip()] \
+        if p.returncode == 0 else []
+
+
+def grade_all(lab: str, todo: list[str], found: dict[str, pathlib.Path], out: pathlib.Path,
+              extra: list[str], env: dict, rows: dict) -> None:
+    """Grade `todo`, printing progress. A GPU lab on a host with several GPUs grades one
+    submission per GPU at once (each grader sees one GPU: its speed is timed against the
+    reference on that GPU); CPU labs, timed on the CPU's cores, one at a time."""
+    gpus = gpu_indices() if gpu.is_gpu_lab(lab) else []
+    lanes = max(1, len(gpus))
+    free = queue.Queue()
+    for g in gpus or [None]:
+        free.put(g)
+    lock = threading.Lock()
+    start, done = time.monotonic(), [0]
+
+    def one(student: str) -> None:
+        device = free.get()
+        try:
+            with lock:
+                where = f" on GPU {device}" if device is not None else ""
+                print(f"[{done[0] + 1}/{len(todo)}] {student}{where} ..."
+                      f"{eta(done[0], len(todo), time.monotonic() - start)}", flush=True)
+            local = env if device is None else {**env, "CUDA_VISIBLE_DEVICES": device}
+            r = grade_one(lab, found[student], out / student, extra, local)
+        finally:
+            free.put(device)
+        with lock:
+            rows[student] = r
+            done[0] += 1
+            note = " (flagged)" if flagged(r) else ""
+            print(f"[{done[0]}/{len(todo)}] {student}: {r.get('score', 0)}/"
+                  f"{r.get('max_score', '')}{note} {failure_cause(r)}".rstrip(), flush=True)
+
+    if lanes == 1:
+        for student in todo:
+            one(student)
+        return
+    print(f"grading on {lanes} GPUs at once", flush=True)
+    with concurrent.futures.ThreadPoolExecutor(lanes) as pool:
+        list(pool.map(one, todo))
+
+
 def write_report(out: pathlib.Path, lab: str, rows: dict[str, dict | None],
                  submitters: dict[str, str] | None) -> None:
     rows = {s: r if r is not None else {"score": 0, "output": "not graded", "tests": []}
@@ -399,15 +457,7 @@ def main(argv=None) -> int:
         if a.only:
             print(f"regrading {len(todo)} flagged of {len(found)} students with the batch's "
                   f"saved secret", flush=True)
-        start = time.monotonic()
-        for k, student in enumerate(todo, 1):
-            print(f"[{k}/{len(todo)}] {student} ...{eta(k - 1, len(todo), time.monotonic() - start)}",
-                  flush=True)
-            rows[student] = grade_one(a.lab, found[student], a.out / student, extra, env)
-            r = rows[student]
-            note = " (flagged)" if flagged(r) else ""
-            print(f"[{k}/{len(todo)}] {student}: {r.get('score', 0)}/{r.get('max_score', '')}"
-                  f"{note} {failure_cause(r)}".rstrip(), flush=True)
+        grade_all(a.lab, todo, found, a.out, extra, env, rows)
     finally:
         if not keep:
             shutil.rmtree(unpacked, ignore_errors=True)

@@ -165,3 +165,31 @@ def test_a_gradescope_export_is_graded_and_keyed_by_submission_id(tmp_path, monk
     assert rows["123456"]["submitters"] == "Ada Lovelace <ada@example.edu> (1815)"
     assert rows["123457"]["submitters"].count("<") == 2 and rows["123457"]["score"] == "0"
     assert rows["123456"]["speedup"] == "1.91"
+
+
+def test_a_gpu_lab_grades_one_submission_per_gpu_at_once(tmp_path, monkeypatch):
+    subs = tmp_path / "subs"
+    for student in ("a", "b", "c", "d"):
+        (subs / student).mkdir(parents=True)
+    monkeypatch.setenv("CUDA_VISIBLE_DEVICES", "0,1")
+    import threading
+    running, most, seen, lock = [0], [0], [], threading.Lock()
+
+    def grade_one(lab, folder, out, extra, env):
+        with lock:
+            running[0] += 1
+            most[0] = max(most[0], running[0])
+            seen.append(env["CUDA_VISIBLE_DEVICES"])
+        import time
+        time.sleep(0.3)
+        with lock:
+            running[0] -= 1
+        out.mkdir(parents=True, exist_ok=True)
+        return FAST
+    monkeypatch.setattr(batch, "grade_one", grade_one)
+    assert batch.main(["05", str(subs), "--out", str(tmp_path / "r")]) == 0
+    assert most[0] == 2 and sorted(seen) == ["0", "0", "1", "1"]
+    seen.clear()
+    most[0] = 0
+    assert batch.main(["03", str(subs), "--out", str(tmp_path / "r3")]) == 0
+    assert most[0] == 1  # a CPU lab: one at a time
