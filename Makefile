@@ -176,9 +176,10 @@ check-nvcc:
 	    -c tests/cuda/device_compile_check.cu -o $(BUILD)/cuda/device_compile_check.o
 	@echo "check-nvcc: $(words $(CORE_HEADERS)) headers of common/core (float and double builds) and the kernel check compile for sm_90"
 
+# GRADE_ARGS: more options of grading/grade.py (e.g. --budget-seconds 30)
 LAB ?= 01
 grade:
-	$(PYTHON) -m grading.grade $(LAB) --trusted
+	$(PYTHON) -m grading.grade $(LAB) --trusted $(GRADE_ARGS)
 
 # The hand-in zip of lab LAB's skeleton files, for Gradescope and make grade-batch
 # (grading/handin.py).
