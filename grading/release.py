@@ -25,6 +25,7 @@ import shutil
 import signal
 import subprocess
 import sys
+import textwrap
 
 from grading import handin, leaks, reference_bins
 from grading.gradescope import repository_files
@@ -125,8 +126,9 @@ def student_readme(lab: str, folders: dict[str, str], prebuilt: list[str]) -> st
     earlier = [f"{n} ({folders[n]})" for n in folders if n < lab]
     try_it = TRY.get(lab, GPU_TRY.format(lab=lab))
     build = "make lab02a lab02" if lab == "02" else f"make lab{lab}"
+    title = (ROOT / "handouts" / f"{name}.md").read_text().splitlines()[0].lstrip("# ")
     return f"""\
-# Lab {lab}: {name.split("-", 1)[1]}
+# {title}
 
 Read `handouts/{name}.md` first: it teaches the lab, says how it is graded and what to hand in.
 
@@ -150,8 +152,10 @@ writes `results.json` and, where an image check fails, `grading-heatmaps/report.
 
 What else is here:
 - the reference binaries of lab {lab} and later, prebuilt for x86-64 Linux in
-  `reference-bin/`: {", ".join(f"`{b}`" for b in prebuilt)}. Any `make` copies them to the
-  top of this folder (`./lab{lab}-ref`); run them from here or give `--scene`.
+  `reference-bin/`, which any `make` copies to the top of this folder (`./lab{lab}-ref`); run
+  them from here or give `--scene`:
+{textwrap.fill(", ".join(f"`{b}`" for b in prebuilt), 92, initial_indent="  ",
+               subsequent_indent="  ")}.
 - {f"the solutions of labs {', '.join(earlier)}: lab {lab} builds on them." if earlier
    else "no solutions: this is the first lab."}
 - {f"the skeletons of labs {', '.join(later)}." if later else "no later lab."}
