@@ -234,3 +234,25 @@ def test_grade_defaults_to_the_lab_and_handin_packs_what_it_grades(finished):
                      f"--results sub.json --budget-seconds 0", timeout=1200)
     assert f"Lab {lab} " in p.stdout and "does not compile" not in p.stdout, \
         p.stdout + p.stderr
+
+
+def test_make_help_has_a_students_and_a_staff_section():
+    out = subprocess.run(["make", "-s", "-C", str(ROOT), "help"], capture_output=True,
+                         text=True, check=True, env=CLEAN_ENV).stdout
+    students, staff = out.split("For course staff")
+    assert students.startswith("For students")
+    for target in ("make grade ", "make handin", "make render", "make test", "make bench-cpu"):
+        assert target in students, target
+    for target in ("make release", "make gradescope", "make grade-batch", "make grade-slurm"):
+        assert target in staff and target not in students, target
+
+
+def test_bench_cpu_builds_only_what_it_times():
+    """Not every binary of the course (the CUDA labs for six architectures): `make -n` shows
+    no prerequisite of bench-cpu, and the tool names the CPU binaries it builds."""
+    p = subprocess.run(["make", "-n", "-C", str(ROOT), "bench-cpu"], capture_output=True,
+                       text=True, check=True, env=CLEAN_ENV)
+    assert [line for line in p.stdout.splitlines() if "bench_cpu.py" in line] and \
+        "nvcc" not in p.stdout and "g++" not in p.stdout, p.stdout
+    source = (ROOT / "tools" / "bench_cpu.py").read_text()
+    assert "load average" in source and "capacity" in source
