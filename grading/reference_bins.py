@@ -171,8 +171,8 @@ ifeq ($(firstword $(MAKEFILE_LIST)),Makefile)
 GOALS := $(or $(MAKECMDGOALS),help)
 OWN_GOALS := $(filter $(PREBUILT) test test-labs,$(GOALS))
 OTHER_GOALS := $(filter-out $(OWN_GOALS),$(GOALS))
-INNER = $(MAKE) --no-print-directory -f Makefile -f GNUmakefile $(addprefix -o ,$(PREBUILT)) \\
-        LAB=$(LAB)
+# $(MAKE) is written out in each recipe, so that make -n runs the inner make too.
+INNER = --no-print-directory -f Makefile -f GNUmakefile $(addprefix -o ,$(PREBUILT)) LAB=$(LAB)
 .PHONY: $(filter-out $(PREBUILT),$(GOALS)) release-prebuilt release-goals
 .DEFAULT_GOAL := $(firstword $(GOALS))
 
@@ -182,7 +182,7 @@ $(PREBUILT): %: reference-bin/%
 release-prebuilt: $(PREBUILT)
 
 test: release-prebuilt
-\t@$(INNER) deps test-unit
+\t@$(MAKE) $(INNER) deps test-unit
 \t$(PYTHON) -m pytest -q tests
 test-labs: release-prebuilt
 \t$(PYTHON) -m pytest -q tests
@@ -190,7 +190,7 @@ test-labs: release-prebuilt
 ifneq ($(OTHER_GOALS),)
 $(OTHER_GOALS): release-goals ; @:
 release-goals: release-prebuilt
-\t@$(INNER) $(OTHER_GOALS)
+\t@$(MAKE) $(INNER) $(OTHER_GOALS)
 endif
 endif
 """

@@ -211,6 +211,18 @@ def test_release_is_a_repository_with_one_commit(finished):
     assert shown.startswith(f"# Lab {lab}") and "make handin" in shown
 
 
+def test_unit_tests_build_against_the_students_copies(finished):
+    """In labs whose students write a shared file (lab 01's path_tracer.h), the unit tests
+    compile with the student's folder first on the include path, as the lab binary does."""
+    lab, release = finished
+    p = run(release, "make -n -B -s build/unit_tests")
+    compiles = [line for line in p.stdout.splitlines() if "-c tests/unit/" in line]
+    assert compiles, p.stdout + p.stderr
+    own = f"-Ilabs/{FOLDERS[lab]}/skeleton"
+    writes_shared = bool(leaks.skeletons.SHARED_SOURCES.get(FOLDERS[lab]))
+    assert all((own in line) == writes_shared for line in compiles), compiles[0]
+
+
 def test_render_and_test_pass(finished):
     lab, release = finished
     for command in ("make render", "make test"):
