@@ -52,39 +52,47 @@ DOUBLE_LIB_OBJ    := $(LIB_OBJ:$(BUILD)/%=$(DOUBLE_BUILD)/%)
 DOUBLE_COMMON_OBJ := $(COMMON_OBJ:$(BUILD)/%=$(DOUBLE_BUILD)/%)
 
 PHONY_EXTRA := variant
-PHONY_EXTRA += render grade check-nvcc bench-micro bench-cpu bench-serial count-work bench-precision
+PHONY_EXTRA += render grade handin check-nvcc bench-micro bench-cpu bench-serial count-work bench-precision
 .PHONY: all help deps labs $(PHONY_EXTRA) test test-unit test-labs skeletons check-skeletons golden bench tradeoff \
         clean
 .DEFAULT_GOAL := help
 
 help:
-	@echo "make labNN        build your code for lab NN (labs/NN-name/skeleton) into ./labNN"
-	@echo "make labNN-ref    build lab NN's reference solution into ./labNN-ref"
-	@echo "                  labs: $(LAB_BINARIES)"
-	@echo "make render       install what is missing, render the default scene to cornell.ppm"
-	@echo "                  with the fastest reference here (GPU, else OpenMP+AVX2)"
-	@echo "make deps         install what is missing (JSON library, OpenMPI, pytest, numpy, matplotlib)"
-	@echo "make grade LAB=NN grade your lab NN code (01-07): score table and results.json"
-	@echo "make check-nvcc   compile every header of common/core for the GPU (needs nvcc)"
-	@echo "make kernel-report registers, spills, stack and shared memory of every CUDA kernel"
-	@echo "make gpu-check OUT=DIR  on a GPU machine: build, test and benchmark the CUDA labs"
-	@echo "make release LAB=NN OUT=DIR  the student repository for lab NN (grading/README.md)"
-	@echo "make lab05-bench  the lab-05 kernel shapes the handout measures (needs a GPU)"
-	@echo "make test         build everything and run every test"
-	@echo "make bench        the report's Tables 4-7 here: every lab, baseline + 3 sweeps, with"
-	@echo "                  plots (QUICK=1: CI size; SCALE=K: sides / K; full: ~25 min a round, 2 cores)"
-	@echo "make bench-serial time the lab-01 reference on the Cornell baseline (minutes)"
-	@echo "make bench-cpu    the CPU labs side by side (the report's Table 4 for this machine)"
-	@echo "make bench-micro  Google Benchmark of the inner loops (closest hit, shadow ray, path)"
-	@echo "make count-work   instructions per camera path, split by query (needs valgrind)"
-	@echo "make tradeoff     speed against accuracy: error vs time of every lab here, bias vs"
-	@echo "                  bounces, fast math, ray offsets; checked, plotted (QUICK=1: CI size;"
-	@echo "                  PLOTS=0: no matplotlib; tools/tradeoff_gpu.sh: the GPU machine's)"
-	@echo "make lab01-ref-double  lab 01's reference computing in double (lab05-ref-double: GPU)"
-	@echo "make bench-precision  float against double: time and error of lab 01's reference"
-	@echo "make golden       regenerate the golden images in reference/ (minutes)"
-	@echo "make skeletons    regenerate the skeletons from the solutions"
-	@echo "make clean        remove build products"
+	@echo "For students"
+	@echo "  make labNN        build your code for lab NN (labs/NN-name/skeleton) into ./labNN"
+	@echo "  make labNN-ref    lab NN's reference solution into ./labNN-ref"
+	@echo "  make grade        grade your code (LAB=NN: which lab): score table and results.json"
+	@echo "  make handin       handin-labNN.zip of your lab's files, for Gradescope (LAB=NN)"
+	@echo "  make render       render the default scene to cornell.ppm with the fastest"
+	@echo "                    reference here (GPU, else OpenMP+AVX2)"
+	@echo "  make test         the unit tests of common/ and the lab tests"
+	@echo "  make deps         install what is missing (JSON library, OpenMPI, pytest, numpy, matplotlib)"
+	@echo "  make bench-serial time the lab-01 reference on the Cornell baseline (minutes)"
+	@echo "  make bench-cpu    the CPU labs side by side with load and capacity (Table 4 here)"
+	@echo "  make tradeoff     speed against accuracy: error vs time of every lab here, bias vs"
+	@echo "                    bounces, fast math, ray offsets (QUICK=1: CI size; PLOTS=0: no plots)"
+	@echo "  make lab05-bench  the lab-05 kernel shapes the handout measures (needs a GPU)"
+	@echo "                    labs: $(LAB_BINARIES)"
+	@echo "For course staff"
+	@echo "  make release LAB=NN OUT=DIR  the student repository for lab NN (grading/README.md)"
+	@echo "  make gradescope LAB=NN       the Gradescope autograder zip for lab NN, in build/"
+	@echo "  make grade-batch LAB=NN SUBMISSIONS=DIR [REPORT=DIR]  grade a class: one folder"
+	@echo "                    or hand-in zip per student, or Gradescope's export as it comes;"
+	@echo "                    grades.csv and report.html in REPORT (ONLY=flagged: regrade those)"
+	@echo "  make grade-slurm LAB=NN SUBMISSIONS=DIR [REPORT=DIR]  the same as a Slurm job array"
+	@echo "  make bench        the report's Tables 4-7 here: every lab, baseline + 3 sweeps"
+	@echo "                    (QUICK=1: CI size; SCALE=K: sides / K; full: ~25 min a round, 2 cores)"
+	@echo "  make bench-micro  Google Benchmark of the inner loops (closest hit, shadow ray, path)"
+	@echo "  make count-work   instructions per camera path, split by query (needs valgrind)"
+	@echo "  make lab01-ref-double  lab 01's reference in double (lab05-ref-double: GPU)"
+	@echo "  make bench-precision  float against double: time and error of lab 01's reference"
+	@echo "  make check-nvcc   compile every header of common/core for the GPU (needs nvcc)"
+	@echo "  make kernel-report registers, spills, stack and shared memory of every CUDA kernel"
+	@echo "  make gpu-check OUT=DIR  on a GPU machine: build, test and benchmark the CUDA labs"
+	@echo "  make golden       regenerate the golden images in reference/ (minutes)"
+	@echo "  make skeletons    regenerate the skeletons from the solutions (check-skeletons: check)"
+	@echo "  make labs         every binary of the course (needs the solutions)"
+	@echo "  make clean        remove build products"
 
 deps:
 	@bash tools/install_deps.sh
@@ -182,9 +190,15 @@ check-nvcc:
 	    -c tests/cuda/device_compile_check.cu -o $(BUILD)/cuda/device_compile_check.o
 	@echo "check-nvcc: $(words $(CORE_HEADERS)) headers of common/core (float and double builds) and the kernel check compile for sm_90"
 
+# GRADE_ARGS: more options of grading/grade.py (e.g. --budget-seconds 30)
 LAB ?= 01
 grade:
-	$(PYTHON) -m grading.grade $(LAB) --trusted
+	$(PYTHON) -m grading.grade $(LAB) --trusted $(GRADE_ARGS)
+
+# The hand-in zip of lab LAB's skeleton files, for Gradescope and make grade-batch
+# (grading/handin.py).
+handin:
+	@$(PYTHON) -m grading.handin $(LAB)
 
 golden: lab01-ref
 	$(PYTHON) tools/make_golden.py
@@ -196,8 +210,9 @@ bench: lab01-ref
 	$(PYTHON) tools/bench_report.py --out $(REPORTS)/bench \
 	    $(if $(filter 1 true yes,$(QUICK)),--quick) $(if $(SCALE),--scale $(SCALE))
 
+# BENCH_ARGS: more options of tools/bench_serial.py (--repeat N, --small)
 bench-serial: lab01-ref
-	$(PYTHON) tools/bench_serial.py baseline
+	$(PYTHON) tools/bench_serial.py baseline $(BENCH_ARGS)
 
 $(BUILD)/intersect_bench: $(BUILD)/bench/intersect_bench.o $(LIB_OBJ)
 	$(CXX) $(CXXFLAGS) $^ -o $@ -lbenchmark -pthread
@@ -206,7 +221,8 @@ $(BUILD)/intersect_bench: $(BUILD)/bench/intersect_bench.o $(LIB_OBJ)
 $(BUILD)/quad_experiment: $(BUILD)/bench/quad_experiment.o $(LIB_OBJ)
 	$(CXX) $(CXXFLAGS) $^ -o $@
 
-bench-cpu: labs
+# Builds only the binaries it times (tools/bench_cpu.py), each that builds here.
+bench-cpu:
 	$(PYTHON) tools/bench_cpu.py
 
 count-work:

@@ -5,22 +5,39 @@ with the same hidden scene; a CSV for the gradebook and an HTML page to read.
     python3 -m grading.batch 01 SUBMISSIONS --out REPORT
     make grade-batch LAB=01 SUBMISSIONS=DIR REPORT=DIR
 
-SUBMISSIONS/<student>/ holds either a lab binary named `lab` or the student's sources
-(render.cpp...). REPORT/<student>/results.json is each student's results.json;
-REPORT/grades.csv and REPORT/report.html sum them up.
+SUBMISSIONS may be Gradescope's export of the assignment, unzipped as it comes
+(submission_<id>/ folders and submission_metadata.yml): grades.csv is then keyed by the
+export's submission ids and names each one's submitters. Otherwise SUBMISSIONS/<student>/
+holds either a lab binary named `lab` or the student's hand-in (its
+files, at the top or in one folder below: grading/handin.py finds them); SUBMISSIONS/
+<student>.zip is a hand-in zip as `make handin` writes it. REPORT/<student>/results.json is
+each student's results.json; REPORT/grades.csv and REPORT/report.html sum them up: per
+student the points, the provisional points apart (a check the machine was too busy to
+measure), the timed seconds, speedup and capacity, and the cause of a failure (compile
+error, crash, timeout, race, which image check); a last row sums up the class and counts
+the flagged (provisional, or not graded for the machine's sake: regrade those on a quiet
+machine). Progress goes to stdout as `[k/N] name ...` with an estimate of the time left.
 """
 from __future__ import annotations
 
 import argparse
+import concurrent.futures
 import csv
 import html
 import json
 import os
 import pathlib
+import queue
+import re
+import shutil
 import subprocess
 import sys
+import tempfile
+import threading
+import time
+import zipfile
 
-from grading import hidden
+from grading import gpu, hidden
 from grading.grade import RUBRICS
 from grading.harness import ROOT
 
@@ -41,16 +58,129 @@ def grade_one(lab: str, folder: pathlib.Path, out: pathlib.Path, extra: list[str
         return {"score": 0, "output": f"the grader left no results.json: {e}", "tests": []}
 
 
-def write_csv(path: pathlib.Path, lab: str, rows: dict[str, dict]) -> None:
+SPEED_CHECKS = ("parallel-speedup", "speedup", "speed")
+# What the speed checks print (grading/checks.py): "... 1.85x over the serial reference
+# (0.600 s -> 0.324 s) on 2 cores giving 1.98x capacity ..." and "1.62x (0.412 s -> 0.254 s
+# wall clock ...)". Structured numbers in a test's extra_data, where the grader gives them,
+# come first.
+SPEED = re.compile(r"(?P<speedup>\d+(?:\.\d+)?)x (?:over the serial reference )?"
+                   r"\((?P<reference>\d+(?:\.\d+)?) s -> (?P<yours>\d+(?:\.\d+)?) s")
+CAPACITY = re.compile(r"giving (?P<capacity>\d+(?:\.\d+)?)x capacity|"
+                      r"gave only (?P<busy>\d+(?:\.\d+)?) cores")
+# The cause of a failure, from what the failing check or the grader said: first match wins.
+CAUSES = [
+    ("no results", re.compile(r"left no results\.json")),
+    ("compile error", re.compile(r"does not compile")),
+    ("no hand-in", re.compile(r"the hand-in holds (none|lab)")),
+    ("timeout", re.compile(r"timed out")),
+    ("race", re.compile(r"nondeterministic|data race|differs? for|differs from the serial")),
+    ("signal", re.compile(r"killed by|signal|SIG[A-Z]+")),
+    ("crash", re.compile(r"exit status|exited with|could not run")),
+    ("no sandbox", re.compile(r"without a sandbox")),
+    ("no GPU", re.compile(r"NVIDIA GPU|cannot render on this machine's GPU")),
+]
+
+
+def speed_numbers(results: dict) -> dict[str, str]:
+    """Times, speedup and capacity of the speed check, as strings ("" where not measured)."""
+    found = dict(reference_s="", yours_s="", speedup="", capacity="")
+    for t in results.get("tests", []):
+        if t.get("extra_data", {}).get("check") not in SPEED_CHECKS:
+            continue
+        extra = t.get("extra_data", {})
+        m = SPEED.search(t.get("output", ""))
+        if m:
+            found.update(reference_s=m["reference"], yours_s=m["yours"], speedup=m["speedup"])
+        c = CAPACITY.search(t.get("output", ""))
+        if c:
+            found["capacity"] = c["capacity"] or c["busy"]
+        for key, name in (("reference_seconds", "reference_s"), ("seconds_reference", "reference_s"),
+                          ("yours_seconds", "yours_s"), ("seconds_yours", "yours_s"),
+                          ("speedup", "speedup"), ("capacity", "capacity")):
+            if isinstance(extra.get(key), (int, float)):
+                found[name] = f"{extra[key]:.3f}"
+    return found
+
+
+def provisional_points(results: dict) -> int:
+    """Points given without a measurement (a machine too busy): the regrade decides them."""
+    return sum(t.get("score", 0) for t in results.get("tests", [])
+               if t.get("extra_data", {}).get("regrade"))
+
+
+def flagged(results: dict) -> bool:
+    """To be graded again on a quiet machine: provisional points, or refused for the
+    machine's sake (no GPU), or no results at all."""
+    return (any(t.get("extra_data", {}).get("regrade") for t in results.get("tests", []))
+            or not results.get("tests"))
+
+
+def failure_cause(results: dict) -> str:
+    """Why points were lost, in a few words, with the first failing check's words: the
+    compiler's first error, a signal, a timeout, a race, which image check."""
+    tests = results.get("tests", [])
+    top = results.get("output", "")
+    failing = [t for t in tests if t.get("status") != "passed"
+               and not t.get("output", "").startswith("not graded until")]
+    texts = [top] + [f"{t['name']}: {t.get('output', '')}" for t in failing]
+    for cause, pattern in CAUSES:
+        for text in texts:
+            if pattern.search(text):
+                if cause == "compile error":  # the compiler's first line after the note
+                    lines = top.splitlines()
+                    at = next((i for i, line in enumerate(lines) if "does not compile" in line), 0)
+                    after = [line for line in lines[at + 1:] if line.strip()]
+                    return f"compile error: {after[0][:200] if after else ''}".rstrip(": ")
+                return f"{cause}: {text.splitlines()[0][:200]}"
+    if failing:
+        t = failing[0]
+        kind = "image check" if t.get("extra_data", {}).get("check", "").startswith(
+            ("golden", "hidden", "sphere", "lit", "glass", "scale")) else "check"
+        return f"{kind} {t['name']}: {t.get('output', '').splitlines()[0][:200] if t.get('output') else ''}"
+    return ""
+
+
+COLUMNS = ["student", "score", "max_score", "provisional_points", "flagged", "reference_s",
+           "yours_s", "speedup", "capacity", "cause"]
+
+
+def write_csv(path: pathlib.Path, lab: str, rows: dict[str, dict],
+              submitters: dict[str, str] | None = None) -> None:
+    """One row per student, then a summary row ("(class)": mean score, flagged count). The
+    cause column is the instructor's: the check's own words, not the student hints. For a
+    Gradescope export (`submitters`) each row is keyed by the export's submission id, and
+    names its submitters."""
     labels = [i.label for i in RUBRICS[lab]]
     with path.open("w", newline="") as f:
         w = csv.writer(f)
-        w.writerow(["student", "score", "max_score", "regrade", *labels])
+        head = ["submission_id", "submitters"] if submitters is not None else []
+        w.writerow([*head, *COLUMNS, *labels])
         for student, r in rows.items():
             by_name = {t["name"]: t for t in r.get("tests", [])}
-            regrade = [t["name"] for t in r.get("tests", []) if t.get("extra_data", {}).get("regrade")]
-            w.writerow([student, r.get("score", 0), r.get("max_score", ""), ";".join(regrade),
+            numbers = speed_numbers(r)
+            key = [submission_id(student), submitters.get(student, "")] \
+                if submitters is not None else []
+            w.writerow([*key, student, r.get("score", 0), r.get("max_score", ""), provisional_points(r),
+                        "yes" if flagged(r) else "", numbers["reference_s"], numbers["yours_s"],
+                        numbers["speedup"], numbers["capacity"], failure_cause(r),
                         *(by_name.get(label, {}).get("score", "") for label in labels)])
+        w.writerow([*(["", ""] if submitters is not None else []),
+                    *summary_row(lab, rows, labels)])
+
+
+def summary_row(lab: str, rows: dict[str, dict], labels: list[str]) -> list:
+    n = len(rows)
+    scores = [r.get("score", 0) for r in rows.values()]
+    mean = f"{sum(scores) / n:.1f}" if n else ""
+    count = sum(flagged(r) for r in rows.values())
+    passed = []
+    for label in labels:
+        ok = sum(any(t["name"] == label and t.get("status") == "passed" for t in r.get("tests", []))
+                 for r in rows.values())
+        passed.append(f"{ok}/{n} passed")
+    return [f"(class: {n} students)", f"mean {mean}", max((r.get("max_score", 0) for r in rows.values()), default=""),
+            sum(provisional_points(r) for r in rows.values()), f"{count} flagged", "", "", "", "",
+            f"{sum(bool(failure_cause(r)) for r in rows.values())} lost points", *passed]
 
 
 def write_html(path: pathlib.Path, lab: str, rows: dict[str, dict]) -> None:
@@ -75,17 +205,207 @@ def write_html(path: pathlib.Path, lab: str, rows: dict[str, dict]) -> None:
         page = path.parent / student / "heatmaps" / "report.html"
         name = (f'<a href="{e(student)}/heatmaps/report.html">{e(student)}</a>' if page.exists()
                 else e(student))
-        body.append(f"<tr><th>{name}</th><td>{r.get('score', 0)}</td>{''.join(cells)}"
-                    f"<td>{note}</td></tr>")
+        numbers = speed_numbers(r)
+        facts = "".join(f"<td>{e(numbers[k])}</td>" for k in ("yours_s", "speedup", "capacity"))
+        flag = " (flagged)" if flagged(r) else ""
+        body.append(f"<tr><th>{name}{flag}</th><td>{r.get('score', 0)}</td>"
+                    f"<td>{provisional_points(r) or ''}</td>{facts}{''.join(cells)}"
+                    f"<td>{e(failure_cause(r))}</td><td>{note}</td></tr>")
     path.write_text(f"""<!doctype html><meta charset="utf-8"><title>Lab {lab} grades</title>
 <style>body{{font-family:sans-serif}} td,th{{padding:2px 8px;border:1px solid #ccc}}
 .passed{{background:#cfc}} .failed{{background:#fcc}} .regrade{{background:#ffc}}
 table{{border-collapse:collapse}}</style>
-<h1>Lab {lab}: {len(rows)} submissions</h1>
+<h1>Lab {lab}: {len(rows)} submissions, {sum(flagged(r) for r in rows.values())} flagged</h1>
 <p>Hover a cell for what the check saw; yellow: marked for regrade (machine too busy).</p>
-<table><tr><th>student</th><th>score</th>{head}<th>note</th></tr>
+<table><tr><th>student</th><th>score</th><th>provisional</th><th>seconds</th><th>speedup</th>
+<th>capacity</th>{head}<th>cause</th><th>note</th></tr>
 {chr(10).join(body)}</table>
 """)
+
+
+EXPORT_METADATA = "submission_metadata.yml"
+
+
+def parse_export_metadata(text: str) -> dict[str, list[dict[str, str]]]:
+    """Gradescope's submission_metadata.yml: folder -> its submitters (":name", ":sid",
+    ":email" without the colons). With PyYAML where installed; else this subset of YAML,
+    which is all the export writes for the fields read here."""
+    try:
+        import yaml
+        data = yaml.safe_load(text) or {}
+        return {str(folder): [{str(k).lstrip(":"): str(v) for k, v in person.items()}
+                              for person in (meta or {}).get(":submitters", []) or []]
+                for folder, meta in data.items()}
+    except ImportError:
+        pass
+    found: dict[str, list[dict[str, str]]] = {}
+    folder, person = None, None
+    for line in text.splitlines():
+        if re.match(r"^[^\s#][^:]*:\s*$", line):
+            folder, person = line.rstrip()[:-1].strip("'\""), None
+            found[folder] = []
+            continue
+        m = re.match(r"^\s*(- )?\s*:(name|sid|email):\s*(.*?)\s*$", line)
+        if folder is not None and m:
+            if m.group(1) or person is None:
+                person = {}
+                found[folder].append(person)
+            person[m.group(2)] = m.group(3).strip("'\"")
+    return found
+
+
+def export_submitters(folder: pathlib.Path) -> dict[str, str] | None:
+    """Gradescope's export of an assignment (its folder unzipped: submission_<id>/ folders and
+    submission_metadata.yml): submission folder -> "name <email> (sid)" of each submitter;
+    None for a plain folder of students."""
+    path = folder / EXPORT_METADATA
+    if not path.is_file():
+        return None
+    return {name: "; ".join(f"{p.get('name', '')} <{p.get('email', '')}> ({p.get('sid', '')})"
+                            for p in people)
+            for name, people in parse_export_metadata(path.read_text()).items()}
+
+
+def submission_id(folder_name: str) -> str:
+    """The export's id of a submission folder ("submission_123456" -> "123456")."""
+    return folder_name.removeprefix("submission_")
+
+
+SECRET_FILE = ".grading-secret"  # in REPORT: the batch's hidden-scene secret, for regrades
+
+
+def batch_secret(out: pathlib.Path) -> str:
+    """The batch's secret: the one saved in REPORT by an earlier run (a regrade must see the
+    same hidden scene as the first grade), else $GRADING_SECRET or a new one, saved there
+    (readable by its owner only)."""
+    saved = out / SECRET_FILE
+    if saved.is_file():
+        return saved.read_text().strip()
+    secret = hidden.secret_from_environment()
+    out.mkdir(parents=True, exist_ok=True)
+    fd = os.open(saved, os.O_WRONLY | os.O_CREAT | os.O_EXCL, 0o600)
+    with os.fdopen(fd, "w") as f:
+        f.write(secret + "\n")
+    return secret
+
+
+def submissions(folder: pathlib.Path, unpacked: pathlib.Path) -> dict[str, pathlib.Path]:
+    """Student -> the folder to grade: SUBMISSIONS/<student>/, or SUBMISSIONS/<student>.zip
+    unpacked under `unpacked` (a zip that cannot be read becomes an empty folder, which the
+    grader then refuses, naming the files it lacks)."""
+    found = {}
+    for entry in sorted(folder.iterdir()):
+        if entry.is_dir():
+            found[entry.name] = entry
+        elif entry.suffix == ".zip" and entry.is_file():
+            target = unpacked / entry.stem
+            if not target.is_dir():  # unpacked aside, then renamed: tasks running at once
+                partial = unpacked / f".{entry.stem}.partial-{os.getpid()}"
+                unzip(entry, partial)
+                try:
+                    os.rename(partial, target)
+                except OSError:  # another task's copy came first
+                    shutil.rmtree(partial, ignore_errors=True)
+            found.setdefault(entry.stem, target)
+    return found
+
+
+def unzip(archive: pathlib.Path, target: pathlib.Path) -> None:
+    """Unpack a hand-in zip into `target`: no absolute paths, no "..", nothing outside. A zip
+    that cannot be read leaves an empty folder, which the grader refuses, naming the files."""
+    target.mkdir(parents=True, exist_ok=True)
+    try:
+        with zipfile.ZipFile(archive) as z:
+            for member in z.infolist():
+                name = pathlib.PurePosixPath(member.filename)
+                if member.is_dir() or name.is_absolute() or ".." in name.parts:
+                    continue
+                dest = target / name
+                dest.parent.mkdir(parents=True, exist_ok=True)
+                with z.open(member) as src, dest.open("wb") as dst:
+                    shutil.copyfileobj(src, dst, 1 << 20)
+    except (zipfile.BadZipFile, OSError):
+        pass
+
+
+def previous(out: pathlib.Path, student: str) -> dict | None:
+    try:
+        return json.loads((out / student / "results.json").read_text())
+    except (OSError, ValueError):
+        return None
+
+
+def eta(done: int, total: int, elapsed: float) -> str:
+    if not done:
+        return ""
+    left = elapsed / done * (total - done)
+    return f", about {left / 60:.0f} min left" if left >= 90 else f", about {left:.0f} s left"
+
+
+def gpu_indices() -> list[str]:
+    """The GPUs to grade on, one submission each at once: CUDA_VISIBLE_DEVICES where set (a
+    scheduler's choice), else every GPU nvidia-smi lists; [] where there is none."""
+    visible = os.environ.get("CUDA_VISIBLE_DEVICES")
+    if visible is not None:
+        return [g for g in visible.split(",") if g.strip()]
+    try:
+        p = subprocess.run(["nvidia-smi", "--query-gpu=index", "--format=csv,noheader"],
+                           capture_output=True, text=True, timeout=30)
+    except (OSError, subprocess.TimeoutExpired):
+        return []
+    return [line.strip() for line in p.stdout.splitlines() if line.strip()] \
+        if p.returncode == 0 else []
+
+
+def grade_all(lab: str, todo: list[str], found: dict[str, pathlib.Path], out: pathlib.Path,
+              extra: list[str], env: dict, rows: dict) -> None:
+    """Grade `todo`, printing progress. A GPU lab on a host with several GPUs grades one
+    submission per GPU at once (each grader sees one GPU: its speed is timed against the
+    reference on that GPU); CPU labs, timed on the CPU's cores, one at a time."""
+    gpus = gpu_indices() if gpu.is_gpu_lab(lab) else []
+    lanes = max(1, len(gpus))
+    free = queue.Queue()
+    for g in gpus or [None]:
+        free.put(g)
+    lock = threading.Lock()
+    start, done = time.monotonic(), [0]
+
+    def one(student: str) -> None:
+        device = free.get()
+        try:
+            with lock:
+                where = f" on GPU {device}" if device is not None else ""
+                print(f"[{done[0] + 1}/{len(todo)}] {student}{where} ..."
+                      f"{eta(done[0], len(todo), time.monotonic() - start)}", flush=True)
+            local = env if device is None else {**env, "CUDA_VISIBLE_DEVICES": device}
+            r = grade_one(lab, found[student], out / student, extra, local)
+        finally:
+            free.put(device)
+        with lock:
+            rows[student] = r
+            done[0] += 1
+            note = " (flagged)" if flagged(r) else ""
+            print(f"[{done[0]}/{len(todo)}] {student}: {r.get('score', 0)}/"
+                  f"{r.get('max_score', '')}{note} {failure_cause(r)}".rstrip(), flush=True)
+
+    if lanes == 1:
+        for student in todo:
+            one(student)
+        return
+    print(f"grading on {lanes} GPUs at once", flush=True)
+    with concurrent.futures.ThreadPoolExecutor(lanes) as pool:
+        list(pool.map(one, todo))
+
+
+def write_report(out: pathlib.Path, lab: str, rows: dict[str, dict | None],
+                 submitters: dict[str, str] | None) -> None:
+    rows = {s: r if r is not None else {"score": 0, "output": "not graded", "tests": []}
+            for s, r in rows.items()}
+    write_csv(out / "grades.csv", lab, rows, submitters)
+    write_html(out / "report.html", lab, rows)
+    count = sum(flagged(r) for r in rows.values())
+    print(f"wrote {out / 'grades.csv'} and {out / 'report.html'}: {len(rows)} students, "
+          f"{count} flagged{' (regrade them: make grade-batch ... ONLY=flagged)' if count else ''}")
 
 
 def main(argv=None) -> int:
@@ -94,20 +414,55 @@ def main(argv=None) -> int:
     p.add_argument("submissions", type=pathlib.Path)
     p.add_argument("--out", type=pathlib.Path, default=pathlib.Path("grades"))
     p.add_argument("--run-seconds", type=float)
+    p.add_argument("--only", choices=["flagged"],
+                   help="regrade only the students an earlier run of this REPORT flagged, with "
+                        "its saved secret, and merge them into its grades")
+    p.add_argument("--task", type=int, metavar="K",
+                   help="grade only the K-th submission (from 0, in name order), with REPORT's "
+                        "saved secret: one task of a Slurm job array (grading/slurm.py)")
+    p.add_argument("--merge", action="store_true",
+                   help="grade nothing: write grades.csv and report.html from REPORT's results")
     a = p.parse_args(argv)
     if not a.submissions.is_dir():
         print(f"error: {a.submissions}: not a folder of submissions", file=sys.stderr)
         return 2
-    # One secret for the batch: every student gets the same hidden scene.
-    env = {**os.environ, "GRADING_SECRET": hidden.secret_from_environment()}
+    if (a.only or a.task is not None) and not (a.out / SECRET_FILE).is_file():
+        print(f"error: {'ONLY=flagged' if a.only else '--task'} needs an earlier batch's "
+              f"report in {a.out} (its secret and results); none there", file=sys.stderr)
+        return 2
+    # One secret for the batch, saved for regrades: every student gets the same hidden scene.
+    env = {**os.environ, "GRADING_SECRET": batch_secret(a.out)}
     extra = ["--run-seconds", str(a.run_seconds)] if a.run_seconds else []
-    rows = {}
-    for folder in sorted(f for f in a.submissions.iterdir() if f.is_dir()):
-        rows[folder.name] = grade_one(a.lab, folder, a.out / folder.name, extra, env)
-        print(f"{folder.name}: {rows[folder.name].get('score', 0)}", flush=True)
-    write_csv(a.out / "grades.csv", a.lab, rows)
-    write_html(a.out / "report.html", a.lab, rows)
-    print(f"wrote {a.out / 'grades.csv'} and {a.out / 'report.html'}")
+    submitters = export_submitters(a.submissions)
+    # A task's zips are unpacked where every task and the merge see them; a whole batch's
+    # in a temporary folder.
+    keep = a.task is not None or a.merge
+    unpacked = a.out / ".unpacked" if keep else pathlib.Path(tempfile.mkdtemp(prefix="grade-batch-"))
+    try:
+        found = submissions(a.submissions, unpacked)
+        if submitters is not None:  # a Gradescope export: its submissions, by its metadata
+            found = {name: folder for name, folder in found.items() if name in submitters}
+        rows = {student: previous(a.out, student) for student in found}
+        if a.merge:
+            write_report(a.out, a.lab, rows, submitters)
+            return 0
+        if a.task is not None:
+            if not 0 <= a.task < len(found):
+                print(f"error: --task {a.task}: there are {len(found)} submissions (0 to "
+                      f"{len(found) - 1})", file=sys.stderr)
+                return 2
+            todo = [list(found)[a.task]]
+        else:
+            todo = [s for s in found if not a.only or rows[s] is None or flagged(rows[s])]
+        if a.only:
+            print(f"regrading {len(todo)} flagged of {len(found)} students with the batch's "
+                  f"saved secret", flush=True)
+        grade_all(a.lab, todo, found, a.out, extra, env, rows)
+    finally:
+        if not keep:
+            shutil.rmtree(unpacked, ignore_errors=True)
+    if a.task is None:
+        write_report(a.out, a.lab, rows, submitters)
     return 0
 
 

@@ -288,7 +288,7 @@ def check_structure_of_arrays(binary) -> CheckResult:
     """Lab 07's lesson, which speed cannot grade: on the H200 lab 06's array of structures is
     within 10% of the structure of arrays (handouts/07-soa.md). The binary reports where its
     path pool puts the same field of two neighbouring queued paths (a probe that stores two
-    paths with the submission's own code and searches the memory: labs/06-cuda-split/
+    paths with the submission's own code and searches the memory: common/wavefront/
     layout_probe.cuh); a structure of arrays puts them one 4-byte word apart."""
     json = run_lab(binary, width=4, height=4, spp=1).json or {}
     layout = json.get("layout") if isinstance(json.get("layout"), dict) else {}

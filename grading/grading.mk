@@ -1,17 +1,20 @@
 # The grader's make targets (make grade, gradescope, release, grade-batch).
 # `make grade` itself is in the Makefile; grading/README.md explains the grader.
 
-.PHONY: gradescope grade-batch release
+.PHONY: gradescope grade-batch grade-slurm release
 
 # make gradescope LAB=NN: the Gradescope autograder zip for lab NN in build/.
 gradescope:
 	$(PYTHON) -m grading.gradescope $(LAB)
 
-# make grade-batch LAB=NN SUBMISSIONS=DIR [REPORT=DIR]: one folder per student, graded in the
-# sandbox; REPORT (default grades/) gets each results.json, grades.csv and report.html.
+# make grade-batch LAB=NN SUBMISSIONS=DIR [REPORT=DIR] [ONLY=flagged]: one folder or hand-in
+# zip per student, graded in the sandbox; REPORT (default grades/) gets each results.json,
+# grades.csv and report.html. ONLY=flagged regrades the students that REPORT flagged, with
+# its saved secret.
 grade-batch:
 	@test -n "$(SUBMISSIONS)" || { echo "grade-batch: needs SUBMISSIONS=DIR" >&2; exit 2; }
-	$(PYTHON) -m grading.batch $(LAB) $(SUBMISSIONS) --out $(or $(REPORT),grades)
+	@$(PYTHON) -m grading.batch $(LAB) $(SUBMISSIONS) --out $(or $(REPORT),grades) \
+	    $(if $(ONLY),--only $(ONLY))
 
 # make release LAB=NN OUT=DIR: the student repository for lab NN (grading/release.py). LAB and
 # OUT have defaults in the Makefiles (for make grade, make gpu-check); a release must name both.
@@ -34,3 +37,10 @@ cuda-variant-driver: $(COMMON_OBJ)
 .PHONY: test-gradescope
 test-gradescope:
 	$(PYTHON) grading/gradescope/test_gradescope.py
+# make grade-slurm LAB=NN SUBMISSIONS=DIR [REPORT=DIR] [PARTITION=P]: the same as a Slurm job
+# array, one task per submission, and a merge job for grades.csv and report.html
+# (grading/slurm.py).
+grade-slurm:
+	@test -n "$(SUBMISSIONS)" || { echo "grade-slurm: needs SUBMISSIONS=DIR" >&2; exit 2; }
+	@$(PYTHON) -m grading.slurm $(LAB) $(SUBMISSIONS) --out $(or $(REPORT),grades) \
+	    $(if $(PARTITION),--partition $(PARTITION))

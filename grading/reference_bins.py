@@ -37,8 +37,13 @@ from grading.harness import ROOT
 # time themselves against. Lab 02 has two parts, and Part B two references: lab02-ref-avx2 is
 # what students write (8 AVX2 lanes), the yardstick of their speed; lab02-ref runs at the
 # CPU's width with compacted packets (handout 02, section 8).
-REFERENCES = {"01": ["lab01-ref"], "02": ["lab02-ref", "lab02-ref-avx2", "lab02a-ref"],
-              "03": ["lab03-ref"], "04": ["lab04-ref"], "05": ["lab05-ref"], "06": ["lab06-ref"],
+# Besides the references themselves, the binaries built from a lab's solution that its
+# handout runs: lab 02's worked example (lab02-prims), lab 03's schedule benchmark
+# (lab03-bench) and the OpenMP/MPI references over lab 02's packets (`make render`'s
+# renderer, handout 02's comparison).
+REFERENCES = {"01": ["lab01-ref"], "02": ["lab02-ref", "lab02-ref-avx2", "lab02a-ref", "lab02-prims"],
+              "03": ["lab03-ref", "lab03-bench", "lab03-simd-ref"],
+              "04": ["lab04-ref", "lab04-simd-ref"], "05": ["lab05-ref"], "06": ["lab06-ref"],
               "07": ["lab07-ref"]}
 # Built where nvcc is; a release without them says so (GPU labs then build only the
 # student's own code).
@@ -139,39 +144,55 @@ def build(targets: list[str], files: list[str], dest: pathlib.Path) -> tuple[lis
         return built, log
 
 
-def front_door(lab: str, prebuilt: list[str]) -> str:
-    """The release's GNUmakefile: `make X` for a prebuilt X copies reference-bin/X into place,
-    `make test` runs the release's own tests; every other goal is Makefile's, unchanged."""
+def front_door(lab: str, prebuilt: list[str], student_folders: list[str]) -> str:
+    """The release's GNUmakefile. GNU make reads it before Makefile, twice over:
+    - as the front door (`make X`): it copies each prebuilt reference out of reference-bin/
+      where missing or older, then runs Makefile for the goals with `-o` for every prebuilt
+      one (`--assume-old`: never rebuilt, so a target that needs ./lab01-ref, such as
+      bench-serial, finds the copy rather than linking a solution the release lacks);
+    - after Makefile, in that inner run (`-f Makefile -f GNUmakefile`), to compile the unit
+      tests against the student's own copies of shared files (`student_folders` first on
+      their include path), as the student's lab binary is.
+    `make test` and `make test-labs` run the release's own tests: Makefile's first build every
+    binary of the course, which needs the solutions. `LAB` defaults to the release's lab."""
+    includes = " ".join(f"-I{folder}" for folder in student_folders)
+    unit = (f"$(BUILD)/tests/unit/%.o: LAB_INCLUDES = {includes}\n" if includes
+            else "# (no shared file is the student's in this lab)\n")
     return f"""\
-# Lab {lab} release: GNU make reads this file before Makefile.
-# - Lab {lab} and the labs after it come without their solution sources, so their reference
-#   binaries are not built here: they ship prebuilt in reference-bin/ (x86-64 Linux), and
-#   `make labNN-ref` for one of them copies it into place (which is how the grader gets it).
-# - `make test` and `make test-labs` run this release's tests: Makefile's first build every
-#   binary of the course, which needs the solutions.
-# Every other goal is Makefile's, unchanged.
+# Lab {lab} release: GNU make reads this file before Makefile (see grading/README.md).
+# Lab {lab} and the labs after it come without their solution sources, so their reference
+# binaries ship prebuilt in reference-bin/ (x86-64 Linux) and are copied into place by every
+# make run; Makefile never rebuilds them (-o). Every goal is otherwise Makefile's.
 PREBUILT := {' '.join(prebuilt)}
-OWN_GOALS := $(filter $(PREBUILT) test test-labs,$(MAKECMDGOALS))
+LAB ?= {lab}
 PYTHON ?= python3
 
-ifeq ($(OWN_GOALS),)
-include Makefile
-else
-OTHER_GOALS := $(filter-out $(OWN_GOALS),$(MAKECMDGOALS))
-.PHONY: $(MAKECMDGOALS) makefile-goals
+ifeq ($(firstword $(MAKEFILE_LIST)),Makefile)
+# The inner run, read after Makefile: the unit tests see the student's copies of shared files.
+{unit}else
+GOALS := $(or $(MAKECMDGOALS),help)
+OWN_GOALS := $(filter $(PREBUILT) test test-labs,$(GOALS))
+OTHER_GOALS := $(filter-out $(OWN_GOALS),$(GOALS))
+# $(MAKE) is written out in each recipe, so that make -n runs the inner make too.
+INNER = --no-print-directory -f Makefile -f GNUmakefile $(addprefix -o ,$(PREBUILT)) LAB=$(LAB)
+.PHONY: $(filter-out $(PREBUILT),$(GOALS)) release-prebuilt release-goals
+.DEFAULT_GOAL := $(firstword $(GOALS))
+
 # Copied, then renamed: a binary that is running (a grade in progress) cannot be overwritten.
-$(filter $(PREBUILT),$(OWN_GOALS)):
-	@cp reference-bin/$@ $@.partial-copy && mv -f $@.partial-copy $@
-test:
-	@$(MAKE) --no-print-directory -f Makefile deps test-unit
-	$(PYTHON) -m pytest -q tests
-test-labs:
-	$(PYTHON) -m pytest -q tests
-# The other goals of the same command line, in one run of Makefile.
+$(PREBUILT): %: reference-bin/%
+\t@cp reference-bin/$@ $@.partial-copy && mv -f $@.partial-copy $@
+release-prebuilt: $(PREBUILT)
+
+test: release-prebuilt
+\t@$(MAKE) $(INNER) deps test-unit
+\t$(PYTHON) -m pytest -q tests
+test-labs: release-prebuilt
+\t$(PYTHON) -m pytest -q tests
+# The other goals of the command line, in one run of Makefile.
 ifneq ($(OTHER_GOALS),)
-$(OTHER_GOALS): makefile-goals ; @:
-makefile-goals:
-	@$(MAKE) --no-print-directory -f Makefile $(OTHER_GOALS)
+$(OTHER_GOALS): release-goals ; @:
+release-goals: release-prebuilt
+\t@$(MAKE) $(INNER) $(OTHER_GOALS)
 endif
 endif
 """

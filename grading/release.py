@@ -25,8 +25,9 @@ import shutil
 import signal
 import subprocess
 import sys
+import textwrap
 
-from grading import leaks, reference_bins
+from grading import handin, leaks, reference_bins
 from grading.gradescope import repository_files
 from grading.harness import ROOT
 
@@ -107,33 +108,60 @@ def add_references(stage: pathlib.Path, lab: str, files: list[str]) -> list[str]
     return sorted(built)
 
 
-def release_notes(lab: str, folders: dict[str, str], prebuilt: list[str]) -> str:
-    later = [f"{n} ({folders[n]})" for n in folders if n >= lab]
+# What a student runs to try lab NN's code at a small size, after `make labNN`.
+TRY = {
+    "01": "./lab01 --width 128 --height 128 --spp 16 --out quick.ppm",
+    "02": "./lab02 --width 128 --height 128 --spp 16 --out quick.ppm",
+    "03": "./lab03 --threads 2 --width 128 --height 128 --spp 16 --out quick.ppm",
+    "04": "mpirun -np 2 ./lab04 --width 128 --height 128 --spp 16 --out quick.ppm",
+}
+GPU_TRY = "./lab{lab} --width 128 --height 128 --spp 16 --out quick.ppm   # needs an NVIDIA GPU"
+
+
+def student_readme(lab: str, folders: dict[str, str], prebuilt: list[str]) -> str:
+    """The release's README.md: what students read first (the course's README is staff's)."""
+    name = folders[lab]
+    files = handin.handin_files(lab)
+    later = [f"{n} ({folders[n]})" for n in folders if n > lab]
     earlier = [f"{n} ({folders[n]})" for n in folders if n < lab]
-    solutions = (f"Solutions of labs {', '.join(earlier)}: lab {lab} builds on them." if earlier
-                 else "No solutions: this is the first lab.")
+    try_it = TRY.get(lab, GPU_TRY.format(lab=lab))
+    build = "make lab02a lab02" if lab == "02" else f"make lab{lab}"
+    title = (ROOT / "handouts" / f"{name}.md").read_text().splitlines()[0].lstrip("# ")
     return f"""\
-# Lab {lab} release
+# {title}
 
-Your lab: `labs/{folders[lab]}/skeleton/` (every place to fill in is marked `TODO(lab{lab})`);
-read `handouts/{folders[lab]}.md` first.
+Read `handouts/{name}.md` first: it teaches the lab, says how it is graded and what to hand in.
 
-- Skeletons of labs {', '.join(later)}.
-- {solutions}
-- Reference binaries, prebuilt for x86-64 Linux, in `reference-bin/`: {', '.join(prebuilt)}.
-  `make labNN-ref` copies one to the top (GNUmakefile), which is how the grader gets them;
-  earlier labs' references build from their solutions. Run them from this folder (their
-  default scene is `./common/scenes/cornell.json`) or give `--scene`.
+**Your code** is in `labs/{name}/skeleton/`: {", ".join(f"`{f}`" for f in files)}. Every place
+to fill in is marked `TODO(lab{lab})`. Nothing else is yours to change: the grader builds
+exactly these files with this repository's `common/`.
 
 ```sh
-make deps                 # what the labs need (JSON library, OpenMPI, pytest, numpy)
-make lab{lab}                # your code, into ./lab{lab}
-make grade LAB={lab}         # the autograder's checks on your code
-make test                 # the public tests: make test-unit (common/), make test-labs
+make deps                 # install what the labs need (compiler libraries, OpenMPI, pytest, numpy)
+{build:<25} # build your code into ./lab{lab}
+{try_it}
+make grade                # the autograder's checks on your code: a score table and results.json
+make test                 # the unit tests of common/ and the public tests
+make render               # the Cornell box with the fastest reference here, into cornell.ppm
+make handin               # handin-lab{lab}.zip: the files to upload to Gradescope
+make help                 # every command
 ```
 
-`make labs` builds every binary of the course, the references' benchmarks and variants
-included, and needs the solutions this release does not have.
+`make grade` grades lab {lab} (add `LAB=NN` for another); it builds `./lab{lab}` first and
+writes `results.json` and, where an image check fails, `grading-heatmaps/report.html`.
+
+What else is here:
+- the reference binaries of lab {lab} and later, prebuilt for x86-64 Linux in
+  `reference-bin/`, which any `make` copies to the top of this folder (`./lab{lab}-ref`); run
+  them from here or give `--scene`:
+{textwrap.fill(", ".join(f"`{b}`" for b in prebuilt), 92, initial_indent="  ",
+               subsequent_indent="  ")}.
+- {f"the solutions of labs {', '.join(earlier)}: lab {lab} builds on them." if earlier
+   else "no solutions: this is the first lab."}
+- {f"the skeletons of labs {', '.join(later)}." if later else "no later lab."}
+
+This folder is a git repository with one commit, the release as you got it: `git diff` shows
+what you changed. Commit your work as you go.
 """
 
 
@@ -148,6 +176,21 @@ def check_skeletons() -> None:
              if not path.is_file() or path.read_text() != text]
     if stale:
         raise ReleaseError(f"skeletons out of date (run make skeletons): {', '.join(stale)}")
+
+
+def commit(stage: pathlib.Path, lab: str) -> None:
+    """Make the release a git repository with one commit holding every file: students start
+    from it, and `git diff` shows them what they changed."""
+    env = {**reference_bins.make_environment(), "GIT_AUTHOR_NAME": "Course staff",
+           "GIT_AUTHOR_EMAIL": "staff@course.invalid", "GIT_COMMITTER_NAME": "Course staff",
+           "GIT_COMMITTER_EMAIL": "staff@course.invalid"}
+    for args in (["init", "-q", "--initial-branch=main"], ["add", "-A", "-f", "."],
+                 ["commit", "-q", "--no-verify", "--no-gpg-sign", "-m", f"Lab {lab} release"]):
+        p = subprocess.run(["git", "-c", "core.hooksPath=/dev/null", *args], cwd=stage, env=env,
+                           capture_output=True, text=True)
+        if p.returncode != 0:
+            raise ReleaseError(f"git {args[0]} failed: "
+                               f"{(p.stderr.strip().splitlines() or ['no output'])[-1]}")
 
 
 def make_release(lab: str, out: pathlib.Path, secret: str | None = None) -> pathlib.Path:
@@ -176,12 +219,16 @@ def make_release(lab: str, out: pathlib.Path, secret: str | None = None) -> path
         files = repository_files()
         copy_sources(stage, lab, folders, files)
         prebuilt = add_references(stage, lab, files)
-        (stage / "GNUmakefile").write_text(reference_bins.front_door(lab, prebuilt))
-        (stage / "RELEASE.md").write_text(release_notes(lab, folders, prebuilt))
+        student_folders = [f"labs/{folders[lab]}/skeleton"] \
+            if leaks.skeletons.SHARED_SOURCES.get(folders[lab]) else []
+        (stage / "GNUmakefile").write_text(
+            reference_bins.front_door(lab, prebuilt, student_folders))
+        (stage / "README.md").write_text(student_readme(lab, folders, prebuilt))
         problems = leaks.leaks(stage, lab, folders, secret)
         if problems:
             more = f" (and {len(problems) - 1} more)" if len(problems) > 1 else ""
             raise ReleaseError(f"refusing to release lab {lab}: {problems[0]}{more}")
+        commit(stage, lab)
         umask = os.umask(0)
         os.umask(umask)
         stage.chmod(0o777 & ~umask)

@@ -8,8 +8,8 @@ build/ are the references'. So a submission is compiled in a students' tree made
 - the Makefile, cuda.mk, grading/grading.mk, every lab's lab.mk and top-level files (the
   drivers a lab links), and common/ with every shared file whose solution regions belong to
   this lab or a later one in its skeleton form (what a student release holds:
-  grading/release.py), and the earlier-lab solutions a lab's own build reads (lab 07 reads
-  lab 06's);
+  grading/release.py); an earlier lab's shared files stay solutions (lab 07 builds on lab
+  06's reference queue and stage loop in common/wavefront/);
 - in its own build/, the driver objects compiled from those files, by the grader, outside the
   sandbox (course code), once per content: cached under build/students-trees/ and copied for
   each grade into a fresh folder the sandbox user may read, wherever the repository lives;
@@ -34,11 +34,6 @@ SOURCE_SUFFIXES = (".cpp", ".h", ".hpp", ".cu", ".cuh")
 MAX_FILE_BYTES = 1 << 20      # a source file of a lab is tens of KiB
 MAX_FILES = 64                # source files taken from the chosen folder
 MAX_WALK_ENTRIES = 20000      # entries looked at while searching a hand-in
-
-# Earlier labs' solutions a lab's own build reads (its lab.mk puts them on the include path):
-# lab 07 is lab 06's reference wavefront with the student's pool. A lab-07 release ships them.
-SHARED_SOLUTIONS = {"07-soa": ("labs/06-cuda-split/solution",)}
-
 
 class HandInError(Exception):
     """A hand-in that cannot be built as it is: one line for the student."""
@@ -152,8 +147,6 @@ def _tree_files(lab_folder: str) -> dict[str, bytes]:
         if lab.is_dir():
             picked += [f for f in sorted(lab.iterdir()) if f.is_file() and not f.is_symlink()]
     picked += sorted(p for p in (ROOT / "common").rglob("*") if p.is_file())
-    for folder in SHARED_SOLUTIONS.get(lab_folder, ()):
-        picked += sorted(p for p in (ROOT / folder).rglob("*") if p.is_file())
     as_skeleton = skeleton_form(lab_folder)
     skeletons = _skeletons()
     files = {}

@@ -36,6 +36,7 @@ import math
 import os
 import pathlib
 import shutil
+import subprocess
 import sys
 import tempfile
 
@@ -321,6 +322,9 @@ def run() -> int:
         return main()
     except KeyboardInterrupt:
         return 130
+    except subprocess.CalledProcessError as e:  # make said why, above
+        print(f"error: bench_openmp: `{' '.join(map(str, e.cmd))}` failed", file=sys.stderr)
+        return 2
     finally:
         shutil.rmtree(BIN, ignore_errors=True)
 

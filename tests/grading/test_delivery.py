@@ -37,6 +37,8 @@ def test_batch_grades_each_student_into_csv_and_html(tmp_path):
                         str(report)], cwd=ROOT, capture_output=True, text=True, timeout=600)
     assert p.returncode == 0, p.stdout + p.stderr
     rows = {r["student"]: r for r in csv.DictReader((report / "grades.csv").open())}
+    assert rows.pop("(class: 3 students)")["flagged"] == "0 flagged"
+    assert rows["carol"]["cause"].startswith("compile error:"), rows["carol"]
     assert {s: int(r["score"]) for s, r in rows.items()} == {"alice": 100, "bob": 0, "carol": 0}
     carol = json.loads((report / "carol" / "results.json").read_text())
     assert "does not compile" in carol["output"]

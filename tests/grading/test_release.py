@@ -128,7 +128,8 @@ def test_lab01_release_layout(pristine01):
     skeleton = (ROOT / "labs/01-serial/skeleton/path_tracer.h").read_text()
     assert (release01 / "common/core/path_tracer.h").read_text() == skeleton.split("\n", 1)[1]
     assert sorted(p.name for p in (release01 / "reference-bin").iterdir()) == \
-        sorted(["lab01-ref", "lab02-ref", "lab02-ref-avx2", "lab02a-ref", "lab03-ref", "lab04-ref"] +
+        sorted(["lab01-ref", "lab02-ref", "lab02-ref-avx2", "lab02a-ref", "lab02-prims", "lab03-ref",
+                "lab03-bench", "lab03-simd-ref", "lab04-ref", "lab04-simd-ref"] +
                [f"lab{n}-ref" for n in ("05", "06", "07") if shutil.which("nvcc")])
     for gone in ("tests/grading", "tools/skeletons.py", "grading/release.py", "ref", ".ci"):
         assert not (release01 / gone).exists(), gone
@@ -273,7 +274,7 @@ def test_interrupted_release_leaves_nothing(tmp_path, release01):
         _, err = p.communicate(timeout=120)
         assert not list(tmp_path.glob(f".{out.name}.partial-*")), err
         if p.returncode == 0:
-            assert (out / "GNUmakefile").is_file() and (out / "RELEASE.md").is_file()
+            assert (out / "GNUmakefile").is_file() and (out / ".git").is_dir()
         else:
             assert p.returncode == 130 and not out.exists(), err
             assert err.strip() == "error: release: interrupted; nothing written"

@@ -1,0 +1,117 @@
+"""A class graded as a Slurm job array, where it outgrows one machine.
+
+    make grade-slurm LAB=NN SUBMISSIONS=DIR [REPORT=DIR] [PARTITION=P]
+    python3 -m grading.slurm NN SUBMISSIONS --out REPORT [--partition P] [--no-submit]
+
+One array task per submission (`python3 -m grading.batch ... --task K`: the K-th in name
+order, in its own grader process, in the sandbox, with the batch's hidden-scene secret that
+this step saves in REPORT before anything is submitted), then a merge job that runs once every
+task has ended, however it ended (`--dependency=afterany`), and writes grades.csv and
+report.html from the tasks' results.json (`--merge`). Each task asks for one whole node
+(`--exclusive`): CPU labs are graded on speed, which another grade on the same cores would
+distort. The scripts are written to REPORT (grade-array.sbatch, merge.sbatch) and submitted
+with sbatch, whose job ids are printed; --no-submit only writes them. The repository must be
+on a file system every node sees (it is each task's working directory).
+"""
+from __future__ import annotations
+
+import argparse
+import os
+import pathlib
+import shlex
+import shutil
+import subprocess
+import sys
+import tempfile
+
+from grading import batch
+from grading.grade import RUBRICS
+from grading.harness import ROOT
+
+
+def count(submissions: pathlib.Path, out: pathlib.Path) -> int:
+    found = batch.submissions(submissions, out / ".unpacked")
+    listed = batch.export_submitters(submissions)
+    return len([s for s in found if listed is None or s in listed])
+
+
+def scripts(lab: str, submissions: pathlib.Path, out: pathlib.Path, n: int,
+            partition: str | None, run_seconds: float | None) -> tuple[str, str]:
+    """(the array job's script, the merge job's script)."""
+    q = shlex.quote
+    part = f"#SBATCH --partition={partition}\n" if partition else ""
+    extra = f" --run-seconds {run_seconds:g}" if run_seconds else ""
+    common = (f"cd {q(str(ROOT))}\n"
+              f"{q(sys.executable)} -m grading.batch {lab} {q(str(submissions))} "
+              f"--out {q(str(out))}{extra}")
+    array = f"""#!/bin/bash
+#SBATCH --job-name=grade-lab{lab}
+#SBATCH --array=0-{n - 1}
+#SBATCH --exclusive
+#SBATCH --nodes=1
+#SBATCH --output={out}/slurm-%A_%a.log
+{part}# One submission per task: the K-th in name order (grading/slurm.py).
+{common} --task "$SLURM_ARRAY_TASK_ID"
+"""
+    merge = f"""#!/bin/bash
+#SBATCH --job-name=grade-lab{lab}-merge
+#SBATCH --nodes=1
+#SBATCH --output={out}/slurm-merge-%j.log
+{part}# grades.csv and report.html from every task's results.json (grading/slurm.py).
+{common} --merge
+"""
+    return array, merge
+
+
+def sbatch(*args: str) -> str:
+    p = subprocess.run(["sbatch", "--parsable", *args], capture_output=True, text=True)
+    if p.returncode != 0:
+        raise RuntimeError((p.stderr.strip().splitlines() or ["sbatch failed"])[-1])
+    return p.stdout.strip().split(";")[0]
+
+
+def main(argv=None) -> int:
+    p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    p.add_argument("lab", choices=sorted(RUBRICS))
+    p.add_argument("submissions", type=pathlib.Path)
+    p.add_argument("--out", type=pathlib.Path, default=pathlib.Path("grades"))
+    p.add_argument("--partition")
+    p.add_argument("--run-seconds", type=float)
+    p.add_argument("--no-submit", action="store_true", help="write the scripts only")
+    a = p.parse_args(argv)
+    submissions, out = a.submissions.absolute(), a.out.absolute()
+    if not submissions.is_dir():
+        print(f"error: grade-slurm: {submissions}: not a folder of submissions", file=sys.stderr)
+        return 2
+    if not a.no_submit and shutil.which("sbatch") is None:
+        print("error: grade-slurm: no sbatch here (Slurm's client, Debian's slurm-client); "
+              "--no-submit writes the scripts only", file=sys.stderr)
+        return 2
+    batch.batch_secret(out)  # saved before any task starts: all of them read it
+    n = count(submissions, out)
+    if n == 0:
+        print(f"error: grade-slurm: no submissions in {submissions}", file=sys.stderr)
+        return 2
+    array, merge = scripts(a.lab, submissions, out, n, a.partition, a.run_seconds)
+    paths = []
+    for name, text in (("grade-array.sbatch", array), ("merge.sbatch", merge)):
+        with tempfile.NamedTemporaryFile("w", dir=out, delete=False, suffix=".partial") as f:
+            f.write(text)
+        os.replace(f.name, out / name)
+        paths.append(out / name)
+    if a.no_submit:
+        print(f"wrote {paths[0]} ({n} tasks) and {paths[1]}")
+        return 0
+    try:
+        array_id = sbatch(str(paths[0]))
+        merge_id = sbatch(f"--dependency=afterany:{array_id}", str(paths[1]))
+    except RuntimeError as e:
+        print(f"error: grade-slurm: {e}", file=sys.stderr)
+        return 2
+    print(f"submitted job array {array_id} ({n} tasks) and merge job {merge_id}: "
+          f"{out / 'grades.csv'} when it ends")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

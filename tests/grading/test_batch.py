@@ -1,0 +1,195 @@
+"""`make grade-batch` for instructors (grading/batch.py): grades.csv carries per student the
+points, provisional points apart, times, speedup, capacity and the cause of a failure, then
+a class row with the flagged count; progress is `[k/N] name ...`; hand-in zips are graded
+as folders; ONLY=flagged regrades only the flagged, with the batch's saved secret, and
+merges them. The grader itself is replaced here by recorded results (test_delivery.py grades
+real submissions)."""
+import csv
+import json
+import zipfile
+
+import pytest
+
+from grading import batch
+
+
+def result_test(check, name, score, max_score, output, passed=None, regrade=False):
+    return {"name": name, "score": score, "max_score": max_score,
+            "status": "passed" if (passed if passed is not None else score == max_score)
+            else "failed", "output": output, "extra_data": {"check": check, "regrade": regrade}}
+
+
+FAST = {"score": 100, "max_score": 100, "output": "", "tests": [
+    result_test("bitwise", "bit-identical to lab 01", 30, 30, "identical for 1 threads"),
+    result_test("parallel-speedup", "parallel speedup", 40, 40,
+         "yours 1.91x over the serial reference (0.611 s -> 0.320 s) on 2 cores giving 1.97x "
+         "capacity; needs >= 1.48x")]}
+BUSY = {"score": 70, "max_score": 100, "output": "marked for regrade", "tests": [
+    result_test("bitwise", "bit-identical to lab 01", 30, 30, "identical"),
+    result_test("parallel-speedup", "parallel speedup", 40, 40,
+         "not measurable: the machine gave only 1.12 cores' worth of throughput in 3 "
+         "attempts; points provisional, marked for regrade", regrade=True)]}
+RACY = {"score": 0, "max_score": 100, "output": "", "tests": [
+    result_test("bitwise", "bit-identical to lab 01", 0, 30, "not graded until the parallel speedup "
+         "passes"),
+    result_test("parallel-speedup", "parallel speedup", 0, 40, "the timed render differs from the "
+         "serial reference's image: speed is graded only for a correct image")]}
+BROKEN = {"score": 0, "max_score": 100,
+          "output": "the code does not compile:\nsrc/render.cpp:3:1: error: expected ';'",
+          "tests": [result_test("bitwise", "bit-identical to lab 01", 0, 30, "not graded: the code does "
+                         "not compile"),
+                    result_test("parallel-speedup", "parallel speedup", 0, 40, "not graded")]}
+
+
+def rows_of(path):
+    return list(csv.DictReader(path.open()))
+
+
+def test_csv_columns_numbers_causes_and_class_row(tmp_path, monkeypatch):
+    monkeypatch.setitem(batch.RUBRICS, "03", [type("I", (), {"label": t["name"]})()
+                                              for t in FAST["tests"]])
+    batch.write_csv(tmp_path / "g.csv", "03",
+                    {"fast": FAST, "busy": BUSY, "racy": RACY, "broken": BROKEN})
+    rows = {r["student"]: r for r in rows_of(tmp_path / "g.csv")}
+    fast, busy, racy, broken = rows["fast"], rows["busy"], rows["racy"], rows["broken"]
+    assert (fast["reference_s"], fast["yours_s"], fast["speedup"], fast["capacity"]) == \
+        ("0.611", "0.320", "1.91", "1.97")
+    assert fast["cause"] == "" and fast["flagged"] == "" and fast["provisional_points"] == "0"
+    assert busy["provisional_points"] == "40" and busy["flagged"] == "yes"
+    assert busy["capacity"] == "1.12"
+    assert racy["cause"].startswith("race: parallel speedup: the timed render differs")
+    assert broken["cause"] == "compile error: src/render.cpp:3:1: error: expected ';'"
+    summary = rows["(class: 4 students)"]
+    assert summary["score"] == "mean 42.5" and summary["flagged"] == "1 flagged"
+    assert summary["provisional_points"] == "40"
+
+
+def fake_grader(calls, results):
+    def grade_one(lab, folder, out, extra, env):
+        calls.append((folder.name, env["GRADING_SECRET"], sorted(
+            p.name for p in folder.rglob("*") if p.is_file())))
+        out.mkdir(parents=True, exist_ok=True)
+        r = results[folder.name]
+        (out / "results.json").write_text(json.dumps(r))
+        return r
+    return grade_one
+
+
+def test_progress_zips_secret_and_only_flagged(tmp_path, monkeypatch, capsys):
+    subs, report = tmp_path / "subs", tmp_path / "report"
+    (subs / "ann").mkdir(parents=True)
+    (subs / "ann" / "render.cpp").write_text("x")
+    with zipfile.ZipFile(subs / "ben.zip", "w") as z:
+        z.writestr("ben-lab03/render.cpp", "y")
+        z.writestr("../escape.cpp", "z")  # never written outside the unpacked folder
+    calls = []
+    monkeypatch.setattr(batch, "grade_one", fake_grader(calls, {"ann": FAST, "ben-lab03": BUSY,
+                                                                "ben": BUSY}))
+    monkeypatch.delenv("GRADING_SECRET", raising=False)
+    assert batch.main(["03", str(subs), "--out", str(report)]) == 0
+    out = capsys.readouterr().out
+    assert "[1/2] ann ..." in out and "[2/2] ben ..." in out and "left" in out
+    assert "1 flagged" in out
+    secret = (report / batch.SECRET_FILE).read_text().strip()
+    assert (report / batch.SECRET_FILE).stat().st_mode & 0o077 == 0
+    assert [c[0] for c in calls] == ["ann", "ben"] and {c[1] for c in calls} == {secret}
+    assert calls[1][2] == ["render.cpp"] and not (tmp_path / "escape.cpp").exists()
+    # the regrade: only ben, with the same secret, merged with ann's first grade
+    calls.clear()
+    monkeypatch.setenv("GRADING_SECRET", "another")
+    assert batch.main(["03", str(subs), "--out", str(report), "--only", "flagged"]) == 0
+    assert [(c[0], c[1]) for c in calls] == [("ben", secret)]
+    assert {r["student"] for r in rows_of(report / "grades.csv")} >= {"ann", "ben"}
+
+
+def test_only_flagged_needs_an_earlier_report(tmp_path, capsys):
+    (tmp_path / "subs").mkdir()
+    assert batch.main(["03", str(tmp_path / "subs"), "--out", str(tmp_path / "r"),
+                       "--only", "flagged"]) == 2
+    assert "needs an earlier batch's report" in capsys.readouterr().err
+
+
+@pytest.mark.parametrize("seconds,text", [(30, "about 30 s left"), (600, "about 10 min left")])
+def test_estimate(seconds, text):
+    assert batch.eta(1, 2, seconds) == f", {text}"
+
+
+EXPORT_METADATA = """\
+---
+submission_123456:
+  :submitters:
+  - :name: Ada Lovelace
+    :sid: '1815'
+    :email: ada@example.edu
+  :created_at: 2026-11-30 10:00:00.000000000 -08:00
+  :score: 0.0
+submission_123457:
+  :submitters:
+  - :name: Alan Turing
+    :sid: '1912'
+    :email: alan@example.edu
+  - :name: Grace Hopper
+    :sid: '1906'
+    :email: grace@example.edu
+"""
+
+
+@pytest.mark.parametrize("with_yaml", [True, False])
+def test_export_metadata_parses_with_and_without_pyyaml(monkeypatch, with_yaml):
+    if not with_yaml:
+        import builtins
+        real = builtins.__import__
+
+        def no_yaml(name, *args, **kwargs):
+            if name == "yaml":
+                raise ImportError(name)
+            return real(name, *args, **kwargs)
+        monkeypatch.setattr(builtins, "__import__", no_yaml)
+    parsed = batch.parse_export_metadata(EXPORT_METADATA)
+    assert parsed["submission_123456"] == [
+        {"name": "Ada Lovelace", "sid": "1815", "email": "ada@example.edu"}]
+    assert [p["name"] for p in parsed["submission_123457"]] == ["Alan Turing", "Grace Hopper"]
+
+
+def test_a_gradescope_export_is_graded_and_keyed_by_submission_id(tmp_path, monkeypatch):
+    export, report = tmp_path / "assignment_99_export", tmp_path / "report"
+    for folder in ("submission_123456", "submission_123457"):
+        (export / folder).mkdir(parents=True)
+        (export / folder / "render.cpp").write_text("x")
+    (export / "submission_metadata.yml").write_text(EXPORT_METADATA)
+    calls = []
+    monkeypatch.setattr(batch, "grade_one", fake_grader(
+        calls, {"submission_123456": FAST, "submission_123457": RACY}))
+    assert batch.main(["03", str(export), "--out", str(report)]) == 0
+    rows = {r["submission_id"]: r for r in rows_of(report / "grades.csv") if r["submission_id"]}
+    assert rows["123456"]["submitters"] == "Ada Lovelace <ada@example.edu> (1815)"
+    assert rows["123457"]["submitters"].count("<") == 2 and rows["123457"]["score"] == "0"
+    assert rows["123456"]["speedup"] == "1.91"
+
+
+def test_a_gpu_lab_grades_one_submission_per_gpu_at_once(tmp_path, monkeypatch):
+    subs = tmp_path / "subs"
+    for student in ("a", "b", "c", "d"):
+        (subs / student).mkdir(parents=True)
+    monkeypatch.setenv("CUDA_VISIBLE_DEVICES", "0,1")
+    import threading
+    running, most, seen, lock = [0], [0], [], threading.Lock()
+
+    def grade_one(lab, folder, out, extra, env):
+        with lock:
+            running[0] += 1
+            most[0] = max(most[0], running[0])
+            seen.append(env["CUDA_VISIBLE_DEVICES"])
+        import time
+        time.sleep(0.3)
+        with lock:
+            running[0] -= 1
+        out.mkdir(parents=True, exist_ok=True)
+        return FAST
+    monkeypatch.setattr(batch, "grade_one", grade_one)
+    assert batch.main(["05", str(subs), "--out", str(tmp_path / "r")]) == 0
+    assert most[0] == 2 and sorted(seen) == ["0", "0", "1", "1"]
+    seen.clear()
+    most[0] = 0
+    assert batch.main(["03", str(subs), "--out", str(tmp_path / "r3")]) == 0
+    assert most[0] == 1  # a CPU lab: one at a time

@@ -1,0 +1,136 @@
+"""A class graded as a Slurm job array (grading/slurm.py) on a one-node Slurm that this test
+starts: its own munge daemon and key, slurmctld and slurmd on free ports, all in a scratch
+folder (Debian's slurm-wlm and munge packages). Two lab-01 hand-ins, one finished and one that
+does not compile, are graded one per array task in the sandbox; the merge job writes
+grades.csv from both. Skipped, saying why, where Slurm is not installed or cannot start."""
+import csv
+import os
+import pathlib
+import shutil
+import signal
+import socket
+import subprocess
+import time
+
+import pytest
+
+from grading import sandbox
+from grading.harness import ROOT
+
+DAEMONS = ("munged", "slurmctld", "slurmd", "sbatch")
+
+
+def free_port() -> int:
+    with socket.socket() as s:
+        s.bind(("127.0.0.1", 0))
+        return s.getsockname()[1]
+
+
+def wait_for(condition, seconds, what):
+    deadline = time.monotonic() + seconds
+    while time.monotonic() < deadline:
+        if condition():
+            return
+        time.sleep(0.5)
+    pytest.skip(f"one-node Slurm did not start: {what}")
+
+
+@pytest.fixture
+def slurm(tmp_path_factory):
+    missing = [d for d in DAEMONS if shutil.which(d) is None
+               and not pathlib.Path("/usr/sbin", d).exists()]
+    if missing:
+        pytest.skip(f"Slurm is not installed ({', '.join(missing)} missing: Debian's slurm-wlm)")
+    if os.geteuid() != 0:
+        pytest.skip("a one-node Slurm with slurmd needs root here")
+    if sandbox.probe():
+        pytest.skip(f"the grader's sandbox is not available: {sandbox.probe()}")
+    d = tmp_path_factory.mktemp("slurm")
+    d.chmod(0o755)
+    key = d / "munge.key"
+    key.write_bytes(os.urandom(1024))
+    key.chmod(0o400)
+    sock = d / "munge.sock"
+    started = []
+    subprocess.run(["munged", f"--socket={sock}", f"--key-file={key}",
+                    f"--log-file={d / 'munged.log'}", f"--pid-file={d / 'munged.pid'}",
+                    f"--seed-file={d / 'munged.seed'}", "--force"], check=True)
+    started.append(d / "munged.pid")
+    host = socket.gethostname()
+    (d / "state").mkdir()
+    (d / "spool").mkdir()
+    conf = d / "slurm.conf"
+    conf.write_text(f"""\
+ClusterName=grading
+SlurmctldHost={host}(127.0.0.1)
+SlurmUser=root
+SlurmdUser=root
+SlurmctldPort={free_port()}
+SlurmdPort={free_port()}
+AuthType=auth/munge
+AuthInfo=socket={sock}
+CredType=cred/munge
+StateSaveLocation={d / 'state'}
+SlurmdSpoolDir={d / 'spool'}
+SlurmctldPidFile={d / 'slurmctld.pid'}
+SlurmdPidFile={d / 'slurmd.pid'}
+ProctrackType=proctrack/linuxproc
+TaskPlugin=task/none
+JobAcctGatherType=jobacct_gather/none
+AccountingStorageType=accounting_storage/none
+SelectType=select/cons_tres
+SelectTypeParameters=CR_Core
+ReturnToService=2
+MpiDefault=none
+SlurmctldLogFile={d / 'slurmctld.log'}
+SlurmdLogFile={d / 'slurmd.log'}
+NodeName={host} NodeAddr=127.0.0.1 CPUs={os.cpu_count()} State=UNKNOWN
+PartitionName=grading Nodes={host} Default=YES MaxTime=INFINITE State=UP
+""")
+    env = {**os.environ, "SLURM_CONF": str(conf)}
+    try:
+        for daemon in ("slurmctld", "slurmd"):
+            subprocess.run([daemon, "-f", str(conf)], check=True, env=env)
+            started.append(d / f"{daemon}.pid")
+
+        def idle():
+            p = subprocess.run(["sinfo", "-h", "-o", "%t"], capture_output=True, text=True,
+                               env=env)
+            return p.returncode == 0 and p.stdout.strip() == "idle"
+        wait_for(idle, 30, (d / "slurmctld.log").read_text()[-500:]
+                 if (d / "slurmctld.log").exists() else "no log")
+        yield env
+    finally:
+        for pid_file in reversed(started):  # only the daemons this test started, by their pid
+            try:
+                os.kill(int(pid_file.read_text().split()[0]), signal.SIGTERM)
+            except (OSError, ValueError):
+                pass
+
+
+def test_a_class_graded_as_a_job_array(tmp_path, slurm):
+    base = tmp_path / "class"
+    subs, report = base / "subs", base / "report"
+    base.mkdir()
+    base.chmod(0o755)
+    (subs / "ada").mkdir(parents=True)
+    shutil.copy(ROOT / "labs/01-serial/solution/render.cpp", subs / "ada")
+    shutil.copy(ROOT / "common/core/path_tracer.h", subs / "ada")
+    (subs / "bob").mkdir()
+    (subs / "bob" / "render.cpp").write_text("int broken( {\n")
+    (subs / "bob" / "path_tracer.h").write_text("")
+    p = subprocess.run(["make", "-s", "-C", str(ROOT), "grade-slurm", "LAB=01",
+                        f"SUBMISSIONS={subs}", f"REPORT={report}"], capture_output=True,
+                       text=True, env=slurm, timeout=120)
+    assert p.returncode == 0, p.stdout + p.stderr
+    assert "(2 tasks)" in p.stdout, p.stdout
+    deadline = time.monotonic() + 900
+    while not (report / "grades.csv").exists() and time.monotonic() < deadline:
+        time.sleep(2)
+    logs = "\n".join(f.read_text()[-800:] for f in report.glob("slurm-*.log"))
+    assert (report / "grades.csv").exists(), logs
+    rows = {r["student"]: r for r in csv.DictReader((report / "grades.csv").open())}
+    assert rows["ada"]["score"] == "100", logs
+    assert rows["bob"]["score"] == "0" and rows["bob"]["cause"].startswith("compile error")
+    assert rows["(class: 2 students)"]["score"] == "mean 50.0"
+    assert len(list(report.glob("slurm-*_*.log"))) == 2  # one log per array task
