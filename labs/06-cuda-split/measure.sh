@@ -23,7 +23,7 @@ bench() {  # bench NAME FLAGS...: one JSON per scene
     timeout 240 ./lab07-bench --repeat "${WAVEFRONT_REPEAT:-3}" "$@" > "$out/bench-$name.json" || status=1
 }
 # WAVEFRONT_ONLY=NAME,...: only those configurations on the three scenes after the baseline
-# (a short lease; the baseline always gets them all).
+# (when GPU time is short; the baseline always gets them all).
 only=(${WAVEFRONT_ONLY:+--only "$WAVEFRONT_ONLY"})
 if [[ $steps == *" bench "* ]]; then
     bench cornell

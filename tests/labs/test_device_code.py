@@ -1,5 +1,5 @@
 """The host+device code in common/ compiles under nvcc (the CUDA labs reuse it). Nothing runs
-on a GPU here; the CUDA labs' own tests do that on the device machine."""
+on a GPU here; the CUDA labs' own tests do that on a machine with a GPU (tools/gpu_check.sh)."""
 import shutil
 import subprocess
 

@@ -23,15 +23,14 @@
 
 const char* const kLabName = "05-cuda-mega";
 
-// The launch shape, each choice measured on an H200 with lab05-bench (the handout's tables,
-// baseline kernel times, best of 5): 32 threads share a pixel's samples (a grid of millions
-// of threads, so the last wave of blocks is a small part of the work, while a pixel's
-// threads still fit in one warp for the shuffles: 47.4 ms with one thread per pixel, 40.36
-// with 32, 40.51 with 16); blocks of 64 threads (block-128 42.0 ms); by bounces with path
-// regeneration; at most 72 registers a thread (39.91 ms: 8 bytes of spills at 44%
-// occupancy; capped at 64, 40 bytes of spills at 50%, 40.36 ms; uncapped, 78 registers at
-// 38%, 41.32 ms); only the material kinds the scene uses (40.51 ms against 41.08 for a
-// kernel compiled for every material, same shape: no glass code, fewer spills).
+// The launch shape, each choice measured on an H200 with lab05-bench (baseline kernel times,
+// best of 5, in handouts/05-cuda-mega.md): 32 threads share a pixel's samples (a grid of
+// millions of threads, so the last wave of blocks is a small part of the work, while a
+// pixel's threads still fit in one warp for the shuffles; section 3's table of threads per
+// pixel); blocks of 64 threads and at most 72 registers a thread (a few bytes of spills at
+// 44% occupancy beat both fewer spills and more occupancy; section 5's tables); by bounces
+// with path regeneration; only the material kinds the scene uses (no glass code, fewer
+// spills; section 6).
 constexpr int kThreadsPerPixel = 32;
 constexpr int kBlockThreads = 64;
 constexpr bool kRegenerate = true;

@@ -34,9 +34,9 @@ enum class Reserve {
 //
 // Why not one atomic per thread, or per warp: every thread of the GPU pushing onto the same
 // queue adds to the same counter, and the L2 performs the additions to one address one after
-// another (on the H200 1.1 to 1.5 ns each). A warp that waits for its place waits for all the
-// additions queued before its own. The compiler already combines a warp's additions to one
-// address; one per block of 128 threads makes 4 times fewer (handouts/06-cuda-split.md).
+// another (handouts/06-cuda-split.md, section 2, times them on the H200). A warp that waits for
+// its place waits for all the additions queued before its own. The compiler already combines
+// a warp's additions to one address; one per block of 128 threads makes 4 times fewer.
 __device__ inline int reserve(int* size, bool wants) {
     // TODO(lab06): count the block's threads that want a place (an atomic add on a
     // __shared__ counter gives each its rank), let one thread reserve that many places
