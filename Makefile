@@ -217,10 +217,6 @@ bench-serial: lab01-ref
 $(BUILD)/intersect_bench: $(BUILD)/bench/intersect_bench.o $(LIB_OBJ)
 	$(CXX) $(CXXFLAGS) $^ -o $@ -lbenchmark -pthread
 
-# The quads-as-one-primitive experiment of reference/timings/README.md (run by hand).
-$(BUILD)/quad_experiment: $(BUILD)/bench/quad_experiment.o $(LIB_OBJ)
-	$(CXX) $(CXXFLAGS) $^ -o $@
-
 # Builds only the binaries it times (tools/bench_cpu.py), each that builds here.
 bench-cpu:
 	$(PYTHON) tools/bench_cpu.py

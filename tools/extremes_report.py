@@ -2,7 +2,7 @@
 """The numerical-stability suite at the extremes, measured in float and in double: each case
 of the render-level suite (the checks of grading/checks.py and tests/labs/test_extremes.py),
 run with lab01-ref and lab01-ref-double, with its property, its tolerance and what each build
-measured; printed as the Markdown table of handouts/extremes.md.
+measured; printed as the Markdown table of docs/extremes.md.
 
     python3 tools/extremes_report.py > table.md      (about a minute; builds what is missing)
 

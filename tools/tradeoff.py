@@ -71,7 +71,7 @@ FULL = Plan("full", None, 4096, True, None, True, 32, 1024, tuple(range(1, 17)),
 # The GPU machine's plan (tools/tradeoff_gpu.sh): FULL's sweeps for the GPU references, with
 # lab01-ref as the efficiency baseline, OpenMP on every core as the CPU's best, and lab 01's
 # double build beside lab 05's. 124 s on the H200 machine's 16 cores
-# (reference/reports/tradeoff-h200-2026-12-02/).
+# (reference/reports/tradeoff-h200/).
 GPU = Plan("gpu", ("lab01-ref", "lab03-ref", "lab03-simd-ref"), 4096, True, ("lab01 double",),
            True, 32, 1024, tuple(range(1, 17)), 64, needs_gpu=True)
 PLANS = {plan.name.split()[0]: plan for plan in (FULL, QUICK, GPU)}

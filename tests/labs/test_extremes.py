@@ -8,7 +8,7 @@ coordinates, not only with the hit point's (ray.h); triangle normals computed in
 (triangle.h). Lab 02 runs the same checks on its references (test_lab02.py).
 
 Every case runs on the float build and on the double build (lab01-ref-double,
-common/core/real.h); handouts/extremes.md tabulates what each measured
+common/core/real.h); docs/extremes.md tabulates what each measured
 (tools/extremes_report.py).
 """
 import pytest
