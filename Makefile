@@ -53,6 +53,7 @@ DOUBLE_COMMON_OBJ := $(COMMON_OBJ:$(BUILD)/%=$(DOUBLE_BUILD)/%)
 
 PHONY_EXTRA := variant
 PHONY_EXTRA += render grade handin check-nvcc bench-micro bench-cpu bench-serial count-work bench-precision
+PHONY_EXTRA += lint format
 .PHONY: all help deps labs $(PHONY_EXTRA) test test-unit test-labs skeletons check-skeletons golden bench tradeoff \
         clean
 .DEFAULT_GOAL := help
@@ -66,7 +67,7 @@ help:
 	@echo "  make render       render the default scene to cornell.ppm with the fastest"
 	@echo "                    reference here (GPU, else OpenMP+AVX2)"
 	@echo "  make test         the unit tests of common/ and the lab tests"
-	@echo "  make deps         install what is missing (JSON library, OpenMPI, pytest, numpy, matplotlib)"
+	@echo "  make deps         install what is missing (JSON library, OpenMPI, tools/requirements.txt)"
 	@echo "  make bench-serial time the lab-01 reference on the Cornell baseline (minutes)"
 	@echo "  make bench-cpu    the CPU labs side by side with load and capacity (Table 4 here)"
 	@echo "  make tradeoff     speed against accuracy: error vs time of every lab here, bias vs"
@@ -91,6 +92,8 @@ help:
 	@echo "  make gpu-check OUT=DIR  on a GPU machine: build, test and benchmark the CUDA labs"
 	@echo "  make golden       regenerate the golden images in reference/ (minutes)"
 	@echo "  make skeletons    regenerate the skeletons from the solutions (check-skeletons: check)"
+	@echo "  make lint         ruff on the Python, clang-format --dry-run on the C++/CUDA (make test runs it)"
+	@echo "  make format       apply clang-format and ruff's fixes, then regenerate the skeletons"
 	@echo "  make labs         every binary of the course (needs the solutions)"
 	@echo "  make clean        remove build products"
 
@@ -155,8 +158,9 @@ test-unit: $(BUILD)/unit_tests
 test-labs: labs
 	$(PYTHON) -m pytest -q tests
 
-# Every test: installs what is missing first, so it works on a fresh machine.
+# Every test: installs what is missing first, so it works on a fresh machine; the style first.
 test: deps
+	$(MAKE) --no-print-directory lint
 	$(MAKE) --no-print-directory test-unit
 	$(MAKE) --no-print-directory test-labs
 
@@ -166,6 +170,21 @@ render: deps
 	@MAKE="$(MAKE)" bash tools/render.sh
 
 skeletons:
+	$(PYTHON) tools/skeletons.py
+
+# Style: ruff (pyproject.toml) on the Python, clang-format (.clang-format) on every tracked
+# C++/CUDA file, both at the versions of tools/requirements.txt (make deps). The skeletons are
+# generated from the solutions, so make format regenerates them after formatting.
+CLANG_FORMAT ?= $(PYTHON) -c 'import clang_format; clang_format.clang_format()'
+CXX_SOURCES = $(shell git ls-files '*.cpp' '*.h' '*.cu' '*.cuh')
+lint:
+	$(PYTHON) -m ruff check --quiet .
+	@$(CLANG_FORMAT) --dry-run --Werror $(CXX_SOURCES)
+	@echo "lint: ruff and clang-format find nothing to change"
+
+format:
+	$(PYTHON) -m ruff check --quiet --fix .
+	@$(CLANG_FORMAT) -i $(CXX_SOURCES)
 	$(PYTHON) tools/skeletons.py
 
 check-skeletons:

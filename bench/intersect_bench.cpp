@@ -11,7 +11,8 @@
 namespace {
 
 const Scene& cornell() {
-    static const Scene scene = load_scene(std::string(RT_SOURCE_DIR) + "/common/scenes/cornell.json");
+    static const Scene scene =
+        load_scene(std::string(RT_SOURCE_DIR) + "/common/scenes/cornell.json");
     return scene;
 }
 

@@ -94,9 +94,14 @@ def speed_numbers(results: dict) -> dict[str, str]:
         c = CAPACITY.search(t.get("output", ""))
         if c:
             found["capacity"] = c["capacity"] or c["busy"]
-        for key, name in (("reference_seconds", "reference_s"), ("seconds_reference", "reference_s"),
-                          ("yours_seconds", "yours_s"), ("seconds_yours", "yours_s"),
-                          ("speedup", "speedup"), ("capacity", "capacity")):
+        for key, name in (
+            ("reference_seconds", "reference_s"),
+            ("seconds_reference", "reference_s"),
+            ("yours_seconds", "yours_s"),
+            ("seconds_yours", "yours_s"),
+            ("speedup", "speedup"),
+            ("capacity", "capacity"),
+        ):
             if isinstance(extra.get(key), (int, float)):
                 found[name] = f"{extra[key]:.3f}"
     return found
@@ -136,7 +141,8 @@ def failure_cause(results: dict) -> str:
         t = failing[0]
         kind = "image check" if t.get("extra_data", {}).get("check", "").startswith(
             ("golden", "hidden", "sphere", "lit", "glass", "scale")) else "check"
-        return f"{kind} {t['name']}: {t.get('output', '').splitlines()[0][:200] if t.get('output') else ''}"
+        first = t.get("output", "").splitlines()[0][:200] if t.get("output") else ""
+        return f"{kind} {t['name']}: {first}"
     return ""
 
 
@@ -160,10 +166,22 @@ def write_csv(path: pathlib.Path, lab: str, rows: dict[str, dict],
             numbers = speed_numbers(r)
             key = [submission_id(student), submitters.get(student, "")] \
                 if submitters is not None else []
-            w.writerow([*key, student, r.get("score", 0), r.get("max_score", ""), provisional_points(r),
-                        "yes" if flagged(r) else "", numbers["reference_s"], numbers["yours_s"],
-                        numbers["speedup"], numbers["capacity"], failure_cause(r),
-                        *(by_name.get(label, {}).get("score", "") for label in labels)])
+            w.writerow(
+                [
+                    *key,
+                    student,
+                    r.get("score", 0),
+                    r.get("max_score", ""),
+                    provisional_points(r),
+                    "yes" if flagged(r) else "",
+                    numbers["reference_s"],
+                    numbers["yours_s"],
+                    numbers["speedup"],
+                    numbers["capacity"],
+                    failure_cause(r),
+                    *(by_name.get(label, {}).get("score", "") for label in labels),
+                ]
+            )
         w.writerow([*(["", ""] if submitters is not None else []),
                     *summary_row(lab, rows, labels)])
 
@@ -178,9 +196,19 @@ def summary_row(lab: str, rows: dict[str, dict], labels: list[str]) -> list:
         ok = sum(any(t["name"] == label and t.get("status") == "passed" for t in r.get("tests", []))
                  for r in rows.values())
         passed.append(f"{ok}/{n} passed")
-    return [f"(class: {n} students)", f"mean {mean}", max((r.get("max_score", 0) for r in rows.values()), default=""),
-            sum(provisional_points(r) for r in rows.values()), f"{count} flagged", "", "", "", "",
-            f"{sum(bool(failure_cause(r)) for r in rows.values())} lost points", *passed]
+    return [
+        f"(class: {n} students)",
+        f"mean {mean}",
+        max((r.get("max_score", 0) for r in rows.values()), default=""),
+        sum(provisional_points(r) for r in rows.values()),
+        f"{count} flagged",
+        "",
+        "",
+        "",
+        "",
+        f"{sum(bool(failure_cause(r)) for r in rows.values())} lost points",
+        *passed,
+    ]
 
 
 def write_html(path: pathlib.Path, lab: str, rows: dict[str, dict]) -> None:
@@ -437,7 +465,9 @@ def main(argv=None) -> int:
     # A task's zips are unpacked where every task and the merge see them; a whole batch's
     # in a temporary folder.
     keep = a.task is not None or a.merge
-    unpacked = a.out / ".unpacked" if keep else pathlib.Path(tempfile.mkdtemp(prefix="grade-batch-"))
+    unpacked = (
+        a.out / ".unpacked" if keep else pathlib.Path(tempfile.mkdtemp(prefix="grade-batch-"))
+    )
     try:
         found = submissions(a.submissions, unpacked)
         if submitters is not None:  # a Gradescope export: its submissions, by its metadata

@@ -94,19 +94,19 @@ mean, a few wrong pixels cannot hold up.  The mean is of min(q, ``CHI_CAP``): a 
 whose rare paths the golden data never saw has an underestimated variance and a huge q,
 which alone must not decide (chi-square(1) exceeds 16 with probability 6e-5, so the cap
 costs a correct render nothing; four times too noisy still averages ~3.7).  The test fails
-when that mean exceeds ``CHI_MEAN_MAX`` or the median falls below ``CHI_MEDIAN_MIN``.  Measured on lab 01's
-reference at 64 spp against the stored golden data (6 seeds each): mean 1.00-1.07 (cornell)
-and 0.95-1.10 (showcase), median 0.45-0.49; at 16 spp mean 4.0-4.2; blurred over 3x3 pixels
-median 0.10-0.18; flattened into 8x8 blocks mean 36-149 (uncapped).  On the hidden scene
-(grading/hidden.py, with its glass and mirror balls; 40 secrets): capped mean 1.01-1.16,
-median 0.33-0.51; blurred, capped mean 2.7-6.7.  Glass makes a pixel's mean of 64 paths
-skewed, which lowers the median of a correct render: hence the lower bound's margin.  For chi-square(1) values the
-standard error of the mean over P values is sqrt(2/P) and of the median ~0.5/(0.47 sqrt(P)),
-i.e. 0.02 and 0.01 for a 64x64 image and 0.03 and 0.02 for 32x32: both bounds are more than
-10 standard errors from 1 and 0.455, and a variance estimated from K renders moves the mean
-only by (K-1)/(K-3) (1.07 for K = 32).  Images with fewer than ``CHI_MIN_VALUES`` pixel
-channels of non-zero variance skip this test.  Every statistic is computed in float64 and
-compared as ``not (value <= bound)``, so a NaN fails.
+when that mean exceeds ``CHI_MEAN_MAX`` or the median falls below ``CHI_MEDIAN_MIN``.
+Measured on lab 01's reference at 64 spp against the stored golden data (6 seeds each): mean
+1.00-1.07 (cornell) and 0.95-1.10 (showcase), median 0.45-0.49; at 16 spp mean 4.0-4.2; blurred
+over 3x3 pixels median 0.10-0.18; flattened into 8x8 blocks mean 36-149 (uncapped).  On the
+hidden scene (grading/hidden.py, with its glass and mirror balls; 40 secrets): capped mean
+1.01-1.16, median 0.33-0.51; blurred, capped mean 2.7-6.7.  Glass makes a pixel's mean of 64
+paths skewed, which lowers the median of a correct render: hence the lower bound's margin.  For
+chi-square(1) values the standard error of the mean over P values is sqrt(2/P) and of the
+median ~0.5/(0.47 sqrt(P)), i.e. 0.02 and 0.01 for a 64x64 image and 0.03 and 0.02 for 32x32:
+both bounds are more than 10 standard errors from 1 and 0.455, and a variance estimated from K
+renders moves the mean only by (K-1)/(K-3) (1.07 for K = 32).  Images with fewer than
+``CHI_MIN_VALUES`` pixel channels of non-zero variance skip this test.  Every statistic is
+computed in float64 and compared as ``not (value <= bound)``, so a NaN fails.
 
 Power: a bias delta per pixel over a block of P pixels is found once
 delta > c * sqrt(mean s2 / P); the global test finds delta > c * sqrt(mean s2 / (H W)).
@@ -282,7 +282,8 @@ class Failure:
     def where(self) -> str:
         if self.block_size == 0:
             return "whole image"
-        return f"{self.block_size}x{self.block_size} block x {self.x0}..{self.x1}, y {self.y0}..{self.y1}"
+        return (f"{self.block_size}x{self.block_size} block x {self.x0}..{self.x1},"
+                f" y {self.y0}..{self.y1}")
 
     def relative_diff(self) -> float | None:
         if self.mean_golden == 0 or not math.isfinite(self.mean_diff):
@@ -341,15 +342,19 @@ class Report:
         if self.nan_count or self.inf_count:
             parts.append(f"{self.nan_count} NaN and {self.inf_count} Inf pixels;")
         if self.passed:
-            parts.append(f"max |z| {self.max_abs_z:.2f} <= {self.critical_z:.2f} over {self.n_tests} tests;")
+            parts.append(
+                f"max |z| {self.max_abs_z:.2f} <= {self.critical_z:.2f} over {self.n_tests} tests;"
+            )
         elif self.n_failed:
             worst = self.failures[0]
             rel = worst.relative_diff()
             rel_s = f", {rel * 100:+.1f}%" if rel is not None else ""
+            channel = CHANNEL_NAMES[worst.channel] if worst.channel < 3 else worst.channel
             parts.append(
                 f"{self.n_failed} of {self.n_tests} tests beyond |z| {self.critical_z:.2f};"
-                f" worst {worst.where()} {CHANNEL_NAMES[worst.channel] if worst.channel < 3 else worst.channel}"
-                f" z={_fmt_z(worst.z)}{rel_s};")
+                f" worst {worst.where()} {channel}"
+                f" z={_fmt_z(worst.z)}{rel_s};"
+            )
         parts.append(f"RMSE {self.rmse:.4g}, relMSE {self.relmse:.4g},"
                      f" bias {self.bias:+.3g} +- {self.bias_se:.2g}")
         noise = self.noise_problem()
@@ -376,21 +381,30 @@ class Report:
         L.append(nonfinite)
         L.append(f"  RMSE   {self.rmse:.6g}")
         L.append(f"  relMSE {self.relmse:.6g}")
-        bias_line = f"  bias   {self.bias:+.6g} +- {self.bias_se:.3g} (render - golden, mean over pixels)"
+        bias_line = (
+            f"  bias   {self.bias:+.6g} +- {self.bias_se:.3g} (render - golden, mean over pixels)"
+        )
         if self.mean_golden > 0:
             bias_line += f" = {self.bias / self.mean_golden * 100:+.2f}% of the mean golden value"
         L.append(bias_line)
         if self.chi_mean is not None:
-            L.append(f"  per-pixel d^2/sigma^2: mean {self.chi_mean:.3f} (allowed <= {CHI_MEAN_MAX:g}),"
-                     f" median {self.chi_median:.3f} (allowed >= {CHI_MEDIAN_MIN:g})"
-                     + ("" if self.noise_problem() is None else "   <- FAIL"))
-        gz = "  ".join(f"{CHANNEL_NAMES[c] if c < 3 else c} {_fmt_z(z)}" for c, z in enumerate(self.global_z))
+            L.append(
+                f"  per-pixel d^2/sigma^2: mean {self.chi_mean:.3f} (allowed <= {CHI_MEAN_MAX:g}),"
+                f" median {self.chi_median:.3f} (allowed >= {CHI_MEDIAN_MIN:g})"
+                + ("" if self.noise_problem() is None else "   <- FAIL")
+            )
+        gz = "  ".join(
+            f"{CHANNEL_NAMES[c] if c < 3 else c} {_fmt_z(z)}" for c, z in enumerate(self.global_z)
+        )
         L.append(f"  global mean z: {gz}")
         if self.worst_block is not None:
             w = self.worst_block
-            L.append(f"  worst block: {w.block_size}x{w.block_size} at x={w.x0}, y={w.y0},"
-                     f" channel {CHANNEL_NAMES[w.channel] if w.channel < 3 else w.channel}, z {_fmt_z(w.z)}"
-                     f" (limit +-{self.critical_z:.2f})")
+            channel = CHANNEL_NAMES[w.channel] if w.channel < 3 else w.channel
+            L.append(
+                f"  worst block: {w.block_size}x{w.block_size} at x={w.x0}, y={w.y0},"
+                f" channel {channel}, z {_fmt_z(w.z)}"
+                f" (limit +-{self.critical_z:.2f})"
+            )
         if self.n_failed:
             shown = len(self.failures)
             L.append(f"  failing tests: {self.n_failed}"
@@ -400,7 +414,9 @@ class Report:
                 rel = f.relative_diff()
                 rel_s = f"{rel * 100:+8.1f}%" if rel is not None else f"{'-':>9}"
                 ch = CHANNEL_NAMES[f.channel] if f.channel < 3 else str(f.channel)
-                L.append(f"    {f.where():<40} {ch:>2} {_fmt_z(f.z):>9} {f.mean_diff:>+11.4g} {rel_s}")
+                L.append(
+                    f"    {f.where():<40} {ch:>2} {_fmt_z(f.z):>9} {f.mean_diff:>+11.4g} {rel_s}"
+                )
         if not self.passed:
             L.extend("  " + h for h in self._hints())
         if self.heatmap_path:
@@ -447,7 +463,9 @@ def _as_image(name: str, a) -> np.ndarray:
     if arr.ndim == 2:
         arr = arr[:, :, None]
     if arr.ndim != 3 or arr.shape[0] < 1 or arr.shape[1] < 1 or arr.shape[2] < 1:
-        raise InputError(f"{name}: expected an image of shape (height, width, channels), got {arr.shape}")
+        raise InputError(
+            f"{name}: expected an image of shape (height, width, channels), got {arr.shape}"
+        )
     if not (np.issubdtype(arr.dtype, np.floating) or np.issubdtype(arr.dtype, np.integer)):
         raise InputError(f"{name}: expected numbers, got dtype {arr.dtype}")
     return arr.astype(np.float64, copy=False)
@@ -472,9 +490,13 @@ def _check_inputs(image, golden, variance, test_spp, golden_spp, alpha, block_si
     gold = _as_image("golden", golden)
     var = _as_image("variance", variance)
     if img.shape != gold.shape:
-        raise InputError(f"size mismatch: image is {_shape_str(img)} but golden is {_shape_str(gold)}")
+        raise InputError(
+            f"size mismatch: image is {_shape_str(img)} but golden is {_shape_str(gold)}"
+        )
     if var.shape != gold.shape:
-        raise InputError(f"size mismatch: variance is {_shape_str(var)} but golden is {_shape_str(gold)}")
+        raise InputError(
+            f"size mismatch: variance is {_shape_str(var)} but golden is {_shape_str(gold)}"
+        )
     if not np.all(np.isfinite(gold)):
         raise InputError("golden image contains NaN or Inf")
     if not np.all(np.isfinite(var)):
@@ -644,8 +666,15 @@ def compare(image, test_spp, golden, variance, golden_spp, alpha: float = 1e-4,
         report.passed = passed = False
     if not passed and heatmap_path is not None and st.z_maps:
         b = min(st.z_maps)
-        heatmap.write_heatmap(os.fspath(heatmap_path), st.z_maps[b], crit, b, h, w,
-                              _block_sums(nonfinite_px[:, :, None].astype(np.float64), b)[:, :, 0] > 0)
+        heatmap.write_heatmap(
+            os.fspath(heatmap_path),
+            st.z_maps[b],
+            crit,
+            b,
+            h,
+            w,
+            _block_sums(nonfinite_px[:, :, None].astype(np.float64), b)[:, :, 0] > 0,
+        )
         report.heatmap_path = os.fspath(heatmap_path)
     return report
 
@@ -693,7 +722,11 @@ def load_reference(directory: str | os.PathLike):
     if not isinstance(meta, dict) or "golden_spp" not in meta:
         raise InputError(f"{meta_path}: expected an object with a \"golden_spp\" entry")
     golden_spp = meta["golden_spp"]
-    if isinstance(golden_spp, bool) or not isinstance(golden_spp, (int, float)) or not golden_spp > 0:
+    if (
+        isinstance(golden_spp, bool)
+        or not isinstance(golden_spp, (int, float))
+        or not golden_spp > 0
+    ):
         raise InputError(f"{meta_path}: golden_spp must be a positive number, got {golden_spp!r}")
     golden = _read_image(os.path.join(directory, "golden.pfm"))
     variance = _read_image(os.path.join(directory, "variance.pfm"))
@@ -754,8 +787,12 @@ def main(argv: Sequence[str] | None = None) -> int:
         try:
             blocks = tuple(int(s) for s in args.blocks.split(",") if s.strip())
         except ValueError:
-            raise InputError(f"--blocks: expected comma-separated integers, got {args.blocks!r}") from None
-        heatmap_path = None if args.no_heatmap else (args.heatmap or _default_heatmap_path(args.image))
+            raise InputError(
+                f"--blocks: expected comma-separated integers, got {args.blocks!r}"
+            ) from None
+        heatmap_path = (
+            None if args.no_heatmap else (args.heatmap or _default_heatmap_path(args.image))
+        )
         try:
             report = compare_files(args.image, args.golden, args.spp, alpha=args.alpha,
                                    block_sizes=blocks, heatmap_path=heatmap_path)

@@ -44,7 +44,9 @@ def problem(golden: pathlib.Path = GOLDEN, record_path: pathlib.Path | None = No
     """What is wrong with the golden data against its record, or None."""
     record_path = record_path or golden / "SHA256SUMS"
     if not record_path.exists():
-        return f"{record_path.relative_to(ROOT)} is missing: regenerate the golden data (make golden)"
+        return (
+            f"{record_path.relative_to(ROOT)} is missing: regenerate the golden data (make golden)"
+        )
     recorded = {}
     for line in record_path.read_text().splitlines():
         digest, _, name = line.partition("  ")
@@ -52,7 +54,9 @@ def problem(golden: pathlib.Path = GOLDEN, record_path: pathlib.Path | None = No
     for f in covered_files(golden):
         name = str(f.relative_to(ROOT))
         if name not in recorded:
-            return f"{name} has no recorded checksum in {record_path.relative_to(ROOT)}: make golden"
+            return (
+                f"{name} has no recorded checksum in {record_path.relative_to(ROOT)}: make golden"
+            )
         if sha256(f) != recorded[name]:
             return (f"{name} does not match its recorded checksum "
                     f"({record_path.relative_to(ROOT)}): restore it (git checkout) or "

@@ -84,7 +84,7 @@ def passes_when(lab: str, item: grade.Item) -> str:
         return f"the image is `lab01-ref`'s bit for bit with {how}"
     if item.id == "parallel-speedup":
         fraction = parameter(checks.check_parallel_speedup, "fraction")
-        who = (f"`mpirun -np N` (N = the cores), 1 thread a rank" if launcher
+        who = ("`mpirun -np N` (N = the cores), 1 thread a rank" if launcher
                else "every core")
         return (f"on {who}, wall-clock speedup over `lab01-ref` (interleaved, best of rounds) "
                 f"at least {fraction:g} x the capacity measured alongside, and at least "

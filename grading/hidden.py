@@ -3,11 +3,12 @@ recognise a golden render and print the stored image. A hidden scene is made at 
 from a secret (a random one per grade unless the instructor fixes it to regrade), its golden
 data rendered there and then by the trusted lab-01 reference, so there is nothing to copy.
 
-The scene is the Cornell box with its light moved and dimmed or brightened, its camera
-nudged, its colours changed and a glass and a mirror ball added, all drawn from the secret. Its golden data follow
-tools/make_golden.py (K renders with distinct seeds: their mean, and their spread times n as
-the variance of one path), only smaller, so that it takes about a second on two cores; with
-K = 32 estimated variances, grading/compare.py's false-failure bound grows by about 1.1x.
+The scene is the Cornell box with its light moved and dimmed or brightened, its camera nudged,
+its colours changed and a glass and a mirror ball added, all drawn from the secret. Its golden
+data follow tools/make_golden.py (K renders with distinct seeds: their mean, and their spread
+times n as the variance of one path), only smaller, so that it takes about a second on two
+cores; with K = 32 estimated variances, grading/compare.py's false-failure bound grows by about
+1.1x.
 """
 from __future__ import annotations
 
@@ -38,7 +39,9 @@ def new_secret() -> str:
 
 def hidden_scene(secret: str) -> dict:
     """The Cornell box varied by `secret`: the same secret, the same scene."""
-    rng = np.random.default_rng(int.from_bytes(hashlib.sha256(secret.encode()).digest()[:8], "little"))
+    rng = np.random.default_rng(
+        int.from_bytes(hashlib.sha256(secret.encode()).digest()[:8], "little")
+    )
     s = scenes.load("cornell")
     s.pop("render", None)
     light = s["light"]
@@ -50,7 +53,9 @@ def hidden_scene(secret: str) -> dict:
     cam["vfov"] = float(cam["vfov"] * rng.uniform(0.9, 1.1))
     for m in s["materials"].values():
         if m.get("type") == "diffuse":
-            m["albedo"] = [float(np.clip(a * rng.uniform(0.6, 1.4), 0.02, 0.9)) for a in m["albedo"]]
+            m["albedo"] = [
+                float(np.clip(a * rng.uniform(0.6, 1.4), 0.02, 0.9)) for a in m["albedo"]
+            ]
     # A glass ball and a mirror ball at drawn places, sizes and (for glass) index: a renderer
     # without glass or mirrors cannot pass here by printing the stored showcase image.
     s["materials"]["clear"] = {"type": "glass", "ior": float(rng.uniform(1.3, 1.8))}

@@ -41,10 +41,15 @@ from grading.harness import ROOT
 # handout runs: lab 02's worked example (lab02-prims), lab 03's schedule benchmark
 # (lab03-bench) and the OpenMP/MPI references over lab 02's packets (`make render`'s
 # renderer, handout 02's comparison).
-REFERENCES = {"01": ["lab01-ref"], "02": ["lab02-ref", "lab02-ref-avx2", "lab02a-ref", "lab02-prims"],
-              "03": ["lab03-ref", "lab03-bench", "lab03-simd-ref"],
-              "04": ["lab04-ref", "lab04-simd-ref"], "05": ["lab05-ref"], "06": ["lab06-ref"],
-              "07": ["lab07-ref"]}
+REFERENCES = {
+    "01": ["lab01-ref"],
+    "02": ["lab02-ref", "lab02-ref-avx2", "lab02a-ref", "lab02-prims"],
+    "03": ["lab03-ref", "lab03-bench", "lab03-simd-ref"],
+    "04": ["lab04-ref", "lab04-simd-ref"],
+    "05": ["lab05-ref"],
+    "06": ["lab06-ref"],
+    "07": ["lab07-ref"],
+}
 # Built where nvcc is; a release without them says so (GPU labs then build only the
 # student's own code).
 GPU_LABS = ("05", "06", "07")

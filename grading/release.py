@@ -215,7 +215,7 @@ def make_release(lab: str, out: pathlib.Path, secret: str | None = None) -> path
             stage.mkdir(mode=0o700)  # private until complete
         except FileExistsError:  # a clash of random names: someone else's, never removed
             stage = None
-            raise ReleaseError("a folder of the same random name appeared; try again")
+            raise ReleaseError("a folder of the same random name appeared; try again") from None
         files = repository_files()
         copy_sources(stage, lab, folders, files)
         prebuilt = add_references(stage, lab, files)

@@ -561,7 +561,10 @@ def _supervise(p: subprocess.Popen, start: float, limits: Limits) -> Outcome:
     """Read both streams up to the cap and wait for the exit within the wall limit. The
     rusage holds the whole tree's CPU time in trusted mode only (see Outcome.cpu_seconds)."""
     deadline = start + limits.wall_seconds
-    streams = {p.stdout.fileno(): ("stdout", bytearray()), p.stderr.fileno(): ("stderr", bytearray())}
+    streams = {
+        p.stdout.fileno(): ("stdout", bytearray()),
+        p.stderr.fileno(): ("stderr", bytearray()),
+    }
     for fd in streams:
         os.set_blocking(fd, False)
     pidfd = os.pidfd_open(p.pid)
@@ -578,7 +581,11 @@ def _supervise(p: subprocess.Popen, start: float, limits: Limits) -> Outcome:
             if not wait_on:
                 break
             # After the exit, give stragglers (trusted mode: children keep pipes open) 1 s.
-            limit = max(timeout, 0.05) if exited_at is None else max(exited_at + 1 - time.perf_counter(), 0)
+            limit = (
+                max(timeout, 0.05)
+                if exited_at is None
+                else max(exited_at + 1 - time.perf_counter(), 0)
+            )
             if exited_at is None:
                 clock.sample()
                 limit = min(limit, SAMPLE_SECONDS)

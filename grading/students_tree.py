@@ -212,7 +212,7 @@ def stage(lab_folder: str, handin_files: dict[str, bytes], missing: list[str],
     work.chmod(0o755)
     root = work / "tree"
     shutil.copytree(tree, root, symlinks=False)  # copy2: the objects stay newer than sources
-    for dirpath, dirs, files in os.walk(root):
+    for dirpath, _dirs, files in os.walk(root):
         os.chmod(dirpath, 0o755)
         for f in files:
             os.chmod(os.path.join(dirpath, f), 0o644)

@@ -33,7 +33,9 @@ def build_sources(variant_lab: str, workdir: pathlib.Path, sources: dict[str, st
     p = subprocess.run(["make", "-s", "-C", str(ROOT), target, f"VARIANT_LAB={variant_lab}",
                         f"VARIANT={src}", *make_args], capture_output=True, text=True)
     if p.returncode != 0:
-        raise RuntimeError(f"building a {variant_lab} variant failed:\n{(p.stdout + p.stderr)[-2000:]}")
+        raise RuntimeError(
+            f"building a {variant_lab} variant failed:\n{(p.stdout + p.stderr)[-2000:]}"
+        )
     return src / "lab"
 
 

@@ -56,7 +56,7 @@ def row_costs(args) -> list[float]:
     for _ in range(args.repeat):
         run = run_lab(BIN / "lab03-row-costs", scene_path(args.scene), width=args.width,
                       height=args.height, spp=args.spp, seed=args.seed)
-        line = next(l for l in run.stderr.splitlines() if l.startswith("row-seconds:"))
+        line = next(ln for ln in run.stderr.splitlines() if ln.startswith("row-seconds:"))
         costs = [float(v) for v in line.split()[1:]]
         best = costs if best is None else [min(a, b) for a, b in zip(best, costs)]
     return best

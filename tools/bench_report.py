@@ -33,13 +33,19 @@ import sys
 
 ROOT = pathlib.Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(ROOT))
-from grading.checks import mpirun  # noqa: E402
-from grading.harness import (RunError, ImageError, available_cores, cpu_has_avx2,  # noqa: E402
-                             measure_parallel, run_lab)
-
 import bench_report_data as report  # noqa: E402
 import tradeoff_report  # noqa: E402  (Machine: CPU model, cores, date, load)
 import tradeoff_series  # noqa: E402  (make, gpu_missing, gpu_info; also sets Open MPI's root switches)
+
+from grading.checks import mpirun  # noqa: E402
+from grading.harness import (  # noqa: E402
+    ImageError,
+    RunError,
+    available_cores,
+    cpu_has_avx2,
+    measure_parallel,
+    run_lab,
+)
 
 FORMAT = "bench-report rows v1"  # the JSON's "format": --merge refuses anything else
 
@@ -336,7 +342,8 @@ def main(argv=None) -> int:
             try:
                 import bench_report_output  # noqa: F401  (checked before minutes of rendering)
             except ImportError:
-                raise BadInput("matplotlib is not installed for this python: run `make deps`")
+                raise BadInput(
+                    "matplotlib is not installed for this python: run `make deps`") from None
             if problem := tradeoff_report.cannot_write(out):
                 raise BadInput(problem)
         machine = machine_dict()

@@ -13,9 +13,8 @@ import statistics
 import matplotlib
 
 matplotlib.use("Agg")  # files only, no display
-import matplotlib.pyplot as plt  # noqa: E402
-
 import bench_report_data as report  # noqa: E402
+import matplotlib.pyplot as plt  # noqa: E402
 
 TITLES = {"baseline": "the baseline", "size": "image size (pixels a side)",
           "spp": "samples per pixel", "bounces": "bounces per ray"}
@@ -36,7 +35,7 @@ def experiments(plan: dict) -> dict:
 def index(rows: list[dict]) -> dict:
     """{(binary, (side, spp, bounces)): row}, each row with its speedup over lab01-ref."""
     by = {(r["binary"], (r["side"], r["spp"], r["bounces"])): r for r in rows}
-    for (binary, s), r in by.items():
+    for (_binary, s), r in by.items():
         serial = by.get((SERIAL, s))
         r["speedup"] = serial["seconds"] / r["seconds"] if serial else None
     return by

@@ -5,8 +5,9 @@
     python3 tools/bench_simd.py --full            the Cornell baseline: 600x600, 512 spp (minutes)
     python3 tools/bench_simd.py --packets         the handout's table of packet widths and methods:
                                                   Cornell 400x400x64 and showcase 300x300x64 at 8
-                                                  bounces, best of 5, with the issue's targets
-    python3 tools/bench_simd.py --only lab02      one variant (yours: lab02, lab02a) against lab01-ref
+                                                  bounces, best of 5, with the handout's targets
+    python3 tools/bench_simd.py --only lab02      one variant (yours: lab02, lab02a) against
+                                                  lab01-ref
 
 Every binary runs pinned to one CPU (taskset; --cpu picks which), interleaved (one of each,
 round after round), and each row reports its best round: a machine that slows down or speeds
@@ -19,8 +20,8 @@ load average before and after; asserts nothing. Report only what it printed.
 """
 import argparse
 import os
-import resource
 import pathlib
+import resource
 import shutil
 import sys
 
@@ -133,7 +134,9 @@ def main() -> int:
         variants = PACKETS if has_avx512() else [v for v in PACKETS if "16" not in v[0]]
         build(*sorted({binary for _, binary, _, _ in variants}))
         repeat = a.repeat or 5
-        scenes = [(a.scene, a.size or 400, a.spp or 64, a.bounces or 4)] if a.size else PACKET_SCENES
+        scenes = (
+            [(a.scene, a.size or 400, a.spp or 64, a.bounces or 4)] if a.size else PACKET_SCENES
+        )
         for scene, size, spp, bounces in scenes:
             best, identical = time_table(variants, scene, size, spp, bounces, repeat, cpu,
                                          a.cpu_time)

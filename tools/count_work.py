@@ -132,4 +132,6 @@ if __name__ == "__main__":
     try:
         main()
     except subprocess.CalledProcessError as error:
-        fail(f"'{' '.join(map(str, error.cmd[:2]))} ...' failed with exit status {error.returncode}")
+        fail(
+            f"'{' '.join(map(str, error.cmd[:2]))} ...' failed with exit status {error.returncode}"
+        )

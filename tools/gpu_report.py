@@ -26,6 +26,7 @@ sys.path.insert(0, str(ROOT))
 def collect(out: pathlib.Path) -> dict:
     """Everything gpu-check.json holds. Runs the lab binaries in the repository root."""
     import numpy as np
+
     from grading import checks
     from grading.compare import compare
     from grading.harness import golden, run_lab
@@ -204,7 +205,8 @@ def summary(result: dict) -> str:
     md += ["| build | golden passes | RMSE | bias (se) | max z | baseline kernel s | identical to default | identical to lab 01 |", "|---|---|---:|---:|---:|---:|---:|---:|"]
     for name, a in acc.items():
         if "error" in a:
-            md.append(f"| {name} | error: {a['error']} |"); continue
+            md.append(f"| {name} | error: {a['error']} |")
+            continue
         same = a.get("vs_default_same_seed", {}).get("identical_pixels")
         md.append(f"| {name} | {a['passed']} | {a['rmse']:.3e} | {a['bias']:.2e} ({a['bias_se']:.1e}) | {a['max_abs_z']:.2f}/{a['critical_z']:.2f} | "
                   f"{a['baseline_kernel_seconds_best'] if a['baseline_kernel_seconds_best'] is not None else '-'} | "
@@ -216,11 +218,14 @@ def summary(result: dict) -> str:
         md += ["| run | kernel | active threads/warp | achieved occupancy % | issue active % | FMA pipe % | thread instr/path | integer/path | fp32/path | fp64/path |", "|---|---|---:|---:|---:|---:|---:|---:|---:|---:|"]
         paths = b.get("width", 600) * b.get("height", 600) * 64  # every ncu run renders 64 spp
         def num(r, k):
-            try: return float(r[k].replace(",", ""))
-            except Exception: return float("nan")
+            try:
+                return float(r[k].replace(",", ""))
+            except Exception:
+                return float("nan")
         for r in ncu:
             if "error" in r:
-                md.append(f"| {r['run']} | error: {r['error']} |"); continue
+                md.append(f"| {r['run']} | error: {r['error']} |")
+                continue
             kn = r.get("Kernel Name", "?")[:60]
             md.append(f"| {r['run']} | `{kn}` | {num(r, keys[0]):.1f} | {num(r, keys[1]):.1f} | {num(r, keys[2]):.1f} | {num(r, keys[3]):.1f} | "
                       f"{num(r, 'smsp__thread_inst_executed.sum') / paths:.0f} | {num(r, 'smsp__sass_thread_inst_executed_op_integer_pred_on.sum') / paths:.0f} | "

@@ -24,8 +24,8 @@ import numpy as np
 
 ROOT = pathlib.Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(ROOT))
-from grading.harness import run_lab  # noqa: E402
 from grading import golden_sums  # noqa: E402
+from grading.harness import run_lab  # noqa: E402
 from grading.pfm import write_pfm  # noqa: E402
 
 # Golden scenes and the settings tests render them at. Small on purpose: the files stay

@@ -36,8 +36,6 @@ import tempfile
 
 ROOT = pathlib.Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(ROOT))
-from grading.harness import golden  # noqa: E402
-
 import tradeoff_bias  # noqa: E402
 import tradeoff_record  # noqa: E402
 import tradeoff_reference  # noqa: E402
@@ -46,6 +44,8 @@ import tradeoff_scenes  # noqa: E402
 import tradeoff_series  # noqa: E402
 import tradeoff_sweep  # noqa: E402
 from tradeoff_series import Series  # noqa: E402
+
+from grading.harness import golden  # noqa: E402
 
 
 @dataclasses.dataclass(frozen=True)

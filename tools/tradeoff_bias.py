@@ -34,11 +34,11 @@ import numpy as np
 
 ROOT = pathlib.Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(ROOT))
-from grading.compare import critical_z  # noqa: E402
-from grading.harness import run_lab  # noqa: E402
-
 import tradeoff_reference  # noqa: E402
 from tradeoff_series import first_words  # noqa: E402
+
+from grading.compare import critical_z  # noqa: E402
+from grading.harness import run_lab  # noqa: E402
 
 ALPHA = 1e-4
 # Float rounding of a path's value: the zero-variance interior of grading/checks.py differs

@@ -106,11 +106,11 @@ def gpu_info() -> str | None:
         return None
     p = subprocess.run(["nvidia-smi", "--query-gpu=name,driver_version",
                         "--format=csv,noheader"], capture_output=True, text=True)
-    lines = [l.strip() for l in p.stdout.splitlines() if l.strip()] if p.returncode == 0 else []
+    lines = [ln.strip() for ln in p.stdout.splitlines() if ln.strip()] if p.returncode == 0 else []
     if not lines:
         return None
-    return "; ".join(f"{l.split(',')[0].strip()}, driver {l.split(',')[-1].strip()}"
-                     for l in lines)
+    return "; ".join(f"{ln.split(',')[0].strip()}, driver {ln.split(',')[-1].strip()}"
+                     for ln in lines)
 
 
 def does_not_run(binary: pathlib.Path) -> str | None:
@@ -202,7 +202,9 @@ def build_variant(v: Variant, log=print) -> Series:
         return s
     if v.target:
         log(f"  building variant '{v.name}' (make {v.target}) ...")
-        p = subprocess.run(["make", "-s", "-C", str(ROOT), v.target], capture_output=True, text=True)
+        p = subprocess.run(
+            ["make", "-s", "-C", str(ROOT), v.target], capture_output=True, text=True
+        )
         if p.returncode != 0:
             s.unavailable = f"does not build: {first_words(p.stderr or p.stdout)}"
         else:

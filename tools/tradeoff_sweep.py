@@ -20,12 +20,12 @@ import sys
 
 ROOT = pathlib.Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(ROOT))
-from grading.compare import compare  # noqa: E402
-from grading.harness import run_lab  # noqa: E402
-
 import tradeoff_fit  # noqa: E402
 from tradeoff_reference import Reference  # noqa: E402
 from tradeoff_series import first_words  # noqa: E402
+
+from grading.compare import compare  # noqa: E402
+from grading.harness import run_lab  # noqa: E402
 
 SWEEP_SEED = 100  # + log2(spp): each point its own seed, none of the reference's
 
@@ -69,7 +69,9 @@ class Sweep:
         if nonfinite:
             return f"{self.series} on {self.scene}: {nonfinite} NaN/Inf pixels"
         if not tradeoff_fit.slope_ok(self.fit) or self.plateau is not None:
-            return f"{self.series} on {self.scene}: " + tradeoff_fit.describe(self.fit, self.plateau)
+            return f"{self.series} on {self.scene}: " + tradeoff_fit.describe(
+                self.fit, self.plateau
+            )
         return None
 
 

@@ -27,8 +27,8 @@ struct Camera {
     // the direction as the file writes it (host/scene.h) and the frame starts from it.
     static Camera looking_along(Vec3 position, const double (&forward)[3], Vec3 up,
                                 real vfov_degrees, int width, int height) {
-        const double f_length = std::sqrt(forward[0] * forward[0] + forward[1] * forward[1] +
-                                          forward[2] * forward[2]);
+        const double f_length =
+            std::sqrt(forward[0] * forward[0] + forward[1] * forward[1] + forward[2] * forward[2]);
         const double f[3] = {forward[0] / f_length, forward[1] / f_length, forward[2] / f_length};
         const double u[3] = {up.x, up.y, up.z};
         double r[3] = {f[1] * u[2] - f[2] * u[1], f[2] * u[0] - f[0] * u[2],

@@ -27,10 +27,11 @@ RT_HD inline void sincos_2pi(real u, real& s, real& c) {
     const real q = rint_real(t);
     const real x = (t - q) * real(1.57079632679489661923);  // in [-pi/4, pi/4]
     const real z = x * x;
-    const real sin_x = x + x * z * ((-1.9515295891e-4f * z + 8.3321608736e-3f) * z - 1.6666654611e-1f);
-    const real cos_x = 1.0f - z * 0.5f +
-                        z * z * ((2.443315711809948e-5f * z - 1.388731625493765e-3f) * z +
-                                 4.166664568298827e-2f);
+    const real sin_x =
+        x + x * z * ((-1.9515295891e-4f * z + 8.3321608736e-3f) * z - 1.6666654611e-1f);
+    const real cos_x =
+        1.0f - z * 0.5f +
+        z * z * ((2.443315711809948e-5f * z - 1.388731625493765e-3f) * z + 4.166664568298827e-2f);
     // Quadrant k: sin = (sin x, cos x, -sin x, -cos x)[k], cos = (cos x, -sin x, -cos x, sin x)[k].
     const int k = static_cast<int>(q) & 3;
     const real s_abs = (k & 1) ? cos_x : sin_x;

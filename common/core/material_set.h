@@ -19,8 +19,8 @@ struct MaterialSet {
     static constexpr bool kSpecular = kWithMirror || kWithGlass;  // anything but diffuse
 };
 
-using AnyMaterial = MaterialSet<true, true>;      // every scene: the default
-using DiffuseOnly = MaterialSet<false, false>;    // scenes without mirrors or glass
+using AnyMaterial = MaterialSet<true, true>;  // every scene: the default
+using DiffuseOnly = MaterialSet<false, false>;  // scenes without mirrors or glass
 
 // What a scene's material table holds: whether a renderer for DiffuseOnly may render it.
 // (A table entry that no primitive uses counts too: the check stays one loop over a short

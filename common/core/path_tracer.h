@@ -170,8 +170,8 @@ RT_HD inline bool sample_light(const SceneView& scene, Vec3 position, Vec3 origi
     const real cos_theta = dot(facing_normal, wi);
     // Light behind the surface, not resolved from it, or a falloff cos/(pi d^2) past the range.
     // One branch: & rather than || (each ordered comparison is false for NaN).
-    const bool in_front = (cos_theta > 0.0f) & (distance > resolved) &
-                          (cos_theta < kRealMax * (kPi * distance2));
+    const bool in_front =
+        (cos_theta > 0.0f) & (distance > resolved) & (cos_theta < kRealMax * (kPi * distance2));
     if (!in_front) return false;
     shadow.ray = {origin, wi};
     shadow.t_max = distance - dot(origin - position, wi);
@@ -238,10 +238,9 @@ RT_HD RT_FORCE_INLINE bool bounce_step(const SceneView& scene, const Hit& hit, c
         // after ~10 bounces its hits overshoot the ray offset (the paths escaped a closed mirror
         // sphere). refract() normalises already.
         const Vec3 off_edges =
-            hit.triangle >= 0
-                ? step_off_edges(scene.triangles[hit.triangle], surface.position,
-                                 ray_offset(surface.position, hit.t, surface.extent))
-                : Vec3(0.0f);
+            hit.triangle >= 0 ? step_off_edges(scene.triangles[hit.triangle], surface.position,
+                                               ray_offset(surface.position, hit.t, surface.extent))
+                              : Vec3(0.0f);
         if (!Materials::kGlass || (Materials::kMirror && material.type == MaterialType::Mirror)) {
             path.throughput *= material.albedo;
             path.ray = {above + off_edges, normalize(reflect(incoming, facing))};
@@ -324,8 +323,8 @@ RT_HD inline Vec3 render_pixel(const SceneView& scene, const Geometry& geometry,
     //> // (SampleStream(settings.seed, pixel, s), dimensions kDimPixelX/kDimPixelY).
     //> // Until then: one path through the pixel's corner.
     //> const SampleStream rng(settings.seed, pixel, 0);
-    //> sum.add(trace_path<Materials>(scene, geometry, camera.ray_through(x, y), rng,
-    //>                               settings.bounces));
+    //> sum.add(
+    //>     trace_path<Materials>(scene, geometry, camera.ray_through(x, y), rng, settings.bounces));
     //> return sum.mean(1);
     // END SOLUTION
 }

@@ -25,8 +25,8 @@ RT_HD inline real sphere_extent(const Sphere& s) { return max_component(abs(s.ce
 //    (Haines et al., "Precision Improvements for Ray/Sphere Intersection", Ray Tracing Gems).
 RT_HD inline real intersect_sphere(const Ray& ray, const Sphere& s, real t_max) {
     const Vec3 f = ray.origin - s.center;
-    const real b = -dot(f, ray.direction);           // the ray passes closest to the centre at t = b
-    const Vec3 perpendicular = f + ray.direction * b;   // centre-to-ray offset at that point
+    const real b = -dot(f, ray.direction);  // the ray passes closest to the centre at t = b
+    const Vec3 perpendicular = f + ray.direction * b;  // centre-to-ray offset at that point
     const real r2 = s.radius * s.radius;
     const real disc = r2 - length_squared(perpendicular);
     if (!(disc >= 0.0f)) return t_max;

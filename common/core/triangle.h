@@ -33,16 +33,15 @@ inline Triangle make_triangle(Vec3 v0, Vec3 v1, Vec3 v2, int material) {
     const double n[3] = {e1[1] * e2[2] - e1[2] * e2[1], e1[2] * e2[0] - e1[0] * e2[2],
                          e1[0] * e2[1] - e1[1] * e2[0]};
     const double len = std::sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
-    const Vec3 normal = len > 0.0 ? Vec3(static_cast<real>(n[0] / len),
-                                         static_cast<real>(n[1] / len),
-                                         static_cast<real>(n[2] / len))
-                                  : Vec3(0.0f);
+    const Vec3 normal = len > 0.0
+                            ? Vec3(static_cast<real>(n[0] / len), static_cast<real>(n[1] / len),
+                                   static_cast<real>(n[2] / len))
+                            : Vec3(0.0f);
     // The plane of the stored (real) normal through v0, rounded once.
-    const real plane_offset = static_cast<real>(double(normal.x) * v0.x +
-                                                  double(normal.y) * v0.y +
-                                                  double(normal.z) * v0.z);
-    const real extent =
-        max_float(max_component(abs(v0)), max_float(max_component(abs(v1)), max_component(abs(v2))));
+    const real plane_offset = static_cast<real>(double(normal.x) * v0.x + double(normal.y) * v0.y +
+                                                double(normal.z) * v0.z);
+    const real extent = max_float(max_component(abs(v0)),
+                                  max_float(max_component(abs(v1)), max_component(abs(v2))));
     Triangle tri;
     tri.normal = normal;
     tri.plane_offset = plane_offset;
@@ -63,8 +62,7 @@ inline Triangle make_triangle(Vec3 v0, Vec3 v1, Vec3 v2, int material) {
 // for each such edge, `margin` along its inward perpendicular. With the normal offset, the
 // origin then lies in front of every face that meets this one at an edge at more than 45
 // degrees, as a room's walls do. Zero for a point farther than `margin` from every edge.
-RT_HD inline void step_off_edge(Vec3 normal, Vec3 from, Vec3 to, Vec3 p, real margin,
-                                Vec3& step) {
+RT_HD inline void step_off_edge(Vec3 normal, Vec3 from, Vec3 to, Vec3 p, real margin, Vec3& step) {
     const Vec3 inward = cross(normal, to - from);  // in the plane, toward the inside
     const real inward_length = length(inward);     // the edge's length
     const real depth = dot(p - from, inward);      // distance inside the edge x inward_length

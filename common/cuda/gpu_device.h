@@ -16,8 +16,9 @@ inline cudaDeviceProp open_device() {
         throw GpuError("GPU: no CUDA GPU found (the CUDA labs render on an NVIDIA GPU)");
     }
     if (status == cudaErrorInsufficientDriver) {  // also what a machine with no driver says
-        throw GpuError("GPU: no usable CUDA GPU: no NVIDIA driver, or one older than this "
-                       "program's CUDA runtime (cudaErrorInsufficientDriver)");
+        throw GpuError(
+            "GPU: no usable CUDA GPU: no NVIDIA driver, or one older than this "
+            "program's CUDA runtime (cudaErrorInsufficientDriver)");
     }
     check(status, "looking for a CUDA GPU");
     check(cudaSetDevice(0), "selecting GPU 0");
@@ -30,6 +31,5 @@ inline cudaDeviceProp open_device() {
 // "NVIDIA H200 (sm_90, 132 SMs)": what RenderStats::device says.
 inline std::string describe(const cudaDeviceProp& prop) {
     return std::string(prop.name) + " (sm_" + std::to_string(prop.major) +
-           std::to_string(prop.minor) + ", " + std::to_string(prop.multiProcessorCount) +
-           " SMs)";
+           std::to_string(prop.minor) + ", " + std::to_string(prop.multiProcessorCount) + " SMs)";
 }

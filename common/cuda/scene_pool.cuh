@@ -34,10 +34,14 @@ struct SceneLayout {
     // into the kernel, the compiler sees where the pointers came from and uses that memory's
     // own load instructions (LDC for constant, LDS for shared).
     __host__ __device__ SceneView view(const float4* pool) const {
-        return {reinterpret_cast<const Sphere*>(pool + sphere_word),     num_spheres,
-                reinterpret_cast<const Triangle*>(pool + triangle_word), num_triangles,
-                reinterpret_cast<const Material*>(pool + material_word), num_materials,
-                light,                                                   has_light,
+        return {reinterpret_cast<const Sphere*>(pool + sphere_word),
+                num_spheres,
+                reinterpret_cast<const Triangle*>(pool + triangle_word),
+                num_triangles,
+                reinterpret_cast<const Material*>(pool + material_word),
+                num_materials,
+                light,
+                has_light,
                 background};
     }
 };

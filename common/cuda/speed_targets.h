@@ -25,12 +25,13 @@ constexpr const char kTargetGpu[] = "H200";  // the GPU the bars are set on (in 
 inline std::string why_not_judged(const cudaDeviceProp& prop, const std::string& scene_path,
                                   const RenderSettings& s) {
     if (std::string(prop.name).find(kTargetGpu) == std::string::npos) {
-        return std::string("the bars are set on an NVIDIA ") + kTargetGpu + ", not this " + prop.name;
+        return std::string("the bars are set on an NVIDIA ") + kTargetGpu + ", not this " +
+               prop.name;
     }
     const std::string baseline = "common/scenes/cornell.json";
-    const bool cornell = scene_path.size() >= baseline.size() &&
-                         scene_path.compare(scene_path.size() - baseline.size(), baseline.size(),
-                                            baseline) == 0;
+    const bool cornell =
+        scene_path.size() >= baseline.size() &&
+        scene_path.compare(scene_path.size() - baseline.size(), baseline.size(), baseline) == 0;
     if (!cornell || s.width != 600 || s.height != 600 || s.spp != 512 || s.bounces != 4) {
         return "the bars are set for the baseline: common/scenes/cornell.json, 600x600, 512 spp, "
                "4 bounces";
@@ -57,7 +58,8 @@ std::string targets_json(const SpeedTarget (&targets)[N],
         else std::snprintf(bar, sizeof bar, "at most %g ms", t.max_ms);
         const bool met = t.faster_than ? ms < other : ms <= t.max_ms;
         const char* verdict = !measured || !why_not.empty() ? "null" : met ? "true" : "false";
-        std::snprintf(buffer, sizeof buffer, "%s{\"config\": \"%s\", \"bar\": \"%s on an NVIDIA %s, the baseline\", ",
+        std::snprintf(buffer, sizeof buffer,
+                      "%s{\"config\": \"%s\", \"bar\": \"%s on an NVIDIA %s, the baseline\", ",
                       i ? ", " : "", t.config, bar, kTargetGpu);
         out += buffer;
         if (measured) std::snprintf(buffer, sizeof buffer, "\"best_ms\": %.3f, ", ms);

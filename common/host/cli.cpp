@@ -11,7 +11,9 @@
 #define RT_SOURCE_DIR "."
 #endif
 
-std::string default_scene_path() { return std::string(RT_SOURCE_DIR) + "/common/scenes/cornell.json"; }
+std::string default_scene_path() {
+    return std::string(RT_SOURCE_DIR) + "/common/scenes/cornell.json";
+}
 
 static void print_usage(const char* program) {
     std::printf(

@@ -16,8 +16,7 @@
 
 unsigned char encode_srgb8(float linear) {
     const float c = std::isnan(linear) ? 0.0f : std::fmin(std::fmax(linear, 0.0f), 1.0f);
-    const float encoded =
-        c <= 0.0031308f ? 12.92f * c : 1.055f * std::pow(c, 1.0f / 2.4f) - 0.055f;
+    const float encoded = c <= 0.0031308f ? 12.92f * c : 1.055f * std::pow(c, 1.0f / 2.4f) - 0.055f;
     return static_cast<unsigned char>(std::lround(encoded * 255.0f));
 }
 
@@ -27,8 +26,8 @@ static float decode_srgb8(unsigned char code) {
 }
 
 std::string ppm_bytes(const Image& image) {
-    std::string out = "P6\n" + std::to_string(image.width) + " " + std::to_string(image.height) +
-                      "\n255\n";
+    std::string out =
+        "P6\n" + std::to_string(image.width) + " " + std::to_string(image.height) + "\n255\n";
     out.reserve(out.size() + image.pixels.size() * 3);
     for (const Vec3& p : image.pixels) {
         out.push_back(static_cast<char>(encode_srgb8(p.x)));
@@ -41,8 +40,8 @@ std::string ppm_bytes(const Image& image) {
 // PFM: "PF", size, then a scale whose sign gives the byte order (negative: little endian);
 // rows are stored bottom to top.
 std::string pfm_bytes(const Image& image) {
-    std::string out = "PF\n" + std::to_string(image.width) + " " + std::to_string(image.height) +
-                      "\n-1.0\n";
+    std::string out =
+        "PF\n" + std::to_string(image.width) + " " + std::to_string(image.height) + "\n-1.0\n";
     const size_t header = out.size();
     out.resize(header + image.pixels.size() * 3 * sizeof(float));
     char* dst = &out[header];

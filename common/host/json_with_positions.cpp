@@ -152,15 +152,13 @@ public:
         frames_.pop_back();
         return container_done(dom_.end_array());
     }
-    bool parse_error(std::size_t position, const std::string&,
-                     const json::exception& ex) override {
+    bool parse_error(std::size_t position, const std::string&, const json::exception& ex) override {
         error_offset = position == 0 ? 0 : position - 1;
         error_message = ex.what();
         // nlohmann points at the last character it read. When a whole token came where it
         // is not allowed ("unexpected string literal"), point at the token's first character;
         // a malformed token ("invalid literal") stays at the character that broke it.
-        if (error_message.find("unexpected") != std::string::npos &&
-            error_offset < text_.size()) {
+        if (error_message.find("unexpected") != std::string::npos && error_offset < text_.size()) {
             size_t i = error_offset;
             auto in_word = [&](size_t k) {
                 return std::isalnum(static_cast<unsigned char>(text_[k])) ||
@@ -180,8 +178,8 @@ public:
 private:
     struct Frame {
         bool is_object;
-        size_t index;               // next array index
-        std::string key;            // current object key
+        size_t index;  // next array index
+        std::string key;  // current object key
         std::set<std::string> keys;  // keys seen, to catch duplicates
     };
 
@@ -289,4 +287,3 @@ std::string line_column(const std::string& text, size_t offset) {
     }
     return "line " + std::to_string(line) + ", column " + std::to_string(column);
 }
-

@@ -23,7 +23,8 @@ struct RenderStats {
     double seconds = 0;  // render time only: no loading, writing or context creation
     std::string device;  // what it ran on, e.g. "AMD EPYC, 1 thread"
     std::string timing = "";  // what `seconds` covers, when more needs saying (GPU: kernel only)
-    std::string layout = "";  // the wavefront labs: how the path pool lays items out (a JSON object)
+    std::string layout =
+        "";  // the wavefront labs: how the path pool lays items out (a JSON object)
 };
 
 // Implemented once per lab (skeleton and solution alike).

@@ -57,10 +57,8 @@ static int run(int argc, char** argv, const LabHooks& hooks, bool& setup_reporte
 
     Image image(settings.width, settings.height);
     Progress progress(settings.height, hooks.writes_output && progress_wanted(options.quiet));
-    const RenderJob job{scene.view(),
-                        settings,
-                        scene.camera.for_image(settings.width, settings.height),
-                        options.threads,
+    const RenderJob job{scene.view(), settings,
+                        scene.camera.for_image(settings.width, settings.height), options.threads,
                         progress};
     if (hooks.setup_done) {
         setup_reported = true;
@@ -84,12 +82,13 @@ static int run(int argc, char** argv, const LabHooks& hooks, bool& setup_reporte
             settings.spp, settings.bounces, static_cast<unsigned long long>(settings.seed),
             stats.seconds, paths_per_second, json_escape(stats.device).c_str(), kPrecisionName,
             to_json(use).c_str(),
-            stats.timing.empty() ? "" : (", \"timing\": \"" + json_escape(stats.timing) + "\"").c_str(),
+            stats.timing.empty() ? ""
+                                 : (", \"timing\": \"" + json_escape(stats.timing) + "\"").c_str(),
             stats.layout.empty() ? "" : (", \"layout\": " + stats.layout).c_str());
     } else {
-        std::printf("%s: %dx%d, %d spp, %d bounces: %.3f s render, %.2f Mpaths/s on %s\n",
-                    kLabName, settings.width, settings.height, settings.spp, settings.bounces,
-                    stats.seconds, paths_per_second / 1e6, stats.device.c_str());
+        std::printf("%s: %dx%d, %d spp, %d bounces: %.3f s render, %.2f Mpaths/s on %s\n", kLabName,
+                    settings.width, settings.height, settings.spp, settings.bounces, stats.seconds,
+                    paths_per_second / 1e6, stats.device.c_str());
     }
     return 0;
 }

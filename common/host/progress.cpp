@@ -43,7 +43,7 @@ void Progress::draw(long done) {
     for (int i = 0; i < width; ++i) bar[i] = i < filled ? '#' : '.';
     bar[width] = '\0';
     const double eta = fraction > 0 ? elapsed * (1 - fraction) / fraction : 0;
-    std::fprintf(stderr, "\r[%s] %5.1f%%  %6.1f s elapsed, ~%.1f s left ", bar,
-                 100.0 * fraction, elapsed, eta);
+    std::fprintf(stderr, "\r[%s] %5.1f%%  %6.1f s elapsed, ~%.1f s left ", bar, 100.0 * fraction,
+                 elapsed, eta);
     std::fflush(stderr);
 }

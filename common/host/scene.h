@@ -77,10 +77,14 @@ struct Scene {
     WrittenCoordinates written;       // the file's points in double, for centre_scene
 
     SceneView view() const {
-        return {spheres.data(),   static_cast<int>(spheres.size()),
-                triangles.data(), static_cast<int>(triangles.size()),
-                materials.data(), static_cast<int>(materials.size()),
-                light,            has_light,
+        return {spheres.data(),
+                static_cast<int>(spheres.size()),
+                triangles.data(),
+                static_cast<int>(triangles.size()),
+                materials.data(),
+                static_cast<int>(materials.size()),
+                light,
+                has_light,
                 background};
     }
 };

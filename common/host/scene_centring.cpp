@@ -109,8 +109,8 @@ Scene centre_scene(Scene scene) {
         scene.spheres[i].center = rounded(moved.sphere_centres[i]);
     for (size_t i = 0; i < scene.triangles.size(); ++i) {
         const WrittenPoint* v = &moved.triangle_vertices[3 * i];
-        scene.triangles[i] = make_triangle(rounded(v[0]), rounded(v[1]), rounded(v[2]),
-                                           scene.triangles[i].material);
+        scene.triangles[i] =
+            make_triangle(rounded(v[0]), rounded(v[1]), rounded(v[2]), scene.triangles[i].material);
     }
     scene.camera.position = rounded(camera_position);
     scene.camera.look_at = rounded(camera_look_at);

@@ -63,22 +63,21 @@ inline std::string coordinate_problem(double x) {
 // `what` names the size ("a radius", ...) at the start of the message.
 inline std::string size_problem(const char* what, double size, double extent) {
     if (size < kMinSize)
-        return std::string(what) + " of " + format_number(size) +
-               " is below " + kMinSizeText + ", too small for the renderer's " +
-               kPrecisionName + " arithmetic: scale the scene up";
+        return std::string(what) + " of " + format_number(size) + " is below " + kMinSizeText +
+               ", too small for the renderer's " + kPrecisionName +
+               " arithmetic: scale the scene up";
     if (size < kMinRelativeSize * extent)
-        return std::string(what) + " of " + format_number(size) +
-               " is too small for " + kPrecisionName +
-               " precision that far from the origin (coordinates up to " + format_number(extent) +
-               "): move the scene nearer the origin or make it larger";
+        return std::string(what) + " of " + format_number(size) + " is too small for " +
+               kPrecisionName + " precision that far from the origin (coordinates up to " +
+               format_number(extent) + "): move the scene nearer the origin or make it larger";
     return "";
 }
 
 inline std::string sphere_problem(const Sphere& s) {
     if (s.radius > kMaxCoordinate)
-        return "a radius of " + format_number(s.radius) +
-               " is above " + kMaxCoordinateText + ", too large for the renderer's " +
-               kPrecisionName + " arithmetic: scale the scene down";
+        return "a radius of " + format_number(s.radius) + " is above " + kMaxCoordinateText +
+               ", too large for the renderer's " + kPrecisionName +
+               " arithmetic: scale the scene down";
     return size_problem("a radius", s.radius, sphere_extent(s));
 }
 

@@ -51,8 +51,8 @@ public:
 
     [[noreturn]] void fail_key(const std::string& pointer, const std::string& what) const {
         auto it = offsets_.find(pointer + "#key");
-        throw InputError(name_ + ":" +
-                         line_column(text_, it == offsets_.end() ? 0 : it->second) + ": " + what);
+        throw InputError(name_ + ":" + line_column(text_, it == offsets_.end() ? 0 : it->second) +
+                         ": " + what);
     }
 
     const json& require(const json& obj, const std::string& pointer, const char* key) const {
@@ -65,8 +65,8 @@ public:
         if (!v.is_number()) fail(pointer, "expected a number, found " + type_of(v));
         const double d = v.get<double>();
         if (!std::isfinite(d) || std::fabs(d) > kMaxNumber)
-            fail(pointer, std::string("expected a finite number within ") + kPrecisionName +
-                              " range");
+            fail(pointer,
+                 std::string("expected a finite number within ") + kPrecisionName + " range");
         return d;
     }
 
@@ -94,10 +94,8 @@ public:
         return r;
     }
 
-    long long integer(const json& v, const std::string& pointer, long long lo,
-                      long long hi) const {
-        if (!v.is_number_integer())
-            fail(pointer, "expected an integer, found " + type_of(v));
+    long long integer(const json& v, const std::string& pointer, long long lo, long long hi) const {
+        if (!v.is_number_integer()) fail(pointer, "expected an integer, found " + type_of(v));
         const long long x = v.get<long long>();
         if (x < lo || x > hi)
             fail(pointer, "expected an integer in " + std::to_string(lo) + ".." +
@@ -169,8 +167,7 @@ void read_camera(const SceneReader& r, const json& root, Scene& scene) {
     r.check_keys(cam, "/camera", {"position", "look_at", "up", "vfov"});
     camera.position =
         read_position(r, r.require(cam, "/camera", "position"), "/camera/position", from);
-    camera.look_at =
-        read_position(r, r.require(cam, "/camera", "look_at"), "/camera/look_at", to);
+    camera.look_at = read_position(r, r.require(cam, "/camera", "look_at"), "/camera/look_at", to);
     if (cam.contains("up")) camera.up = r.vec3(cam["up"], "/camera/up");
     if (cam.contains("vfov")) {
         camera.vfov_degrees = r.number(cam["vfov"], "/camera/vfov");
@@ -233,8 +230,8 @@ Material read_material(const SceneReader& r, const json& m, const std::string& p
 std::map<std::string, int> read_materials(const SceneReader& r, const json& root, Scene& scene) {
     const json& materials = r.require(root, "", "materials");
     if (!materials.is_object() || materials.empty())
-        r.fail("/materials", "expected an object of named materials, found " +
-                                 SceneReader::type_of(materials));
+        r.fail("/materials",
+               "expected an object of named materials, found " + SceneReader::type_of(materials));
     std::map<std::string, int> index;
     for (auto it = materials.begin(); it != materials.end(); ++it) {
         index[it.key()] = static_cast<int>(scene.materials.size());
@@ -264,11 +261,12 @@ public:
     int material(const json& obj, const std::string& p) const {
         const json& name = r_.require(obj, p, "material");
         if (!name.is_string())
-            r_.fail(p + "/material", "expected a material name, found " + SceneReader::type_of(name));
+            r_.fail(p + "/material",
+                    "expected a material name, found " + SceneReader::type_of(name));
         const auto found = materials_.find(name.get<std::string>());
         if (found == materials_.end())
-            r_.fail(p + "/material", "unknown material " + name.dump() +
-                                         " (not defined under \"materials\")");
+            r_.fail(p + "/material",
+                    "unknown material " + name.dump() + " (not defined under \"materials\")");
         return found->second;
     }
 
@@ -280,8 +278,7 @@ public:
                                          " points, found " + SceneReader::type_of(v));
         std::vector<Vec3> points;
         for (size_t k = 0; k < count; ++k)
-            points.push_back(
-                read_position(r_, v[k], p + "/vertices/" + std::to_string(k), unused));
+            points.push_back(read_position(r_, v[k], p + "/vertices/" + std::to_string(k), unused));
         return points;
     }
 
@@ -355,8 +352,8 @@ void check_scene_scale(const SceneReader& r, const json& root, const Scene& scen
     };
     double extent = 0.0;
     for (size_t i = 0; i < scene.spheres.size(); ++i)
-        extent = std::fmax(extent, from_centre(scene.written.sphere_centres[i]) +
-                                       scene.spheres[i].radius);
+        extent = std::fmax(extent,
+                           from_centre(scene.written.sphere_centres[i]) + scene.spheres[i].radius);
     for (const WrittenPoint& v : scene.written.triangle_vertices)
         extent = std::fmax(extent, from_centre(v));
     for (size_t i = 0; i < scene.spheres.size(); ++i) {
@@ -394,8 +391,9 @@ Scene parse_scene(const std::string& text, const std::string& name) {
     const SceneReader r(name, text, parsed.offsets);
     if (!parsed.duplicate_key_pointer.empty())
         r.fail_key(parsed.duplicate_key_pointer, "duplicate key \"" + parsed.duplicate_key + "\"");
-    r.check_keys(root, "", {"camera", "background", "light", "materials", "spheres", "triangles",
-                            "quads", "render"});
+    r.check_keys(
+        root, "",
+        {"camera", "background", "light", "materials", "spheres", "triangles", "quads", "render"});
 
     Scene scene;
     scene.name = name;

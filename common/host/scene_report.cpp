@@ -58,8 +58,8 @@ std::string describe(const SceneUse& use) {
     add(use.mirrors, "mirror");
     add(use.glass, "glass");
     std::string line = "scene: " + plural(use.spheres, "sphere", "spheres") + ", " +
-                       plural(use.triangles, "triangle", "triangles") + "; materials: " +
-                       (materials.empty() ? "none" : materials) + "; " +
+                       plural(use.triangles, "triangle", "triangles") +
+                       "; materials: " + (materials.empty() ? "none" : materials) + "; " +
                        (use.light ? "a point light" : "no light") + "; " +
                        (use.background ? "a background" : "a black background");
     if (use.smallest > 0) {
@@ -78,11 +78,13 @@ std::string scale_warning(const SceneUse& use) {
 }
 
 std::string to_json(const SceneUse& use) {
-    return "{\"spheres\": " + std::to_string(use.spheres) + ", \"triangles\": " +
-           std::to_string(use.triangles) + ", \"diffuse\": " + std::to_string(use.diffuse) +
-           ", \"mirrors\": " + std::to_string(use.mirrors) + ", \"glass\": " +
-           std::to_string(use.glass) + ", \"light\": " + (use.light ? "true" : "false") +
-           ", \"background\": " + (use.background ? "true" : "false") + ", \"smallest\": " +
-           number(use.smallest) + ", \"extent\": " + number(use.extent) + ", \"warning\": " +
-           (scale_warning(use).empty() ? "false" : "true") + "}";
+    return "{\"spheres\": " + std::to_string(use.spheres) +
+           ", \"triangles\": " + std::to_string(use.triangles) +
+           ", \"diffuse\": " + std::to_string(use.diffuse) +
+           ", \"mirrors\": " + std::to_string(use.mirrors) +
+           ", \"glass\": " + std::to_string(use.glass) +
+           ", \"light\": " + (use.light ? "true" : "false") +
+           ", \"background\": " + (use.background ? "true" : "false") +
+           ", \"smallest\": " + number(use.smallest) + ", \"extent\": " + number(use.extent) +
+           ", \"warning\": " + (scale_warning(use).empty() ? "false" : "true") + "}";
 }

@@ -52,7 +52,7 @@ struct PathGroup {
     int count = 0;
 
     PathPacket<F> load(int i, int bounce, MaskOf<F> active) const {
-        const auto v = [i](const float (&a)[3][kCapacity]) {
+        const auto v = [i](const float(&a)[3][kCapacity]) {
             return Vec3xN<F>(F::load(a[0] + i), F::load(a[1] + i), F::load(a[2] + i));
         };
         return {{v(origin), v(direction)}, v(throughput), v(radiance), bounce, active};
@@ -61,9 +61,9 @@ struct PathGroup {
     // Writes the lanes of `keep` at entries at, at+1, ...; returns how many. Writes a whole
     // packet from `at`: the caller's `at` is at most the packet's own first entry.
     template <class Compress>
-    int store(int at, const Compress& keep, const PathPacket<F>& path, IntOf<F> slots,
-              IntOf<F> low, IntOf<F> high) {
-        const auto put = [&](float (&a)[3][kCapacity], const Vec3xN<F>& value) {
+    int store(int at, const Compress& keep, const PathPacket<F>& path, IntOf<F> slots, IntOf<F> low,
+              IntOf<F> high) {
+        const auto put = [&](float(&a)[3][kCapacity], const Vec3xN<F>& value) {
             keep(value.x).store(a[0] + at);
             keep(value.y).store(a[1] + at);
             keep(value.z).store(a[2] + at);

@@ -41,17 +41,25 @@ inline Vec3xN<F> operator-(const Vec3xN<F>& a, const Vec3xN<F>& b) {
     return {a.x - b.x, a.y - b.y, a.z - b.z};
 }
 template <class F>
-inline Vec3xN<F> operator-(const Vec3xN<F>& a) { return {-a.x, -a.y, -a.z}; }
+inline Vec3xN<F> operator-(const Vec3xN<F>& a) {
+    return {-a.x, -a.y, -a.z};
+}
 template <class F>
 inline Vec3xN<F> operator*(const Vec3xN<F>& a, const Vec3xN<F>& b) {
     return {a.x * b.x, a.y * b.y, a.z * b.z};
 }
 template <class F>
-inline Vec3xN<F> operator*(const Vec3xN<F>& a, F s) { return {a.x * s, a.y * s, a.z * s}; }
+inline Vec3xN<F> operator*(const Vec3xN<F>& a, F s) {
+    return {a.x * s, a.y * s, a.z * s};
+}
 template <class F>
-inline Vec3xN<F>& operator+=(Vec3xN<F>& a, const Vec3xN<F>& b) { return a = a + b; }
+inline Vec3xN<F>& operator+=(Vec3xN<F>& a, const Vec3xN<F>& b) {
+    return a = a + b;
+}
 template <class F>
-inline Vec3xN<F>& operator*=(Vec3xN<F>& a, const Vec3xN<F>& b) { return a = a * b; }
+inline Vec3xN<F>& operator*=(Vec3xN<F>& a, const Vec3xN<F>& b) {
+    return a = a * b;
+}
 template <class F>
 inline Vec3xN<F> select(MaskOf<F> mask, const Vec3xN<F>& a, const Vec3xN<F>& b) {
     return {select(mask, a.x, b.x), select(mask, a.y, b.y), select(mask, a.z, b.z)};
@@ -59,15 +67,25 @@ inline Vec3xN<F> select(MaskOf<F> mask, const Vec3xN<F>& a, const Vec3xN<F>& b) 
 
 // No horizontal work anywhere: a dot product of N pairs is 3 multiplies and 2 adds.
 template <class F>
-inline F dot(const Vec3xN<F>& a, const Vec3xN<F>& b) { return a.x * b.x + a.y * b.y + a.z * b.z; }
+inline F dot(const Vec3xN<F>& a, const Vec3xN<F>& b) {
+    return a.x * b.x + a.y * b.y + a.z * b.z;
+}
 template <class F>
-inline F length_squared(const Vec3xN<F>& a) { return dot(a, a); }
+inline F length_squared(const Vec3xN<F>& a) {
+    return dot(a, a);
+}
 template <class F>
-inline Vec3xN<F> normalize(const Vec3xN<F>& a) { return a * (F(1.0f) / sqrt(dot(a, a))); }
+inline Vec3xN<F> normalize(const Vec3xN<F>& a) {
+    return a * (F(1.0f) / sqrt(dot(a, a)));
+}
 template <class F>
-inline Vec3xN<F> abs(const Vec3xN<F>& a) { return {abs(a.x), abs(a.y), abs(a.z)}; }
+inline Vec3xN<F> abs(const Vec3xN<F>& a) {
+    return {abs(a.x), abs(a.y), abs(a.z)};
+}
 template <class F>
-inline F max_component(const Vec3xN<F>& a) { return max(a.x, max(a.y, a.z)); }
+inline F max_component(const Vec3xN<F>& a) {
+    return max(a.x, max(a.y, a.z));
+}
 template <class F>
 inline Vec3xN<F> reflect(const Vec3xN<F>& d, const Vec3xN<F>& n) {
     return d - n * (F(2.0f) * dot(d, n));
@@ -101,10 +119,12 @@ inline void sincos_2pi(F u, F& s, F& c) {
     const F q = round_to_nearest(t);
     const F x = (t - q) * 1.57079632679489661923f;  // in [-pi/4, pi/4]
     const F z = x * x;
-    const F sin_x = x + x * z * ((F(-1.9515295891e-4f) * z + 8.3321608736e-3f) * z - 1.6666654611e-1f);
-    const F cos_x = F(1.0f) - z * 0.5f +
-                    z * z * ((F(2.443315711809948e-5f) * z - 1.388731625493765e-3f) * z +
-                             4.166664568298827e-2f);
+    const F sin_x =
+        x + x * z * ((F(-1.9515295891e-4f) * z + 8.3321608736e-3f) * z - 1.6666654611e-1f);
+    const F cos_x =
+        F(1.0f) - z * 0.5f +
+        z * z *
+            ((F(2.443315711809948e-5f) * z - 1.388731625493765e-3f) * z + 4.166664568298827e-2f);
     // Quadrant k: sin = (sin x, cos x, -sin x, -cos x)[k], cos = (cos x, -sin x, -cos x, sin x)[k].
     const IntOf<F> k = to_int(q) & 3;
     const auto odd = (k & 1) == 1;
@@ -185,8 +205,8 @@ private:
 // Where an edge function rounded to exactly zero (`on_edge`), recompute u, v, w of those
 // lanes in double (triangle.h's edge_function_exact), so the sign is exact there too.
 template <class F>
-inline void redo_edges_exactly(MaskOf<F> on_edge, F ax, F ay, F bx, F by, F cx, F cy, F& u,
-                               F& v, F& w) {
+inline void redo_edges_exactly(MaskOf<F> on_edge, F ax, F ay, F bx, F by, F cx, F cy, F& u, F& v,
+                               F& w) {
     constexpr int kN = F::kLanes;
     float uvw[3][kN];
     u.store(uvw[0]);

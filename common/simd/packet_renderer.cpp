@@ -7,10 +7,9 @@
 
 // Defined in packets_avx2.cpp and packets_avx512.cpp.
 void render_pixels_avx2(const SceneView&, const Camera&, const RenderSettings&, long, int, Vec3*);
-void render_pixels_avx2_compacted(const SceneView&, const Camera&, const RenderSettings&, long,
-                                  int, Vec3*);
-void render_pixels_avx512(const SceneView&, const Camera&, const RenderSettings&, long, int,
-                          Vec3*);
+void render_pixels_avx2_compacted(const SceneView&, const Camera&, const RenderSettings&, long, int,
+                                  Vec3*);
+void render_pixels_avx512(const SceneView&, const Camera&, const RenderSettings&, long, int, Vec3*);
 void render_pixels_avx512_compacted(const SceneView&, const Camera&, const RenderSettings&, long,
                                     int, Vec3*);
 void count_lanes_avx2(const SceneView&, const Camera&, const RenderSettings&, long, int, bool,
@@ -34,15 +33,14 @@ PacketRenderer packet_renderer(int lanes, bool compacted) {
                          std::to_string(lanes));
     }
     if (!cpu_has_avx512()) {
-        throw MissingCpuFeature("16-lane packets need a CPU with AVX-512 (F, DQ, VL, BW), and "
-                                "this one (" + cpu_model_name() + ") has not" +
-                                (forced_off("RT_FORCE_NO_AVX512") ? " (RT_FORCE_NO_AVX512 is set)"
-                                                                 : ""));
+        throw MissingCpuFeature(
+            "16-lane packets need a CPU with AVX-512 (F, DQ, VL, BW), and "
+            "this one (" +
+            cpu_model_name() + ") has not" +
+            (forced_off("RT_FORCE_NO_AVX512") ? " (RT_FORCE_NO_AVX512 is set)" : ""));
     }
     return {compacted ? render_pixels_avx512_compacted : render_pixels_avx512, count_lanes_avx512,
             16, compacted};
 }
 
-PacketRenderer widest_packet_renderer() {
-    return packet_renderer(cpu_has_avx512() ? 16 : 8, true);
-}
+PacketRenderer widest_packet_renderer() { return packet_renderer(cpu_has_avx512() ? 16 : 8, true); }

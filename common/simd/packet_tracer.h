@@ -181,9 +181,9 @@ RT_PACKET_INLINE F intersect_triangle(const RayPacket<F>& ray, const RayShearN<F
 // The nearest surface of each lane's ray.
 template <class F>
 struct HitPacket {
-    F t;                  // distance; t_max where nothing was hit
-    IntOf<F> sphere;      // index of the sphere hit, or -1
-    IntOf<F> triangle;    // index of the triangle hit, or -1
+    F t;  // distance; t_max where nothing was hit
+    IntOf<F> sphere;  // index of the sphere hit, or -1
+    IntOf<F> triangle;  // index of the triangle hit, or -1
 
     MaskOf<F> found() const { return ~((sphere == -1) & (triangle == -1)); }
 };
@@ -192,8 +192,7 @@ struct HitPacket {
 // lane's nearest hit with a masked update. Lanes outside `active` find nothing (their t_max
 // is 0, which every test rejects).
 template <class F>
-inline HitPacket<F> closest_hit(const SceneView& scene, const RayPacket<F>& ray,
-                                MaskOf<F> active) {
+inline HitPacket<F> closest_hit(const SceneView& scene, const RayPacket<F>& ray, MaskOf<F> active) {
     using I = IntOf<F>;
     HitPacket<F> hit{select(active, F(FLT_MAX), F(0.0f)), I(-1), I(-1)};
     for (int i = 0; i < scene.num_spheres; ++i) {
@@ -342,8 +341,8 @@ struct PathPacket {
     RayPacket<F> ray;
     Vec3xN<F> throughput;
     Vec3xN<F> radiance;
-    int bounce;        // surface interactions so far, the same in every lane
-    MaskOf<F> alive;   // lanes whose path goes on
+    int bounce;  // surface interactions so far, the same in every lane
+    MaskOf<F> alive;  // lanes whose path goes on
 };
 
 // ShadowRay (path_tracer.h) for N lanes: the lanes that asked for one are what bounce_step
@@ -382,15 +381,15 @@ inline MaskOf<F> sample_light(const SceneView& scene, const Vec3xN<F>& position,
 // a shadow ray. Each material is handled in turn, each for its own lanes only. Forced inline
 // as the scalar step is (out of line: +7% instructions per path).
 template <class F>
-RT_PACKET_INLINE MaskOf<F> bounce_step(
-    const SceneView& scene, const HitPacket<F>& hit, const SampleStreamN<F>& rng,
-    int max_bounces, PathPacket<F>& path, ShadowPacket<F>& shadow) {
+RT_PACKET_INLINE MaskOf<F> bounce_step(const SceneView& scene, const HitPacket<F>& hit,
+                                       const SampleStreamN<F>& rng, int max_bounces,
+                                       PathPacket<F>& path, ShadowPacket<F>& shadow) {
     using Mask = MaskOf<F>;
     constexpr int kM = stride_of<Material>();
     const Mask found = hit.found();
     const Mask escaped = and_not(path.alive, found);
-    path.radiance =
-        select(escaped, path.radiance + path.throughput * Vec3xN<F>(scene.background), path.radiance);
+    path.radiance = select(escaped, path.radiance + path.throughput * Vec3xN<F>(scene.background),
+                           path.radiance);
     path.alive = path.alive & found;
     if (none(path.alive)) return path.alive;
 
@@ -445,11 +444,10 @@ RT_PACKET_INLINE MaskOf<F> bounce_step(
         const Mask reflects = rng.at(bounce_dimension(bounce, 0)) < reflectance;
         const Vec3xN<F> below = offset_ray_origin(surface.position, -facing, hit.t, surface.extent);
         next.origin = select(glass, select(reflects, above, below) + off_edges, next.origin);
-        next.direction =
-            select(glass,
-                   select(reflects, normalize(reflect(ray.direction, facing)),
-                          refract(ray.direction, facing, eta, cos_t)),
-                   next.direction);
+        next.direction = select(glass,
+                                select(reflects, normalize(reflect(ray.direction, facing)),
+                                       refract(ray.direction, facing, eta, cos_t)),
+                                next.direction);
     }
     path.ray = next;
     return lit;

@@ -11,38 +11,37 @@
 // Pixel after pixel, each one's samples in packets traced from camera to end
 // (packet_tracer.h, as lab 02's students write it).
 void render_pixels_avx2(const SceneView& scene, const Camera& camera,
-                      const RenderSettings& settings, long first_pixel, int pixel_count,
-                      Vec3* out) {
+                        const RenderSettings& settings, long first_pixel, int pixel_count,
+                        Vec3* out) {
     for (int i = 0; i < pixel_count; ++i) {
         const long p = first_pixel + i;
         out[i] = render_pixel_packets<Float8>(scene, camera, settings,
-                                          static_cast<int>(p % settings.width),
-                                          static_cast<int>(p / settings.width));
+                                              static_cast<int>(p % settings.width),
+                                              static_cast<int>(p / settings.width));
     }
 }
 
 // The run's samples in groups whose packets are refilled after every bounce
 // (compacted_tracer.h).
 void render_pixels_avx2_compacted(const SceneView& scene, const Camera& camera,
-                                  const RenderSettings& settings, long first_pixel,
-                                  int pixel_count, Vec3* out) {
+                                  const RenderSettings& settings, long first_pixel, int pixel_count,
+                                  Vec3* out) {
     render_pixels_compacted<Float8>(scene, camera, settings, first_pixel, pixel_count, out);
 }
 
 // How full the packets of either method are, bounce by bounce (lab02-bench's
 // RT_SIMD_LANE_USE): the same paths as the functions above, counted, not summed.
-void count_lanes_avx2(const SceneView& scene, const Camera& camera,
-                    const RenderSettings& settings, long first_pixel, int pixel_count,
-                    bool compacted, LaneUse& use) {
+void count_lanes_avx2(const SceneView& scene, const Camera& camera, const RenderSettings& settings,
+                      long first_pixel, int pixel_count, bool compacted, LaneUse& use) {
     if (compacted) {
         std::vector<Vec3> discarded(static_cast<size_t>(pixel_count));
         render_pixels_compacted<Float8>(scene, camera, settings, first_pixel, pixel_count,
-                                    discarded.data(), &use);
+                                        discarded.data(), &use);
         return;
     }
     for (int i = 0; i < pixel_count; ++i) {
         const long p = first_pixel + i;
         count_pixel_lanes<Float8>(scene, camera, settings, static_cast<int>(p % settings.width),
-                              static_cast<int>(p / settings.width), use);
+                                  static_cast<int>(p / settings.width), use);
     }
 }

@@ -15,7 +15,9 @@
 class PixelRenderer {
 public:
     explicit PixelRenderer(const RenderJob& job)
-        : scene_(job.scene), camera_(job.camera), settings_(job.settings),
+        : scene_(job.scene),
+          camera_(job.camera),
+          settings_(job.settings),
           packets_(widest_packet_renderer()) {}
 
     // Reads only: safe to call from any number of threads at once.

@@ -88,11 +88,19 @@ inline Float16& operator*=(Float16& a, Float16 b) { return a = a * b; }
 
 // Comparisons: the _OQ predicates are false when a lane holds NaN, like scalar <, >, ==.
 inline Mask16 operator<(Float16 a, Float16 b) { return {_mm512_cmp_ps_mask(a.v, b.v, _CMP_LT_OQ)}; }
-inline Mask16 operator<=(Float16 a, Float16 b) { return {_mm512_cmp_ps_mask(a.v, b.v, _CMP_LE_OQ)}; }
+inline Mask16 operator<=(Float16 a, Float16 b) {
+    return {_mm512_cmp_ps_mask(a.v, b.v, _CMP_LE_OQ)};
+}
 inline Mask16 operator>(Float16 a, Float16 b) { return {_mm512_cmp_ps_mask(a.v, b.v, _CMP_GT_OQ)}; }
-inline Mask16 operator>=(Float16 a, Float16 b) { return {_mm512_cmp_ps_mask(a.v, b.v, _CMP_GE_OQ)}; }
-inline Mask16 operator==(Float16 a, Float16 b) { return {_mm512_cmp_ps_mask(a.v, b.v, _CMP_EQ_OQ)}; }
-inline Mask16 operator!=(Float16 a, Float16 b) { return {_mm512_cmp_ps_mask(a.v, b.v, _CMP_NEQ_OQ)}; }
+inline Mask16 operator>=(Float16 a, Float16 b) {
+    return {_mm512_cmp_ps_mask(a.v, b.v, _CMP_GE_OQ)};
+}
+inline Mask16 operator==(Float16 a, Float16 b) {
+    return {_mm512_cmp_ps_mask(a.v, b.v, _CMP_EQ_OQ)};
+}
+inline Mask16 operator!=(Float16 a, Float16 b) {
+    return {_mm512_cmp_ps_mask(a.v, b.v, _CMP_NEQ_OQ)};
+}
 // !(a <= b) and !(a >= b): true where a lane holds NaN, as the negated scalar test is.
 inline Mask16 not_less_equal(Float16 a, Float16 b) {
     return {_mm512_cmp_ps_mask(a.v, b.v, _CMP_NLE_UQ)};
@@ -126,7 +134,7 @@ struct Int16 {
     __m512i v;
 
     Int16() = default;
-    Int16(__m512i v_) : v(v_) {}                         // NOLINT: implicit by design
+    Int16(__m512i v_) : v(v_) {}  // NOLINT: implicit by design
     explicit Int16(int s) : v(_mm512_set1_epi32(s)) {}  // broadcast
     static Int16 load(const int32_t* p) { return {_mm512_loadu_si512(p)}; }
     void store(int32_t* p) const { _mm512_storeu_si512(p, v); }
@@ -159,8 +167,8 @@ inline Float16 permuted(const Vec3& v, Int16 k) {
 
 inline Float16 gather(const float& first, int stride, Int16 index, Mask16 mask) {
     return _mm512_mask_i32gather_ps(_mm512_setzero_ps(), mask.m,
-                                    _mm512_mullo_epi32(index.v, _mm512_set1_epi32(stride)),
-                                    &first, 4);
+                                    _mm512_mullo_epi32(index.v, _mm512_set1_epi32(stride)), &first,
+                                    4);
 }
 inline Int16 gather(const int& first, int stride, Int16 index, Mask16 mask) {
     return _mm512_mask_i32gather_epi32(_mm512_setzero_si512(), mask.m,
@@ -194,7 +202,8 @@ struct U64x16 {
     static U64x16 load(const uint32_t* low, const uint32_t* high) {
         const auto half = [](const uint32_t* l, const uint32_t* h) {
             const auto words = [](const uint32_t* w) {
-                return _mm512_cvtepu32_epi64(_mm256_loadu_si256(reinterpret_cast<const __m256i*>(w)));
+                return _mm512_cvtepu32_epi64(
+                    _mm256_loadu_si256(reinterpret_cast<const __m256i*>(w)));
             };
             const __m512i lo32 = words(l);
             const __m512i hi32 = words(h);

@@ -122,7 +122,7 @@ struct Int8 {
     __m256i v;
 
     Int8() = default;
-    Int8(__m256i v_) : v(v_) {}                        // NOLINT: implicit by design
+    Int8(__m256i v_) : v(v_) {}  // NOLINT: implicit by design
     explicit Int8(int s) : v(_mm256_set1_epi32(s)) {}  // broadcast
     static Int8 load(const int32_t* p) {
         return {_mm256_loadu_si256(reinterpret_cast<const __m256i*>(p))};
@@ -161,8 +161,8 @@ inline Float8 permuted(const Vec3& v, Int8 k) {
 // holds, 0 elsewhere.
 inline Float8 gather(const float& first, int stride, Int8 index, Mask8 mask) {
     return _mm256_mask_i32gather_ps(_mm256_setzero_ps(), &first,
-                                    _mm256_mullo_epi32(index.v, _mm256_set1_epi32(stride)),
-                                    mask.m, 4);
+                                    _mm256_mullo_epi32(index.v, _mm256_set1_epi32(stride)), mask.m,
+                                    4);
 }
 inline Int8 gather(const int& first, int stride, Int8 index, Mask8 mask) {
     return _mm256_mask_i32gather_epi32(_mm256_setzero_si256(), &first,
@@ -196,10 +196,10 @@ public:
         }();
         const unsigned bits = keep.bits();
         count_ = __builtin_popcount(bits);
-        index_ = _mm256_and_si256(
-            _mm256_srlv_epi32(_mm256_set1_epi32(static_cast<int>(table[bits])),
-                              _mm256_setr_epi32(0, 4, 8, 12, 16, 20, 24, 28)),
-            _mm256_set1_epi32(15));
+        index_ =
+            _mm256_and_si256(_mm256_srlv_epi32(_mm256_set1_epi32(static_cast<int>(table[bits])),
+                                               _mm256_setr_epi32(0, 4, 8, 12, 16, 20, 24, 28)),
+                             _mm256_set1_epi32(15));
     }
     int count() const { return count_; }  // lanes kept
     Float8 operator()(Float8 a) const { return _mm256_permutevar8x32_ps(a.v, index_); }

@@ -26,8 +26,12 @@ struct BroadcastRay {
     Float8 sx, sy, sz;   // the shear constants
 
     explicit BroadcastRay(const Ray& r)
-        : shear(r.direction), origin(r.origin), direction(r.direction),
-          sx(shear.sx), sy(shear.sy), sz(shear.sz) {}
+        : shear(r.direction),
+          origin(r.origin),
+          direction(r.direction),
+          sx(shear.sx),
+          sy(shear.sy),
+          sz(shear.sz) {}
 };
 
 inline Vec3x8 load3(const float (&rows)[3][kSimdWidth]) {

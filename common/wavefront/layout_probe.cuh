@@ -16,12 +16,17 @@
 #include <path_pool.cuh>
 
 // The ray origin x of the probe's paths at places 0 and 1: values no other field holds.
-__host__ __device__ constexpr float probe_marker(int place) { return place == 0 ? 1234.5f : -4321.25f; }
+__host__ __device__ constexpr float probe_marker(int place) {
+    return place == 0 ? 1234.5f : -4321.25f;
+}
 
 template <class Paths>
 __global__ void store_two_probe_paths(const Paths paths) {
     const int k = static_cast<int>(threadIdx.x);
-    if (k < 2) paths.store(k, QueuedPath{{Vec3(probe_marker(k), 0.0f, 0.0f), Vec3(0.0f, 0.0f, 1.0f)}, Vec3(0.0f), 0});
+    if (k < 2)
+        paths.store(
+            k,
+            QueuedPath{{Vec3(probe_marker(k), 0.0f, 0.0f), Vec3(0.0f, 0.0f, 1.0f)}, Vec3(0.0f), 0});
 }
 
 // The distance in bytes, or -1 when the markers are not both found (a layout that stores
@@ -54,6 +59,6 @@ long long neighbour_bytes() {
 // For --json: {"name": "SoA", "bytes_between_neighbours": 4}
 template <class Layout>
 std::string describe_layout() {
-    return std::string("{\"name\": \"") + Layout::kName + "\", \"bytes_between_neighbours\": " +
-           std::to_string(neighbour_bytes<Layout>()) + "}";
+    return std::string("{\"name\": \"") + Layout::kName +
+           "\", \"bytes_between_neighbours\": " + std::to_string(neighbour_bytes<Layout>()) + "}";
 }

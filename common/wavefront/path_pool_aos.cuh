@@ -43,8 +43,8 @@ struct AosPaths : RowRecords<3> {
         const Ray& r = p.ray;
         records[k].row[0] = make_float4(r.origin.x, r.origin.y, r.origin.z, r.direction.x);
         records[k].row[1] = make_float4(r.direction.y, r.direction.z, 0.0f, __int_as_float(-1));
-        records[k].row[2] = make_float4(p.throughput.x, p.throughput.y, p.throughput.z,
-                                        __int_as_float(p.slot));
+        records[k].row[2] =
+            make_float4(p.throughput.x, p.throughput.y, p.throughput.z, __int_as_float(p.slot));
     }
     __device__ QueuedPath load(int k) const {
         const float4 c = records[k].row[2];
@@ -70,7 +70,8 @@ struct AosShadowRays : RowRecords<3> {
         const Ray& r = q.shadow.ray;
         const Vec3& l = q.shadow.radiance;
         records[k].row[0] = make_float4(r.origin.x, r.origin.y, r.origin.z, r.direction.x);
-        records[k].row[1] = make_float4(r.direction.y, r.direction.z, q.shadow.t_max, __int_as_float(q.slot));
+        records[k].row[1] =
+            make_float4(r.direction.y, r.direction.z, q.shadow.t_max, __int_as_float(q.slot));
         records[k].row[2] = make_float4(l.x, l.y, l.z, 0.0f);
     }
     __device__ QueuedShadowRay load(int k) const {
@@ -81,7 +82,9 @@ struct AosShadowRays : RowRecords<3> {
 };
 
 struct AosRadiance : RowRecords<1> {
-    __device__ void start(int slot, Vec3 v) const { records[slot].row[0] = make_float4(v.x, v.y, v.z, 0.0f); }
+    __device__ void start(int slot, Vec3 v) const {
+        records[slot].row[0] = make_float4(v.x, v.y, v.z, 0.0f);
+    }
     __device__ void add(int slot, Vec3 v) const { start(slot, load(slot) + v); }
     __device__ Vec3 load(int slot) const {
         const float4 v = records[slot].row[0];

@@ -35,7 +35,9 @@ struct FieldArrays {
         store(field + 1, k, v.y);
         store(field + 2, k, v.z);
     }
-    __device__ Ray load_ray(int field, int k) const { return {load3(field, k), load3(field + 3, k)}; }
+    __device__ Ray load_ray(int field, int k) const {
+        return {load3(field, k), load3(field + 3, k)};
+    }
     __device__ void store_ray(int field, int k, const Ray& r) const {
         store3(field, k, r.origin);
         store3(field + 3, k, r.direction);
@@ -44,7 +46,14 @@ struct FieldArrays {
 
 // The fields of AosPaths::Record, each in its own array: 12 words per place.
 struct SoaPaths {
-    enum Field { kRay = 0, kThroughput = 6, kSlot = 9, kHitT = 10, kHitPrimitive = 11, kFields = 12 };
+    enum Field {
+        kRay = 0,
+        kThroughput = 6,
+        kSlot = 9,
+        kHitT = 10,
+        kHitPrimitive = 11,
+        kFields = 12
+    };
     FieldArrays<kFields> a;
 
     void carve(ArrayCarver& c) { a.carve(c); }

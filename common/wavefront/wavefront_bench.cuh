@@ -77,8 +77,10 @@ struct Setup {
 
 // One wavefront configuration: a pool layout, a push, a scene memory, a wave size.
 template <class C>
-static Config wavefront(const Setup& s, std::string name, std::string change, long long wave_paths) {
-    return {std::move(name), std::move(change), [s, wave_paths](Image& image, WavefrontStats* stats) {
+static Config wavefront(const Setup& s, std::string name, std::string change,
+                        long long wave_paths) {
+    return {std::move(name), std::move(change),
+            [s, wave_paths](Image& image, WavefrontStats* stats) {
                 Progress progress(s.settings.height, false);
                 const RenderJob job{s.scene->view(), s.settings, s.camera, 0, progress};
                 const std::string paths = std::to_string(wave_paths);
@@ -100,8 +102,10 @@ template <SceneMemory kMemory, class Materials>
 static double megakernel(const Setup& s, Image& image) {
     constexpr auto kernel = lab05_kernel<kMemory, Materials>;
     const size_t shared = kMemory == SceneMemory::Shared ? s.layout.bytes() : 0;
-    DeviceArray<Vec3> pixels(static_cast<size_t>(s.settings.width) * s.settings.height, "allocating the image");
-    const KernelArgs args{s.layout, s.pool, s.camera, s.settings, 0, s.settings.height, pixels.data()};
+    DeviceArray<Vec3> pixels(static_cast<size_t>(s.settings.width) * s.settings.height,
+                             "allocating the image");
+    const KernelArgs args{s.layout,          s.pool,       s.camera, s.settings, 0,
+                          s.settings.height, pixels.data()};
     const long long threads =
         static_cast<long long>(s.settings.width) * s.settings.height * kLab05ThreadsPerPixel;
     cudaFuncAttributes attributes{};
@@ -124,26 +128,44 @@ static void add_pool_configs(const Setup& s, std::vector<Config>& configs) {
     using SharedWarp = WavefrontConfig<Pool, SceneMemory::Shared, Reserve::kPerWarp, Materials>;
     using SharedAny = WavefrontConfig<Pool, SceneMemory::Shared, Reserve::kPerBlock, AnyMaterial>;
     using Global = WavefrontConfig<Pool, SceneMemory::Global, Reserve::kPerBlock, Materials>;
-    using Occupancy50 = WavefrontConfig<Pool, SceneMemory::Shared, Reserve::kPerBlock, Materials, 8>;
-    using Occupancy75 = WavefrontConfig<Pool, SceneMemory::Shared, Reserve::kPerBlock, Materials, 12>;
-    using Occupancy100 = WavefrontConfig<Pool, SceneMemory::Shared, Reserve::kPerBlock, Materials, 16>;
-    using Prefetch = WavefrontConfig<Pool, SceneMemory::Shared, Reserve::kPerBlock, Materials, 1, true>;
-    using GridStride = WavefrontConfig<Pool, SceneMemory::Shared, Reserve::kPerBlock, Materials, 1, false, false>;
+    using Occupancy50 =
+        WavefrontConfig<Pool, SceneMemory::Shared, Reserve::kPerBlock, Materials, 8>;
+    using Occupancy75 =
+        WavefrontConfig<Pool, SceneMemory::Shared, Reserve::kPerBlock, Materials, 12>;
+    using Occupancy100 =
+        WavefrontConfig<Pool, SceneMemory::Shared, Reserve::kPerBlock, Materials, 16>;
+    using Prefetch =
+        WavefrontConfig<Pool, SceneMemory::Shared, Reserve::kPerBlock, Materials, 1, true>;
+    using GridStride =
+        WavefrontConfig<Pool, SceneMemory::Shared, Reserve::kPerBlock, Materials, 1, false, false>;
     const std::string n = Pool::kName;
     if (choose_scene_memory(s.layout) == SceneMemory::Shared) {
         configs.push_back(wavefront<Shared>(s, n, "the lab's reference", kDefaultWavePaths));
-        configs.push_back(wavefront<SharedWarp>(s, n + "-atomic-per-warp", "one atomicAdd per warp's pushes", kDefaultWavePaths));
-        configs.push_back(wavefront<SharedEach>(s, n + "-atomic-each", "one atomicAdd per push", kDefaultWavePaths));
-        configs.push_back(wavefront<Prefetch>(s, n + "-prefetch", "each thread loads its next item ahead", kDefaultWavePaths));
-        configs.push_back(wavefront<GridStride>(s, n + "-grid-stride", "grids that fill the GPU once, threads striding over the queue", kDefaultWavePaths));
-        configs.push_back(wavefront<Global>(s, n + "-global-scene", "scene in global memory", kDefaultWavePaths));
+        configs.push_back(wavefront<SharedWarp>(
+            s, n + "-atomic-per-warp", "one atomicAdd per warp's pushes", kDefaultWavePaths));
+        configs.push_back(wavefront<SharedEach>(s, n + "-atomic-each", "one atomicAdd per push",
+                                                kDefaultWavePaths));
+        configs.push_back(wavefront<Prefetch>(
+            s, n + "-prefetch", "each thread loads its next item ahead", kDefaultWavePaths));
+        configs.push_back(wavefront<GridStride>(
+            s, n + "-grid-stride", "grids that fill the GPU once, threads striding over the queue",
+            kDefaultWavePaths));
+        configs.push_back(
+            wavefront<Global>(s, n + "-global-scene", "scene in global memory", kDefaultWavePaths));
         if (!std::is_same_v<Materials, AnyMaterial>) {
             configs.push_back(wavefront<SharedAny>(s, n + "-all-materials",
-                                                   "shading compiled for every material kind", kDefaultWavePaths));
+                                                   "shading compiled for every material kind",
+                                                   kDefaultWavePaths));
         }
-        configs.push_back(wavefront<Occupancy50>(s, n + "-occupancy-50", "8 blocks a multiprocessor (at most 64 registers)", kDefaultWavePaths));
-        configs.push_back(wavefront<Occupancy75>(s, n + "-occupancy-75", "12 blocks a multiprocessor (at most 40 registers)", kDefaultWavePaths));
-        configs.push_back(wavefront<Occupancy100>(s, n + "-occupancy-100", "16 blocks a multiprocessor (at most 32 registers)", kDefaultWavePaths));
+        configs.push_back(wavefront<Occupancy50>(s, n + "-occupancy-50",
+                                                 "8 blocks a multiprocessor (at most 64 registers)",
+                                                 kDefaultWavePaths));
+        configs.push_back(wavefront<Occupancy75>(
+            s, n + "-occupancy-75", "12 blocks a multiprocessor (at most 40 registers)",
+            kDefaultWavePaths));
+        configs.push_back(wavefront<Occupancy100>(
+            s, n + "-occupancy-100", "16 blocks a multiprocessor (at most 32 registers)",
+            kDefaultWavePaths));
         for (long long w : {1LL << 18, 1LL << 19, 1LL << 20, 1LL << 22}) {
             configs.push_back(wavefront<Shared>(s, n + "-wave-" + std::to_string(w),
                                                 std::to_string(w) + " paths a wave", w));
@@ -169,7 +191,8 @@ static double max_relative_difference(const Image& a, const Image& b) {
             const Vec3 p = a.at(x, y), q = b.at(x, y);
             const float pa[3] = {p.x, p.y, p.z}, pb[3] = {q.x, q.y, q.z};
             for (int c = 0; c < 3; ++c)
-                worst = std::max(worst, std::abs(double(pa[c]) - pb[c]) / std::max(std::abs(double(pa[c])), 1e-3));
+                worst = std::max(worst, std::abs(double(pa[c]) - pb[c]) /
+                                            std::max(std::abs(double(pa[c])), 1e-3));
         }
     return worst;
 }
@@ -217,7 +240,8 @@ int run_wavefront_bench(int argc, char** argv, const SpeedTarget (&targets)[N]) 
             shared_args.push_back(argv[i]);
         }
     }
-    const Options options = parse_options(static_cast<int>(shared_args.size()), shared_args.data(), argv[0]);
+    const Options options =
+        parse_options(static_cast<int>(shared_args.size()), shared_args.data(), argv[0]);
     const Scene scene = load_scene(options.scene_path);
     Setup s;
     s.scene = &scene;
@@ -237,31 +261,37 @@ int run_wavefront_bench(int argc, char** argv, const SpeedTarget (&targets)[N]) 
     const bool specular = has_specular_material(scene.view().materials, scene.view().num_materials);
     // Lab 05's reference as lab05-ref runs it: the scene's memory and material kinds.
     const void* const lab05 =
-        small ? (specular ? reinterpret_cast<const void*>(lab05_kernel<SceneMemory::Shared, AnyMaterial>)
-                          : reinterpret_cast<const void*>(lab05_kernel<SceneMemory::Shared, DiffuseOnly>))
-              : (specular ? reinterpret_cast<const void*>(lab05_kernel<SceneMemory::Global, AnyMaterial>)
-                          : reinterpret_cast<const void*>(lab05_kernel<SceneMemory::Global, DiffuseOnly>));
-    configs.push_back({"megakernel", small ? "lab 05's reference kernel" : "lab 05's kernel, scene in global memory",
-                       [s, small, specular](Image& image, WavefrontStats*) {
-                           if (small) {
-                               return specular ? megakernel<SceneMemory::Shared, AnyMaterial>(s, image)
-                                               : megakernel<SceneMemory::Shared, DiffuseOnly>(s, image);
-                           }
-                           return specular ? megakernel<SceneMemory::Global, AnyMaterial>(s, image)
-                                           : megakernel<SceneMemory::Global, DiffuseOnly>(s, image);
-                       }});
+        small
+            ? (specular
+                   ? reinterpret_cast<const void*>(lab05_kernel<SceneMemory::Shared, AnyMaterial>)
+                   : reinterpret_cast<const void*>(lab05_kernel<SceneMemory::Shared, DiffuseOnly>))
+            : (specular
+                   ? reinterpret_cast<const void*>(lab05_kernel<SceneMemory::Global, AnyMaterial>)
+                   : reinterpret_cast<const void*>(lab05_kernel<SceneMemory::Global, DiffuseOnly>));
+    configs.push_back(
+        {"megakernel",
+         small ? "lab 05's reference kernel" : "lab 05's kernel, scene in global memory",
+         [s, small, specular](Image& image, WavefrontStats*) {
+             if (small) {
+                 return specular ? megakernel<SceneMemory::Shared, AnyMaterial>(s, image)
+                                 : megakernel<SceneMemory::Shared, DiffuseOnly>(s, image);
+             }
+             return specular ? megakernel<SceneMemory::Global, AnyMaterial>(s, image)
+                             : megakernel<SceneMemory::Global, DiffuseOnly>(s, image);
+         }});
     if (list) {
         for (const Config& c : configs) std::printf("%s\t%s\n", c.name.c_str(), c.change.c_str());
         return 0;
     }
 
     const RenderSettings& st = s.settings;
-    std::printf("{\"device\": \"%s\", \"scene\": \"%s\", \"width\": %d, \"height\": %d, \"spp\": %d, "
-                "\"bounces\": %d, \"seed\": %llu, \"repeat\": %d, \"timing\": \"CUDA events around all "
-                "kernels of a render (the lab binaries' seconds); best and median of repeat runs after "
-                "a warm-up; stage_ms from one more run with events around every launch\", \"configs\": [",
-                describe(s.prop).c_str(), options.scene_path.c_str(), st.width, st.height, st.spp,
-                st.bounces, static_cast<unsigned long long>(st.seed), repeat);
+    std::printf(
+        "{\"device\": \"%s\", \"scene\": \"%s\", \"width\": %d, \"height\": %d, \"spp\": %d, "
+        "\"bounces\": %d, \"seed\": %llu, \"repeat\": %d, \"timing\": \"CUDA events around all "
+        "kernels of a render (the lab binaries' seconds); best and median of repeat runs after "
+        "a warm-up; stage_ms from one more run with events around every launch\", \"configs\": [",
+        describe(s.prop).c_str(), options.scene_path.c_str(), st.width, st.height, st.spp,
+        st.bounces, static_cast<unsigned long long>(st.seed), repeat);
     const Image* reference = nullptr;
     std::vector<Image> kept;
     kept.reserve(configs.size());
@@ -287,23 +317,27 @@ int run_wavefront_bench(int argc, char** argv, const SpeedTarget (&targets)[N]) 
         kept.push_back(std::move(image));
         const Image& img = kept.back();
         if (!reference) reference = &img;
-        std::printf("%s\n  {\"name\": \"%s\", \"change\": \"%s\", \"best_ms\": %.3f, \"median_ms\": %.3f, "
-                    "\"paths_per_second\": %.4g, \"nonfinite_pixels\": %zu, \"image_mean\": %.6g, "
-                    "\"identical_to_first\": %s, \"max_relative_difference\": %.3g",
-                    first ? "" : ",", c.name.c_str(), c.change.c_str(), ms.front(), median,
-                    double(st.width) * st.height * st.spp / (ms.front() * 1e-3), nonfinite(img),
-                    image_mean(img), identical(img, *reference) ? "true" : "false",
-                    max_relative_difference(*reference, img));
+        std::printf(
+            "%s\n  {\"name\": \"%s\", \"change\": \"%s\", \"best_ms\": %.3f, \"median_ms\": %.3f, "
+            "\"paths_per_second\": %.4g, \"nonfinite_pixels\": %zu, \"image_mean\": %.6g, "
+            "\"identical_to_first\": %s, \"max_relative_difference\": %.3g",
+            first ? "" : ",", c.name.c_str(), c.change.c_str(), ms.front(), median,
+            double(st.width) * st.height * st.spp / (ms.front() * 1e-3), nonfinite(img),
+            image_mean(img), identical(img, *reference) ? "true" : "false",
+            max_relative_difference(*reference, img));
         if (wavefront) {
-            std::printf(", \"waves\": %d, \"wave_paths\": %d, \"bytes_per_path\": %zu, \"stages\": [",
-                        stats.waves, stats.wave_paths, stats.bytes_per_path);
+            std::printf(
+                ", \"waves\": %d, \"wave_paths\": %d, \"bytes_per_path\": %zu, \"stages\": [",
+                stats.waves, stats.wave_paths, stats.bytes_per_path);
             for (int k = 0; k < kStageCount; ++k) {
                 const cudaFuncAttributes& a = stats.attributes[k];
-                std::printf("%s{\"kernel\": \"%s\", \"ms\": %.3f, \"registers\": %d, \"local_bytes\": %zu, "
-                            "\"blocks_per_sm\": %d, \"occupancy\": %.3f}",
-                            k ? ", " : "", stage_name(k), stats.stage_ms[k], a.numRegs, a.localSizeBytes,
-                            stats.blocks_per_sm[k],
-                            double(stats.blocks_per_sm[k]) * kStageThreads / s.prop.maxThreadsPerMultiProcessor);
+                std::printf(
+                    "%s{\"kernel\": \"%s\", \"ms\": %.3f, \"registers\": %d, \"local_bytes\": %zu, "
+                    "\"blocks_per_sm\": %d, \"occupancy\": %.3f}",
+                    k ? ", " : "", stage_name(k), stats.stage_ms[k], a.numRegs, a.localSizeBytes,
+                    stats.blocks_per_sm[k],
+                    double(stats.blocks_per_sm[k]) * kStageThreads /
+                        s.prop.maxThreadsPerMultiProcessor);
             }
             std::printf("], \"active_paths\": [");
             for (size_t b = 0; b < stats.active_paths.size(); ++b)
@@ -319,9 +353,10 @@ int run_wavefront_bench(int argc, char** argv, const SpeedTarget (&targets)[N]) 
             check(cudaOccupancyMaxActiveBlocksPerMultiprocessor(&blocks, lab05, kLab05BlockThreads,
                                                                 small ? s.layout.bytes() : 0),
                   "computing the megakernel's occupancy");
-            std::printf(", \"registers\": %d, \"local_bytes\": %zu, \"blocks_per_sm\": %d, \"occupancy\": %.3f",
-                        a.numRegs, a.localSizeBytes, blocks,
-                        double(blocks) * kLab05BlockThreads / s.prop.maxThreadsPerMultiProcessor);
+            std::printf(
+                ", \"registers\": %d, \"local_bytes\": %zu, \"blocks_per_sm\": %d, \"occupancy\": %.3f",
+                a.numRegs, a.localSizeBytes, blocks,
+                double(blocks) * kLab05BlockThreads / s.prop.maxThreadsPerMultiProcessor);
         }
         std::printf("}");
         std::fflush(stdout);
@@ -333,7 +368,8 @@ int run_wavefront_bench(int argc, char** argv, const SpeedTarget (&targets)[N]) 
             if (n == name) return best;
         return -1.0;
     };
-    std::printf("\n], \"targets\": %s}\n",
-                targets_json(targets, best_of, why_not_judged(s.prop, options.scene_path, st)).c_str());
+    std::printf(
+        "\n], \"targets\": %s}\n",
+        targets_json(targets, best_of, why_not_judged(s.prop, options.scene_path, st)).c_str());
     return 0;
 }

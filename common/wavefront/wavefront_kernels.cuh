@@ -27,8 +27,9 @@
 #include <scene_pool.cuh>
 #include <wave.cuh>
 
-template <class LayoutT, SceneMemory kMemory, Reserve kHow = Reserve::kPerBlock, class MaterialsT = AnyMaterial,
-          int kMinBlocks = 1, bool kPrefetchNext = false, bool kGridPerItem = true>
+template <class LayoutT, SceneMemory kMemory, Reserve kHow = Reserve::kPerBlock,
+          class MaterialsT = AnyMaterial, int kMinBlocks = 1, bool kPrefetchNext = false,
+          bool kGridPerItem = true>
 struct WavefrontConfig {
     using Layout = LayoutT;  // AosPathPool (lab 06) or SoaPathPool (lab 07)
     using Pool = PathPool<Layout>;
@@ -63,7 +64,8 @@ constexpr int kStageThreads = 128;
 // kMinBlocksPerSM (a measurement made on an H200) is capped at what each target holds.
 #if defined(__CUDA_ARCH__) && __CUDA_ARCH__ == 750
 constexpr int kMaxThreadsPerSM = 1024;
-#elif defined(__CUDA_ARCH__) && (__CUDA_ARCH__ == 860 || __CUDA_ARCH__ == 870 || __CUDA_ARCH__ == 890)
+#elif defined(__CUDA_ARCH__) && \
+    (__CUDA_ARCH__ == 860 || __CUDA_ARCH__ == 870 || __CUDA_ARCH__ == 890)
 constexpr int kMaxThreadsPerSM = 1536;
 #else
 constexpr int kMaxThreadsPerSM = 2048;
@@ -76,8 +78,8 @@ constexpr int min_blocks_per_sm(int wanted) {
 // numbers), its radiance sum started, and every path onto the first queue.
 template <class C>
 __global__ void __launch_bounds__(kStageThreads, min_blocks_per_sm(C::kMinBlocksPerSM))
-    generate_camera_paths(const WavefrontArgs args, const Wave wave, const typename C::Radiance radiance,
-                          const typename C::Paths paths) {
+    generate_camera_paths(const WavefrontArgs args, const Wave wave,
+                          const typename C::Radiance radiance, const typename C::Paths paths) {
     for_each_place(wave.paths(), [&](int slot, bool valid) {
         PathState path{};
         if (valid) {
@@ -85,8 +87,8 @@ __global__ void __launch_bounds__(kStageThreads, min_blocks_per_sm(C::kMinBlocks
             const uint64_t pixel = wave.pixel_of(slot);
             const int x = static_cast<int>(pixel % args.settings.width);
             const int y = static_cast<int>(pixel / args.settings.width);
-            const Ray ray = args.camera.ray_through(x + real(rng.at(kDimPixelX)),
-                                                    y + real(rng.at(kDimPixelY)));
+            const Ray ray =
+                args.camera.ray_through(x + real(rng.at(kDimPixelX)), y + real(rng.at(kDimPixelY)));
             path = start_path(ray, args.settings.bounces);
             radiance.start(slot, path.radiance);
         }
@@ -114,8 +116,8 @@ __global__ void __launch_bounds__(kStageThreads, min_blocks_per_sm(C::kMinBlocks
 // addition the core's loop makes, and no radiance read or written for the other paths.
 template <class C>
 __global__ void __launch_bounds__(kStageThreads, min_blocks_per_sm(C::kMinBlocksPerSM))
-    shade_hits(const WavefrontArgs args, const Wave wave, const typename C::Radiance radiance, int bounce,
-               const typename C::Paths paths, const typename C::Paths next,
+    shade_hits(const WavefrontArgs args, const Wave wave, const typename C::Radiance radiance,
+               int bounce, const typename C::Paths paths, const typename C::Paths next,
                const typename C::ShadowRays shadows) {
     extern __shared__ float4 shared_scene[];
     const SceneView scene = scene_in<C::kSceneMemory>(args.layout, args.scene_pool, shared_scene);
@@ -129,7 +131,8 @@ __global__ void __launch_bounds__(kStageThreads, min_blocks_per_sm(C::kMinBlocks
             slot = queued.slot;
             path = {queued.ray, queued.throughput, Vec3(0.0f), bounce, true};
             wants_shadow_ray = bounce_step<typename C::Materials>(
-                scene, paths.items.load_hit(k), stream_of(args, wave, slot), args.settings.bounces, path, shadow);
+                scene, paths.items.load_hit(k), stream_of(args, wave, slot), args.settings.bounces,
+                path, shadow);
             if (path.radiance.x != 0.0f || path.radiance.y != 0.0f || path.radiance.z != 0.0f) {
                 radiance.add(slot, path.radiance);
             }
@@ -149,10 +152,11 @@ __global__ void __launch_bounds__(kStageThreads, min_blocks_per_sm(C::kMinBlocks
     extern __shared__ float4 shared_scene[];
     const SceneView scene = scene_in<C::kSceneMemory>(args.layout, args.scene_pool, shared_scene);
     for_each_queued<C::kPrefetch>(
-        shadows, [&](int k) { return shadows.items.load(k); }, [&](int, const QueuedShadowRay& queued) {
-        const ShadowRay& s = queued.shadow;
-        if (!occluded(scene, s.ray, s.t_max)) radiance.add(queued.slot, s.radiance);
-    });
+        shadows, [&](int k) { return shadows.items.load(k); },
+        [&](int, const QueuedShadowRay& queued) {
+            const ShadowRay& s = queued.shadow;
+            if (!occluded(scene, s.ray, s.t_max)) radiance.add(queued.slot, s.radiance);
+        });
 }
 
 // CHECK: once every path of the wave has ended, adds each pixel's samples of this wave to
@@ -161,8 +165,8 @@ __global__ void __launch_bounds__(kStageThreads, min_blocks_per_sm(C::kMinBlocks
 // receives sum.mean(spp). One thread per pixel: no atomics, no order to depend on.
 template <class C>
 __global__ void __launch_bounds__(kStageThreads, min_blocks_per_sm(C::kMinBlocksPerSM))
-    accumulate_samples(const Wave wave, const typename C::Radiance radiance, SampleSum* sums, Vec3* means,
-                       int spp) {
+    accumulate_samples(const Wave wave, const typename C::Radiance radiance, SampleSum* sums,
+                       Vec3* means, int spp) {
     const int threads = static_cast<int>(gridDim.x * blockDim.x);
     for (int p = static_cast<int>(blockIdx.x * blockDim.x + threadIdx.x); p < wave.pixels;
          p += threads) {

@@ -31,8 +31,8 @@
 // The stages, for the per-kernel tables.
 enum Stage { kGenerate, kClosestHit, kShade, kShadow, kAccumulate, kStageCount };
 inline const char* stage_name(int stage) {
-    static const char* const names[] = {"generate_camera_paths", "find_closest_hits",
-                                        "shade_hits", "trace_shadow_rays", "accumulate_samples"};
+    static const char* const names[] = {"generate_camera_paths", "find_closest_hits", "shade_hits",
+                                        "trace_shadow_rays", "accumulate_samples"};
     return names[stage];
 }
 
@@ -110,12 +110,14 @@ public:
 
     void generate_camera_paths(const typename C::Paths& active) {
         launch(kGenerate, [&] {
-            ::generate_camera_paths<C><<<grid_[kGenerate], kStageThreads>>>(args_, wave_, memory_.pool.radiance, active);
+            ::generate_camera_paths<C>
+                <<<grid_[kGenerate], kStageThreads>>>(args_, wave_, memory_.pool.radiance, active);
         });
     }
     void find_closest_hits(const typename C::Paths& active) {
         launch(kClosestHit, [&] {
-            ::find_closest_hits<C><<<queue_grid(kClosestHit), kStageThreads, shared_bytes_>>>(args_, active);
+            ::find_closest_hits<C>
+                <<<queue_grid(kClosestHit), kStageThreads, shared_bytes_>>>(args_, active);
         });
     }
     // The bounce of the paths on `active` is where its counter lies: active(b)'s is sizes[b].
@@ -156,7 +158,8 @@ private:
     // Blocks for a kernel that pops a queue: one thread per path of the wave (no queue holds
     // more), or with C::kOneItemPerThread false enough to fill the GPU once.
     unsigned queue_grid(Stage stage) const {
-        const unsigned covering = static_cast<unsigned>((wave_.paths() + kStageThreads - 1) / kStageThreads);
+        const unsigned covering =
+            static_cast<unsigned>((wave_.paths() + kStageThreads - 1) / kStageThreads);
         return C::kOneItemPerThread ? std::max(grid_[stage], covering) : grid_[stage];
     }
 
@@ -182,12 +185,14 @@ private:
         check(cudaDeviceSynchronize(), "running a wave");
         for (size_t i = 0; i < launches_; ++i) {
             float ms = 0;
-            check(cudaEventElapsedTime(&ms, events_[2 * i], events_[2 * i + 1]), "reading a CUDA event timer");
+            check(cudaEventElapsedTime(&ms, events_[2 * i], events_[2 * i + 1]),
+                  "reading a CUDA event timer");
             stats_->stage_ms[stages_[i]] += ms;
         }
         std::vector<int> sizes(counters);
-        check(cudaMemcpy(sizes.data(), memory_.sizes, counters * sizeof(int), cudaMemcpyDeviceToHost),
-              "copying the queue sizes back");
+        check(
+            cudaMemcpy(sizes.data(), memory_.sizes, counters * sizeof(int), cudaMemcpyDeviceToHost),
+            "copying the queue sizes back");
         const int bounces = args_.settings.bounces;
         stats_->active_paths.resize(bounces, 0);
         stats_->shadow_rays.resize(bounces, 0);
@@ -231,7 +236,8 @@ std::array<unsigned, kStageCount> prepare_stages(const cudaDeviceProp& prop, siz
         check(cudaOccupancyMaxActiveBlocksPerMultiprocessor(&blocks, kernels[s], kStageThreads,
                                                             reads_scene ? shared_bytes : 0),
               "computing a wavefront kernel's occupancy");
-        if (blocks == 0) throw GpuError(std::string("GPU: ") + stage_name(s) + " cannot run on this GPU");
+        if (blocks == 0)
+            throw GpuError(std::string("GPU: ") + stage_name(s) + " cannot run on this GPU");
         grid[s] = static_cast<unsigned>(blocks * prop.multiProcessorCount);
         if (stats) {
             stats->attributes[s] = attributes;
@@ -260,8 +266,8 @@ double render_waves(const RenderJob& job, const cudaDeviceProp& prop, const Scen
     DeviceArray<int> sizes(2 * settings.bounces + 1, "allocating the queue sizes");
     DeviceArray<SampleSum> sums(band_pixels, "allocating the pixel sums");
     DeviceArray<Vec3> means(band_pixels, "allocating the image band");
-    const typename WaveStages<C>::Memory memory{Pool::carve(pool_memory.data(), slots), sizes.data(),
-                                                sums.data(), means.data()};
+    const typename WaveStages<C>::Memory memory{Pool::carve(pool_memory.data(), slots),
+                                                sizes.data(), sums.data(), means.data()};
     const WavefrontArgs args{layout, scene_pool, job.camera, settings};
     WaveStages<C> stages(args, memory, shared_bytes, grid, stats);
 
@@ -271,7 +277,8 @@ double render_waves(const RenderJob& job, const cudaDeviceProp& prop, const Scen
         const int rows = std::min(plan.band_rows, settings.height - first_row);
         const int pixels = rows * settings.width;
         timer.start();
-        check(cudaMemsetAsync(sums.data(), 0, pixels * sizeof(SampleSum)), "clearing the pixel sums");
+        check(cudaMemsetAsync(sums.data(), 0, pixels * sizeof(SampleSum)),
+              "clearing the pixel sums");
         for (int first = 0; first < settings.spp; first += plan.samples_per_wave) {
             const int samples = std::min(plan.samples_per_wave, settings.spp - first);
             stages.run({first_row * settings.width, pixels, first, samples},
@@ -297,17 +304,20 @@ RenderStats render_wavefront(const RenderJob& job, Image& image, WavefrontStats*
     const SceneLayout layout = layout_of(job.scene);
     const std::vector<float4> host_pool = pack(job.scene, layout);
     DeviceArray<float4> scene_pool(host_pool.size(), "allocating the scene on the GPU");
-    check(cudaMemcpy(scene_pool.data(), host_pool.data(), scene_pool.bytes(), cudaMemcpyHostToDevice),
-          "copying the scene to the GPU");
+    check(
+        cudaMemcpy(scene_pool.data(), host_pool.data(), scene_pool.bytes(), cudaMemcpyHostToDevice),
+        "copying the scene to the GPU");
     const bool shared = choose_scene_memory(layout) == SceneMemory::Shared;
     const bool specular = has_specular_material(job.scene.materials, job.scene.num_materials);
     using S = std::integral_constant<SceneMemory, SceneMemory::Shared>;
     using G = std::integral_constant<SceneMemory, SceneMemory::Global>;
     const auto render = [&](auto memory, auto materials) {
-        using C = WavefrontConfig<Layout, decltype(memory)::value, Reserve::kPerBlock, decltype(materials)>;
+        using C = WavefrontConfig<Layout, decltype(memory)::value, Reserve::kPerBlock,
+                                  decltype(materials)>;
         return render_waves<C>(job, prop, layout, scene_pool.data(), image, stats);
     };
-    const double seconds = shared ? (specular ? render(S{}, AnyMaterial{}) : render(S{}, DiffuseOnly{}))
-                                  : (specular ? render(G{}, AnyMaterial{}) : render(G{}, DiffuseOnly{}));
+    const double seconds =
+        shared ? (specular ? render(S{}, AnyMaterial{}) : render(S{}, DiffuseOnly{}))
+               : (specular ? render(G{}, AnyMaterial{}) : render(G{}, DiffuseOnly{}));
     return {seconds, describe(prop), kKernelTimeOnly, describe_layout<Layout>()};
 }

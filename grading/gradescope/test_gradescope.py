@@ -62,7 +62,9 @@ def debian_mirror() -> str:
     for source in [pathlib.Path("/etc/apt/sources.list"),
                    *pathlib.Path("/etc/apt/sources.list.d").glob("*.sources")]:
         if source.is_file():
-            m = re.search(r"(?m)^(?:URIs:\s*|deb\s+(?:\[[^]]*\]\s+)?)(\S+/debian)/?\s", source.read_text())
+            m = re.search(
+                r"(?m)^(?:URIs:\s*|deb\s+(?:\[[^]]*\]\s+)?)(\S+/debian)/?\s", source.read_text()
+            )
             if m:
                 return m.group(1)
     return "http://deb.debian.org/debian"
@@ -106,9 +108,23 @@ def grade(work: pathlib.Path, name: str, files: dict[str, str | pathlib.Path]) -
             (sub / file_name).symlink_to(content)
         else:
             (sub / file_name).write_text(content)
-    p = subprocess.run(["docker", "run", "--rm", *LIMITS, "-v", f"{sub}:/autograder/submission:ro",
-                        "-v", f"{results}:/autograder/results", IMAGE, "/autograder/run_autograder"],
-                       capture_output=True, text=True, timeout=1800)
+    p = subprocess.run(
+        [
+            "docker",
+            "run",
+            "--rm",
+            *LIMITS,
+            "-v",
+            f"{sub}:/autograder/submission:ro",
+            "-v",
+            f"{results}:/autograder/results",
+            IMAGE,
+            "/autograder/run_autograder",
+        ],
+        capture_output=True,
+        text=True,
+        timeout=1800,
+    )
     try:
         return json.loads((results / "results.json").read_text())
     except (OSError, ValueError):
@@ -126,16 +142,32 @@ def main() -> int:
         solution = (ROOT / "labs/01-serial/solution/render.cpp").read_text()
         tracer = (ROOT / "common/core/path_tracer.h").read_text()
         cases = [
-            ("reference", {"render.cpp": solution, "path_tracer.h": tracer},
-             lambda s: s == 100, "100"),
+            (
+                "reference",
+                {"render.cpp": solution, "path_tracer.h": tracer},
+                lambda s: s == 100,
+                "100",
+            ),
             ("skeleton", pristine_skeleton("01-serial"), lambda s: s <= 10, "at most 10"),
-            ("includes-the-solution", {
-                "render.cpp": '#include "/autograder/source/labs/01-serial/solution/render.cpp"\n',
-                "path_tracer.h": '#include "/autograder/source/common/core/path_tracer.h"\n'},
-             lambda s: s <= 10, "at most 10"),
-            ("links", {"render.cpp": solution,
-                       "path_tracer.h": pathlib.Path("/autograder/source/common/core/path_tracer.h")},
-             lambda s: s <= 10, "at most 10"),
+            (
+                "includes-the-solution",
+                {
+                    "render.cpp":
+                        '#include "/autograder/source/labs/01-serial/solution/render.cpp"\n',
+                    "path_tracer.h": '#include "/autograder/source/common/core/path_tracer.h"\n',
+                },
+                lambda s: s <= 10,
+                "at most 10",
+            ),
+            (
+                "links",
+                {
+                    "render.cpp": solution,
+                    "path_tracer.h": pathlib.Path("/autograder/source/common/core/path_tracer.h"),
+                },
+                lambda s: s <= 10,
+                "at most 10",
+            ),
         ]
         failed = 0
         for name, files, ok, want in cases:

@@ -68,8 +68,8 @@ RenderStats render(const RenderJob& job, Image& image) {
         for (int x = 0; x < settings.width; ++x) {
             SampleSum sum;
             for (int s = 0; s < settings.spp; ++s) {
-                const Ray ray = job.camera.ray_through(x + rng.at(kDimPixelX),
-                                                       y + rng.at(kDimPixelY));
+                const Ray ray =
+                    job.camera.ray_through(x + rng.at(kDimPixelX), y + rng.at(kDimPixelY));
                 sum.add(trace_path(scene, scene, ray, rng, settings.bounces));
             }
             image.at(x, y) = sum.mean(settings.spp);

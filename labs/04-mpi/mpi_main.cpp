@@ -37,8 +37,9 @@ int main(int argc, char** argv) {
         int all_ok = setup_ok;
         MPI_Allreduce(MPI_IN_PLACE, &all_ok, 1, MPI_INT, MPI_MIN, MPI_COMM_WORLD);
         if (setup_ok && !all_ok) {
-            throw InputError("another MPI rank could not set up the render (on several hosts: "
-                             "is the scene file at the same path on each?)");
+            throw InputError(
+                "another MPI rank could not set up the render (on several hosts: "
+                "is the scene file at the same path on each?)");
         }
     };
     const int status = lab_main(argc, argv, hooks);

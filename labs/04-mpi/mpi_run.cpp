@@ -32,7 +32,8 @@ RunConfig run_config(const Team& team) {
     MPI_Bcast(choice, 2, MPI_INT, 0, MPI_COMM_WORLD);
     if (choice[0] < 0) {
         throw InputError(std::string("RT_MPI_DISTRIBUTION: expected block, interleaved or "
-                                     "dynamic, found '") + (name ? name : "") + "'");
+                                     "dynamic, found '") +
+                         (name ? name : "") + "'");
     }
     return {static_cast<Distribution>(choice[0]), choice[1] != 0};
 }
@@ -99,7 +100,6 @@ void print_report(const Team& team, const RankReport& mine, double seconds) {
     std::fprintf(stderr, "render %.3f s; imbalance (busiest rank's CPU / mean): %.2f\n", seconds,
                  total > 0 ? busiest / (total / team.size) : 1.0);
 }
-
 
 std::string describe_run(const Team& team, int hosts, Distribution distribution) {
     const auto plural = [](int n, const char* what) {

@@ -17,8 +17,9 @@ RenderStats render(const RenderJob& job, Image& image) {
     MPI_Allreduce(MPI_IN_PLACE, &all_have_avx2, 1, MPI_INT, MPI_MIN, MPI_COMM_WORLD);
     if (!all_have_avx2) {
         require_avx2("lab04-simd-ref (MPI on lab 02's SIMD packets)", cpu_model_name());
-        throw MissingCpuFeature("lab04-simd-ref needs AVX2 and FMA on every host, and another "
-                                "MPI rank's CPU has not");
+        throw MissingCpuFeature(
+            "lab04-simd-ref needs AVX2 and FMA on every host, and another "
+            "MPI rank's CPU has not");
     }
     RenderStats stats = render_avx2(job, image);
     stats.device += ", " + widest_packet_renderer().describe() + " (rank 0)";

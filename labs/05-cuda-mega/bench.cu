@@ -55,7 +55,7 @@ struct Variant {
     int threads_per_pixel;
     SceneMemory memory;
     int block_threads;
-    bool regenerate;    // by bounces, starting the next sample at once (else trace_path per sample)
+    bool regenerate;  // by bounces, starting the next sample at once (else trace_path per sample)
     int max_registers;  // render_kernel's cap (255: none)
     bool diffuse_only;  // compiled for DiffuseOnly (material_set.h), else for AnyMaterial
     const void* kernel;
@@ -66,7 +66,8 @@ template <int kT, SceneMemory kM, int kB, bool kRegenerate, int kMaxRegisters, c
 void launch_megakernel(const KernelArgs& args, size_t shared_bytes) {
     const long long threads = static_cast<long long>(args.rows) * args.settings.width * kT;
     const unsigned blocks = static_cast<unsigned>((threads + kB - 1) / kB);
-    render_kernel<kT, kM, kB, kRegenerate, kMaxRegisters, Materials><<<blocks, kB, shared_bytes>>>(args);
+    render_kernel<kT, kM, kB, kRegenerate, kMaxRegisters, Materials>
+        <<<blocks, kB, shared_bytes>>>(args);
 }
 
 void launch_plain(const KernelArgs& args, size_t) {
@@ -76,11 +77,11 @@ void launch_plain(const KernelArgs& args, size_t) {
                                   args.pixels);
 }
 
-#define MEGA_FOR(name, change, t, m, b, regen, regs, mats)                                  \
-    Variant {                                                                               \
-        name, change, t, SceneMemory::m, b, regen, regs, std::is_same_v<mats, DiffuseOnly>, \
+#define MEGA_FOR(name, change, t, m, b, regen, regs, mats)                                         \
+    Variant {                                                                                      \
+        name, change, t, SceneMemory::m, b, regen, regs, std::is_same_v<mats, DiffuseOnly>,        \
             reinterpret_cast<const void*>(render_kernel<t, SceneMemory::m, b, regen, regs, mats>), \
-            launch_megakernel<t, SceneMemory::m, b, regen, regs, mats>                      \
+            launch_megakernel<t, SceneMemory::m, b, regen, regs, mats>                             \
     }
 #define MEGA(name, change, t, m, b, regen, regs) \
     MEGA_FOR(name, change, t, m, b, regen, regs, AnyMaterial)
@@ -95,16 +96,20 @@ static const std::vector<Variant>& variants() {
         MEGA_DIFFUSE("diffuse-split-16", "16 threads per pixel", 16, Shared, 64, true, 72),
         MEGA_DIFFUSE("diffuse-regs-64", "at most 64 registers", 32, Shared, 64, true, 64),
         MEGA_DIFFUSE("diffuse-regs-any", "no register cap", 32, Shared, 64, true, 255),
-        MEGA_DIFFUSE("diffuse-whole-paths", "trace_path per sample (no regeneration)", 32, Shared, 64, false, 72),
+        MEGA_DIFFUSE("diffuse-whole-paths", "trace_path per sample (no regeneration)", 32, Shared,
+                     64, false, 72),
         MEGA_DIFFUSE("diffuse-block-32", "blocks of 32", 32, Shared, 32, true, 72),
         MEGA_DIFFUSE("diffuse-block-128", "blocks of 128", 32, Shared, 128, true, 72),
         MEGA_DIFFUSE("diffuse-scene-global", "scene in global memory", 32, Global, 64, true, 72),
         // From here on, compiled for every material kind: one choice changed from reference-16.
-        MEGA("reference-16", "the previous reference: 16 threads per pixel, at most 64 registers, every material", 16, Shared, 64, true, 64),
+        MEGA("reference-16",
+             "the previous reference: 16 threads per pixel, at most 64 registers, every material",
+             16, Shared, 64, true, 64),
         {"plain", "render_pixel per pixel, 16x16 blocks, global memory", 1, SceneMemory::Global,
          256, false, 255, false, reinterpret_cast<const void*>(plain_kernel), launch_plain},
         MEGA("whole-paths", "trace_path per sample (no regeneration)", 16, Shared, 64, false, 64),
-        MEGA("whole-paths-split-1", "trace_path per sample, 1 thread per pixel", 1, Shared, 64, false, 64),
+        MEGA("whole-paths-split-1", "trace_path per sample, 1 thread per pixel", 1, Shared, 64,
+             false, 64),
         MEGA("split-1", "1 thread per pixel", 1, Shared, 64, true, 64),
         MEGA("split-2", "2 threads per pixel", 2, Shared, 64, true, 64),
         MEGA("split-4", "4 threads per pixel", 4, Shared, 64, true, 64),
@@ -112,12 +117,17 @@ static const std::vector<Variant>& variants() {
         MEGA("split-32", "32 threads per pixel", 32, Shared, 64, true, 64),
         MEGA("scene-global", "scene in global memory", 16, Global, 64, true, 64),
         MEGA("scene-constant", "scene in the constant bank", 16, Constant, 64, true, 64),
-        MEGA("whole-paths-global", "trace_path per sample, scene in global memory", 16, Global, 64, false, 64),
-        MEGA("whole-paths-constant", "trace_path per sample, scene in the constant bank", 16, Constant, 64, false, 64),
+        MEGA("whole-paths-global", "trace_path per sample, scene in global memory", 16, Global, 64,
+             false, 64),
+        MEGA("whole-paths-constant", "trace_path per sample, scene in the constant bank", 16,
+             Constant, 64, false, 64),
         MEGA("regs-any", "no register cap", 16, Shared, 64, true, 255),
-        MEGA("whole-paths-regs-any", "trace_path per sample, no register cap", 16, Shared, 64, false, 255),
-        MEGA("global-regs-any", "scene in global memory, no register cap", 16, Global, 64, true, 255),
-        MEGA("constant-regs-any", "scene in the constant bank, no register cap", 16, Constant, 64, true, 255),
+        MEGA("whole-paths-regs-any", "trace_path per sample, no register cap", 16, Shared, 64,
+             false, 255),
+        MEGA("global-regs-any", "scene in global memory, no register cap", 16, Global, 64, true,
+             255),
+        MEGA("constant-regs-any", "scene in the constant bank, no register cap", 16, Constant, 64,
+             true, 255),
         MEGA("regs-56", "at most 56 registers", 16, Shared, 64, true, 56),
         MEGA("regs-48", "at most 48 registers", 16, Shared, 64, true, 48),
         MEGA("regs-40", "at most 40 registers", 16, Shared, 64, true, 40),
@@ -165,7 +175,8 @@ static double max_relative_difference(const std::vector<Vec3>& a, const std::vec
     for (size_t i = 0; i < a.size(); ++i) {
         const float pa[3] = {a[i].x, a[i].y, a[i].z}, pb[3] = {b[i].x, b[i].y, b[i].z};
         for (int c = 0; c < 3; ++c) {
-            const double d = std::abs(double(pa[c]) - pb[c]) / std::max(std::abs(double(pa[c])), 1e-3);
+            const double d =
+                std::abs(double(pa[c]) - pb[c]) / std::max(std::abs(double(pa[c])), 1e-3);
             worst = std::max(worst, d);
         }
     }
@@ -215,25 +226,28 @@ static int run(int argc, char** argv) {
     check(cudaMemcpy(pool.data(), host_pool.data(), pool.bytes(), cudaMemcpyHostToDevice),
           "copying the scene to the GPU");
     const double scene_upload_ms = ms_since(t0);
-    if (!fits_constant(layout)) throw GpuError("the benchmark needs a scene that fits in constant memory");
+    if (!fits_constant(layout))
+        throw GpuError("the benchmark needs a scene that fits in constant memory");
     check(cudaMemcpyToSymbol(constant_pool, host_pool.data(), layout.bytes()),
           "copying the scene to the GPU's constant memory");
     const size_t n = static_cast<size_t>(settings.width) * settings.height;
     t0 = now();
     DeviceArray<Vec3> pixels(n, "allocating the image");
     const double image_alloc_ms = ms_since(t0);
-    const KernelArgs args{layout, pool.data(), scene.camera.for_image(settings.width, settings.height),
-                          settings, 0, settings.height, pixels.data()};
+    const KernelArgs args{
+        layout,       pool.data(), scene.camera.for_image(settings.width, settings.height),
+        settings,     0,           settings.height,
+        pixels.data()};
     const double paths = double(n) * settings.spp;
 
     std::vector<Vec3> reference_image;
-    std::printf("{\"device\": \"%s\", \"scene\": \"%s\", \"width\": %d, \"height\": %d, "
-                "\"spp\": %d, \"bounces\": %d, \"seed\": %llu, \"repeat\": %d, "
-                "\"timing\": \"CUDA events around each launch, kernel only; best and median of "
-                "repeat runs after one warm-up run\", \"variants\": [",
-                describe(prop).c_str(), options.scene_path.c_str(), settings.width,
-                settings.height, settings.spp, settings.bounces,
-                static_cast<unsigned long long>(settings.seed), repeat);
+    std::printf(
+        "{\"device\": \"%s\", \"scene\": \"%s\", \"width\": %d, \"height\": %d, "
+        "\"spp\": %d, \"bounces\": %d, \"seed\": %llu, \"repeat\": %d, "
+        "\"timing\": \"CUDA events around each launch, kernel only; best and median of "
+        "repeat runs after one warm-up run\", \"variants\": [",
+        describe(prop).c_str(), options.scene_path.c_str(), settings.width, settings.height,
+        settings.spp, settings.bounces, static_cast<unsigned long long>(settings.seed), repeat);
     bool first = true;
     double first_load_ms = 0, download_ms = 0;
     std::vector<std::pair<std::string, double>> best_ms;  // of each variant run
@@ -258,24 +272,28 @@ static int run(int argc, char** argv) {
         if (first) download_ms = ms_since(t0);
         if (reference_image.empty()) reference_image = image;
         size_t nonfinite = 0;
-        for (const Vec3& p : image) nonfinite += !(std::isfinite(p.x) && std::isfinite(p.y) && std::isfinite(p.z));
-        const bool identical = std::memcmp(image.data(), reference_image.data(), pixels.bytes()) == 0;
-        const double occupancy = double(blocks_per_sm) * v.block_threads / prop.maxThreadsPerMultiProcessor;
-        std::printf("%s\n  {\"name\": \"%s\", \"change\": \"%s\", \"threads_per_pixel\": %d, "
-                    "\"scene_memory\": \"%s\", \"block_threads\": %d, \"regenerate\": %s, \"max_registers\": %d, "
-                    "\"materials\": \"%s\", "
-                    "\"registers\": %d, \"local_bytes\": %zu, \"blocks_per_sm\": %d, "
-                    "\"occupancy\": %.3f, \"best_ms\": %.3f, \"median_ms\": %.3f, "
-                    "\"paths_per_second\": %.4g, \"nonfinite_pixels\": %zu, "
-                    "\"identical_to_reference\": %s, \"max_relative_difference\": %.3g}",
-                    first ? "" : ",", v.name, v.change, v.threads_per_pixel,
-                    v.memory == SceneMemory::Global ? "global"
-                    : v.memory == SceneMemory::Constant ? "constant" : "shared",
-                    v.block_threads, v.regenerate ? "true" : "false", v.max_registers,
-                    v.diffuse_only ? "diffuse only" : "any", attr.numRegs, attr.localSizeBytes,
-                    blocks_per_sm, occupancy, t.best_ms, t.median_ms, paths / (t.best_ms * 1e-3),
-                    nonfinite, identical ? "true" : "false",
-                    max_relative_difference(reference_image, image));
+        for (const Vec3& p : image)
+            nonfinite += !(std::isfinite(p.x) && std::isfinite(p.y) && std::isfinite(p.z));
+        const bool identical =
+            std::memcmp(image.data(), reference_image.data(), pixels.bytes()) == 0;
+        const double occupancy =
+            double(blocks_per_sm) * v.block_threads / prop.maxThreadsPerMultiProcessor;
+        std::printf(
+            "%s\n  {\"name\": \"%s\", \"change\": \"%s\", \"threads_per_pixel\": %d, "
+            "\"scene_memory\": \"%s\", \"block_threads\": %d, \"regenerate\": %s, \"max_registers\": %d, "
+            "\"materials\": \"%s\", "
+            "\"registers\": %d, \"local_bytes\": %zu, \"blocks_per_sm\": %d, "
+            "\"occupancy\": %.3f, \"best_ms\": %.3f, \"median_ms\": %.3f, "
+            "\"paths_per_second\": %.4g, \"nonfinite_pixels\": %zu, "
+            "\"identical_to_reference\": %s, \"max_relative_difference\": %.3g}",
+            first ? "" : ",", v.name, v.change, v.threads_per_pixel,
+            v.memory == SceneMemory::Global     ? "global"
+            : v.memory == SceneMemory::Constant ? "constant"
+                                                : "shared",
+            v.block_threads, v.regenerate ? "true" : "false", v.max_registers,
+            v.diffuse_only ? "diffuse only" : "any", attr.numRegs, attr.localSizeBytes,
+            blocks_per_sm, occupancy, t.best_ms, t.median_ms, paths / (t.best_ms * 1e-3), nonfinite,
+            identical ? "true" : "false", max_relative_difference(reference_image, image));
         std::fflush(stdout);
         best_ms.emplace_back(v.name, t.best_ms);
         first = false;
@@ -285,11 +303,13 @@ static int run(int argc, char** argv) {
             if (n == name) return ms;
         return -1.0;
     };
-    std::printf("\n], \"host_ms\": {\"context_creation\": %.2f, \"module_load\": %.2f, "
-                "\"scene_upload\": %.3f, \"image_allocation\": %.3f, \"image_download\": %.3f}, "
-                "\"targets\": %s}\n",
-                context_ms, first_load_ms, scene_upload_ms, image_alloc_ms, download_ms,
-                targets_json(kLab05Targets, best_of, why_not_judged(prop, options.scene_path, settings)).c_str());
+    std::printf(
+        "\n], \"host_ms\": {\"context_creation\": %.2f, \"module_load\": %.2f, "
+        "\"scene_upload\": %.3f, \"image_allocation\": %.3f, \"image_download\": %.3f}, "
+        "\"targets\": %s}\n",
+        context_ms, first_load_ms, scene_upload_ms, image_alloc_ms, download_ms,
+        targets_json(kLab05Targets, best_of, why_not_judged(prop, options.scene_path, settings))
+            .c_str());
     return 0;
 }
 

@@ -7,7 +7,6 @@ bench-*.json files of lab07-bench and the ncu-*.csv files of Nsight Compute.
 import csv
 import json
 import pathlib
-import re
 import sys
 
 STAGES = ["generate_camera_paths", "find_closest_hits", "shade_hits", "trace_shadow_rays",

@@ -15,7 +15,9 @@ static void expect(bool ok, const std::string& what, const std::string& got) {
     ++failures;
 }
 
-static bool has(const std::string& text, const char* part) { return text.find(part) != std::string::npos; }
+static bool has(const std::string& text, const char* part) {
+    return text.find(part) != std::string::npos;
+}
 
 int main() {
     cudaDeviceProp h200{}, other{};
@@ -40,12 +42,17 @@ int main() {
         return [=](const char* name) { return std::strcmp(name, "AoS") == 0 ? aos : soa; };
     };
     std::string json = targets_json(targets, times(55.0, 50.0), "");
-    expect(has(json, "\"config\": \"AoS\", \"bar\": \"at most 60 ms on an NVIDIA H200, the baseline\", "
-                     "\"best_ms\": 55.000, \"met\": true"), "a met bar", json);
-    expect(has(json, "\"config\": \"SoA\", \"bar\": \"faster than AoS on an NVIDIA H200, the baseline\", "
-                     "\"best_ms\": 50.000, \"met\": true"), "a met comparison", json);
+    expect(has(json,
+               "\"config\": \"AoS\", \"bar\": \"at most 60 ms on an NVIDIA H200, the baseline\", "
+               "\"best_ms\": 55.000, \"met\": true"),
+           "a met bar", json);
+    expect(has(json,
+               "\"config\": \"SoA\", \"bar\": \"faster than AoS on an NVIDIA H200, the baseline\", "
+               "\"best_ms\": 50.000, \"met\": true"),
+           "a met comparison", json);
     json = targets_json(targets, times(61.0, 62.0), "");
-    expect(has(json, "\"best_ms\": 61.000, \"met\": false") && has(json, "\"best_ms\": 62.000, \"met\": false"),
+    expect(has(json, "\"best_ms\": 61.000, \"met\": false") &&
+               has(json, "\"best_ms\": 62.000, \"met\": false"),
            "missed bars", json);
     json = targets_json(targets, times(55.0, 50.0), "not this GPU");
     expect(has(json, "\"met\": null, \"why_not\": \"not this GPU\""), "not judged", json);

@@ -1,8 +1,8 @@
 """Broken lab-05 hand-ins for the GPU rubrics' tests: the reference hand-in (labs/05-cuda-mega/
 solution/ and the megakernel, common/cuda/megakernel.cuh) with one classic GPU bug each, built
-as `make cuda-variant` builds a student's folder. Each edit names the text it replaces, which must be in the solution exactly once, so
-a change to the solution that moves that text fails the build loudly instead of testing a
-mutant that is no longer broken.
+as `make cuda-variant` builds a student's folder. Each edit names the text it replaces, which
+must be in the solution exactly once, so a change to the solution that moves that text fails the
+build loudly instead of testing a mutant that is no longer broken.
 """
 from __future__ import annotations
 
@@ -11,8 +11,8 @@ import pathlib
 import subprocess
 
 from grading.harness import ROOT
-from grading.variants import lab_sources
 from grading.leaks import skeletons
+from grading.variants import lab_sources
 
 LAB = "05-cuda-mega"
 

@@ -139,6 +139,7 @@ def golden_copier(folder) -> pathlib.Path:
     """Recognises the golden scenes by name and prints the stored golden images; anything else
     it cannot render."""
     import base64
+
     from grading.harness import GOLDEN
     cases = []
     for scene in ("cornell", "showcase"):
@@ -179,13 +180,16 @@ def altered_reference(folder: pathlib.Path, change: str,
 def fewer_samples(folder, divisor: int = 4) -> pathlib.Path:
     """The reference asked for N paths per pixel renders N / divisor: cheaper, and its block
     means are still right."""
-    return carrying_reference(folder, f"""prev=""
+    return carrying_reference(
+        folder,
+        f"""prev=""
 for a in "$@"; do
   shift
   if [ "$prev" = "--spp" ]; then set -- "$@" $(( (a + {divisor - 1}) / {divisor} )); else set -- "$@" "$a"; fi
   prev="$a"
 done
-./ref "$@" """)
+./ref "$@" """,
+    )
 
 
 # Image changes for altered_reference: a 3x3 box blur, 8x8 blocks flattened to their mean

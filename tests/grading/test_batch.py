@@ -29,16 +29,39 @@ BUSY = {"score": 70, "max_score": 100, "output": "marked for regrade", "tests": 
     result_test("parallel-speedup", "parallel speedup", 40, 40,
          "not measurable: the machine gave only 1.12 cores' worth of throughput in 3 "
          "attempts; points provisional, marked for regrade", regrade=True)]}
-RACY = {"score": 0, "max_score": 100, "output": "", "tests": [
-    result_test("bitwise", "bit-identical to lab 01", 0, 30, "not graded until the parallel speedup "
-         "passes"),
-    result_test("parallel-speedup", "parallel speedup", 0, 40, "the timed render differs from the "
-         "serial reference's image: speed is graded only for a correct image")]}
-BROKEN = {"score": 0, "max_score": 100,
-          "output": "the code does not compile:\nsrc/render.cpp:3:1: error: expected ';'",
-          "tests": [result_test("bitwise", "bit-identical to lab 01", 0, 30, "not graded: the code does "
-                         "not compile"),
-                    result_test("parallel-speedup", "parallel speedup", 0, 40, "not graded")]}
+RACY = {
+    "score": 0,
+    "max_score": 100,
+    "output": "",
+    "tests": [
+        result_test(
+            "bitwise",
+            "bit-identical to lab 01",
+            0,
+            30,
+            "not graded until the parallel speedup passes",
+        ),
+        result_test(
+            "parallel-speedup",
+            "parallel speedup",
+            0,
+            40,
+            "the timed render differs from the "
+            "serial reference's image: speed is graded only for a correct image",
+        ),
+    ],
+}
+BROKEN = {
+    "score": 0,
+    "max_score": 100,
+    "output": "the code does not compile:\nsrc/render.cpp:3:1: error: expected ';'",
+    "tests": [
+        result_test(
+            "bitwise", "bit-identical to lab 01", 0, 30, "not graded: the code does not compile"
+        ),
+        result_test("parallel-speedup", "parallel speedup", 0, 40, "not graded"),
+    ],
+}
 
 
 def rows_of(path):

@@ -20,11 +20,16 @@ if REPO not in sys.path:
 
 from grading import compare as cmp  # noqa: E402
 from grading.compare import (  # noqa: E402
-    InputError, compare, count_tests, critical_z, false_failure_rate, heatmap_png,
-    normal_quantile)
+    InputError,
+    compare,
+    count_tests,
+    critical_z,
+    false_failure_rate,
+    heatmap_png,
+    normal_quantile,
+)
 from grading.heatmap import heatmap_scale  # noqa: E402
 from grading.pfm import PFMError, read_pfm, write_pfm  # noqa: E402
-
 
 # ---------------------------------------------------------------------------------------
 # Synthetic scenes
@@ -34,7 +39,9 @@ def scene(rng, h=64, w=64):
     """A smooth 'true' image in [0.1, 1] and a per-path variance (coefficient of variation
     about 1 per path, as for a diffusely lit scene)."""
     y, x = np.mgrid[0:h, 0:w]
-    base = 0.55 + 0.45 * np.sin(x / 9.0)[..., None] * np.cos(y / 7.0)[..., None] * np.array([1.0, 0.8, 0.6])
+    base = 0.55 + 0.45 * np.sin(x / 9.0)[..., None] * np.cos(y / 7.0)[..., None] * np.array(
+        [1.0, 0.8, 0.6]
+    )
     truth = np.clip(base, 0.1, 1.0) + 0.0 * rng.random((h, w, 3))
     variance = (truth * rng.uniform(0.5, 1.5, size=truth.shape)) ** 2
     return truth, variance
@@ -308,7 +315,9 @@ def test_bad_inputs_raise_value_error():
 
 def test_pfm_round_trip_exact(tmp_path):
     rng = np.random.default_rng(12)
-    img = (rng.standard_normal((5, 7, 3)) * 10.0 ** rng.integers(-30, 30, (5, 7, 3))).astype(np.float32)
+    img = (rng.standard_normal((5, 7, 3)) * 10.0 ** rng.integers(-30, 30, (5, 7, 3))).astype(
+        np.float32
+    )
     img[0, 0] = [np.inf, -0.0, 1e-45]
     path = tmp_path / "x.pfm"
     write_pfm(path, img)

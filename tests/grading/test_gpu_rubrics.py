@@ -12,8 +12,9 @@ stand-in.
 On a GPU (tools/gpu_check.sh runs these; elsewhere they skip and say why): each lab's
 reference scores 100 in the sandbox, each pristine skeleton at most 10%, and each classic GPU
 bug (tests/grading/gpu_mutants.py) loses the points it should, with a message naming the
-symptom, and lab 06's reference handed in for lab 07 loses the layout's points. Renders are small but for the timed ones (~0.4 s of kernel time each on an H200),
-so that this part stays within a few minutes there.
+symptom, and lab 06's reference handed in for lab 07 loses the layout's points. Renders are
+small but for the timed ones (~0.4 s of kernel time each on an H200), so that this part stays
+within a few minutes there.
 """
 import concurrent.futures
 import json
@@ -26,12 +27,24 @@ import sys
 import pytest
 
 from grading import checks, gpu, sandbox
-from grading.grade import (GOLDENS, GPU_TIMED_SCALE, RUBRICS, describe, grade, grading_order,
-                           passed_by_check)
+from grading.grade import (
+    GOLDENS,
+    GPU_TIMED_SCALE,
+    RUBRICS,
+    describe,
+    grade,
+    grading_order,
+    passed_by_check,
+)
 from grading.harness import ROOT, build
 from tests.grading import submissions
-from tests.grading.gpu_mutants import (LAB, MUTANTS, build_cuda_folder, mutant_sources,
-                                       reference_hand_in)
+from tests.grading.gpu_mutants import (
+    LAB,
+    MUTANTS,
+    build_cuda_folder,
+    mutant_sources,
+    reference_hand_in,
+)
 from tests.labs.cuda_env import missing_gpu, missing_nvcc
 
 GPU_LABS = {"05": "05-cuda-mega", "06": "06-cuda-split", "07": "07-soa"}
@@ -127,7 +140,9 @@ def test_a_gpu_submission_including_the_solution_does_not_compile(nvcc_and_sandb
     solution = ROOT / "labs" / GPU_LABS["05"] / "solution"
     (tmp_path / "render.cu").write_text(f'#include "{solution}/render.cu"\n')
     # The other file lab 05's students write: a hand-in without it does not build at all.
-    (tmp_path / "megakernel.cuh").write_text(pristine_skeleton_sources(GPU_LABS["05"])["megakernel.cuh"])
+    (tmp_path / "megakernel.cuh").write_text(
+        pristine_skeleton_sources(GPU_LABS["05"])["megakernel.cuh"]
+    )
     binary, errors = build_lab("05", tmp_path, trusted=False)
     assert binary is None and "No such file or directory" in errors, errors
     binary, errors = build_lab("05", tmp_path, trusted=True)
@@ -370,6 +385,7 @@ def test_a_timed_render_is_checked_at_the_golden_size():
     """The timed render is the golden view `scale` times larger; box-filtered, a correct one
     is the golden image (here: the golden image itself, upsampled), a transposed one is not."""
     import numpy as np
+
     from grading.harness import golden
     g = golden("cornell")
     big = np.kron(g.mean, np.ones((GPU_TIMED_SCALE, GPU_TIMED_SCALE, 1), np.float32))

@@ -7,7 +7,8 @@ import sys
 
 import pytest
 
-from grading.grade import describe, grade as grade_in_process, passed_by_check, unmeasurable
+from grading.grade import describe, passed_by_check, unmeasurable
+from grading.grade import grade as grade_in_process
 from grading.harness import ROOT, build, cpu_has_avx2
 
 
@@ -57,7 +58,9 @@ def test_lab02_scalar_hand_in_loses_only_the_speedup(lab01_ref, tmp_path):
     assert all(passed.values()), describe(results)
 
 
-@pytest.mark.skipif(not cpu_has_avx2(), reason="this CPU has no AVX2/FMA: lab 02's Part B cannot run")
+@pytest.mark.skipif(
+    not cpu_has_avx2(), reason="this CPU has no AVX2/FMA: lab 02's Part B cannot run"
+)
 def test_lab02_reference_gets_full_marks(tmp_path):
     results = grade_in_process("02", build("lab02-ref")[0], tmp_path)
     assert results["score"] == results["max_score"] == 100, describe(results)

@@ -50,6 +50,7 @@ def test_a_grade_writes_a_page_with_the_images(lab01_ref, tmp_path):
     submission's image, the golden image and (for a failed comparison) the heatmap, as PNGs;
     a flipped image's page says so."""
     import subprocess
+
     from tests.grading.submissions import altered_reference
     flipped = altered_reference(tmp_path, "image[::-1]", lab01_ref)
     for name, binary in (("right", lab01_ref), ("flipped", flipped)):

@@ -76,7 +76,9 @@ def test_one_nan_pixel_fails_every_image_check(tmp_path):
     results = grade("01", sub.nan_pixel(tmp_path), tmp_path)
     assert results["score"] == 0, describe(results)
     for t in results["tests"]:
-        assert "1 NaN" in t["output"] or t["output"].startswith("not graded until"), describe(results)
+        assert "1 NaN" in t["output"] or t["output"].startswith("not graded until"), describe(
+            results
+        )
 
 
 def test_nan_only_in_the_scaled_scenes_fails_the_scale_check(tmp_path):
@@ -174,7 +176,9 @@ def test_an_output_flood_is_cut(tmp_path, stream):
     assert p.returncode == 0, p.stderr.read()
     results = json.loads(out.read_text())
     assert results["score"] == 0
-    assert f"wrote more than 1024 KiB on {stream}" in results["tests"][0]["output"], describe(results)
+    assert f"wrote more than 1024 KiB on {stream}" in results["tests"][0]["output"], describe(
+        results
+    )
     assert out.stat().st_size < 100_000, out.stat().st_size
     assert usage.ru_maxrss < 400_000, f"the grader grew to {usage.ru_maxrss // 1024} MiB"
 
@@ -414,6 +418,7 @@ def test_too_smooth_is_named_on_the_golden_image():
     """The golden Cornell box rendered by the reference and blurred over 3x3 pixels: its block
     means pass, its per-pixel noise is too small."""
     import numpy as np
+
     from grading.compare import compare
     from grading.harness import build, golden, run_lab
     reference, = build("lab01-ref")
@@ -422,7 +427,9 @@ def test_too_smooth_is_named_on_the_golden_image():
                     bounces=g.meta["bounces"], seed=7).image
     assert compare(image, 64, g.mean, g.variance, g.meta["golden_spp"]).passed
     padded = np.pad(image, ((1, 1), (1, 1), (0, 0)), mode="edge")
-    blurred = np.lib.stride_tricks.sliding_window_view(padded, (3, 3), axis=(0, 1)).mean(axis=(-1, -2))
+    blurred = np.lib.stride_tricks.sliding_window_view(padded, (3, 3), axis=(0, 1)).mean(
+        axis=(-1, -2)
+    )
     report = compare(blurred, 64, g.mean, g.variance, g.meta["golden_spp"])
     assert not report.passed and "too smooth" in report.summary(), report.summary()
 

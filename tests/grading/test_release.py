@@ -127,10 +127,21 @@ def test_lab01_release_layout(pristine01):
     # lab 01 writes common/core/path_tracer.h's regions: the release has its skeleton form
     skeleton = (ROOT / "labs/01-serial/skeleton/path_tracer.h").read_text()
     assert (release01 / "common/core/path_tracer.h").read_text() == skeleton.split("\n", 1)[1]
-    assert sorted(p.name for p in (release01 / "reference-bin").iterdir()) == \
-        sorted(["lab01-ref", "lab02-ref", "lab02-ref-avx2", "lab02a-ref", "lab02-prims", "lab03-ref",
-                "lab03-bench", "lab03-simd-ref", "lab04-ref", "lab04-simd-ref"] +
-               [f"lab{n}-ref" for n in ("05", "06", "07") if shutil.which("nvcc")])
+    assert sorted(p.name for p in (release01 / "reference-bin").iterdir()) == sorted(
+        [
+            "lab01-ref",
+            "lab02-ref",
+            "lab02-ref-avx2",
+            "lab02a-ref",
+            "lab02-prims",
+            "lab03-ref",
+            "lab03-bench",
+            "lab03-simd-ref",
+            "lab04-ref",
+            "lab04-simd-ref",
+        ]
+        + [f"lab{n}-ref" for n in ("05", "06", "07") if shutil.which("nvcc")]
+    )
     for gone in ("tests/grading", "tools/skeletons.py", "grading/release.py", "ref", ".ci"):
         assert not (release01 / gone).exists(), gone
     assert not list(pristine01.parent.glob(".*partial*")), "a partial release was left behind"

@@ -57,6 +57,7 @@ def test_a_cpu_quota_below_two_cores_times_nothing(monkeypatch):
 def test_the_quota_is_read_from_the_cgroup():
     """Whatever this machine's quota, the capacity never exceeds the CPUs it may run on."""
     import os
+
     from grading import harness
     quota = harness.cpu_quota()
     assert quota is None or quota > 0

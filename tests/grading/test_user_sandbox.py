@@ -4,7 +4,6 @@ instead (grading/sandbox.py, grading/confine.py). The grader runs here under a s
 refusing namespace creation (tests/grading/no_namespaces.py), as such a container would."""
 import json
 import os
-import pathlib
 import subprocess
 import sys
 
@@ -14,7 +13,12 @@ from grading import sandbox
 from grading.harness import GOLDEN, ROOT, build
 from tests.grading import submissions as sub
 
-NO_NAMESPACES = [sandbox.SYSTEM_PYTHON, "-I", str(ROOT / "tests" / "grading" / "no_namespaces.py"), "--"]
+NO_NAMESPACES = [
+    sandbox.SYSTEM_PYTHON,
+    "-I",
+    str(ROOT / "tests" / "grading" / "no_namespaces.py"),
+    "--",
+]
 
 
 @pytest.fixture(scope="module", autouse=True)
@@ -77,12 +81,16 @@ def test_user_sandbox_walls(user_sandbox, tmp_path):
     nothing left running after a run."""
     import socket
     client = sub.socket_client(tmp_path)
-    spy = sub.script(tmp_path, f"""cat "{ROOT / 'labs' / '01-serial' / 'solution' / 'render.cpp'}" >/dev/null 2>&1 && echo SPY solution
-cat "{GOLDEN / 'cornell' / 'meta.json'}" >/dev/null 2>&1 && echo SPY golden
+    spy = sub.script(
+        tmp_path,
+        f"""cat "{ROOT / "labs" / "01-serial" / "solution" / "render.cpp"}" >/dev/null 2>&1 && echo SPY solution
+cat "{GOLDEN / "cornell" / "meta.json"}" >/dev/null 2>&1 && echo SPY golden
 unshare -U true 2>/dev/null && echo SPY namespace
 echo "SECRET=$GRADING_SECRET"
 (sleep 987653 &)
-""", name="spy")
+""",
+        name="spy",
+    )
     os.environ["GRADING_SECRET"] = "leak-me-4713"
     try:
         with socket.socket() as server:

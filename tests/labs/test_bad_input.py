@@ -69,7 +69,7 @@ def test_bad_scene(lab01_ref, tmp_path, case):
 
 def test_error_position_points_at_the_token(lab01_ref, tmp_path):
     text = json.dumps(GOOD, indent=2).replace('"radius": 0.2', '"radius": -0.2')
-    line_no = next(i for i, l in enumerate(text.splitlines(), 1) if '"radius"' in l)
+    line_no = next(i for i, ln in enumerate(text.splitlines(), 1) if '"radius"' in ln)
     column = text.splitlines()[line_no - 1].index("-0.2") + 1
     p = run(lab01_ref, "--scene", str(scene_with(tmp_path, text)))
     assert f"line {line_no}, column {column}" in p.stderr, p.stderr

@@ -67,8 +67,9 @@ def test_ppm_is_srgb_of_pfm(lab01_ref, tmp_path):
     ppm, pfm = tmp_path / "a.ppm", tmp_path / "a.pfm"
     subprocess.run([str(lab01_ref), "--quiet", "--width", "16", "--height", "16", "--spp", "4",
                     "--out", str(ppm), "--pfm", str(pfm)], check=True)
-    from grading.pfm import read_pfm
     import numpy as np
+
+    from grading.pfm import read_pfm
     linear = np.clip(read_pfm(pfm), 0, 1)
     srgb = np.where(linear <= 0.0031308, 12.92 * linear, 1.055 * linear ** (1 / 2.4) - 0.055)
     data = ppm.read_bytes()

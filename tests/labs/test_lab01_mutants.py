@@ -69,7 +69,8 @@ MUTANTS = {
     "uniform sampling weighted as cosine": (
         "material.h", "const real r = sqrt_real(u1);", "const real r = sqrt_real(1.0f - u1 * u1);",
         ["cornell"]),
-    "glass never reflects": ("path_tracer.h", "if (rng.at(bounce_dimension(bounce, 0)) < reflectance)",
+    "glass never reflects": ("path_tracer.h",
+                             "if (rng.at(bounce_dimension(bounce, 0)) < reflectance)",
                              "if (reflectance < 0.0f)", ["glass"]),
     "sphere: far root only": ("sphere.h", "if (t_near > 0.0f && t_near < t_max) return t_near;",
                               "", ["cornell", "showcase"]),

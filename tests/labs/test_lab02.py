@@ -25,8 +25,15 @@ import subprocess
 import pytest
 
 from grading import checks
-from grading.harness import ROOT, available_cores, build, cpu_has_avx2, interleaved_speedup, \
-    render_seconds, run_lab
+from grading.harness import (
+    ROOT,
+    available_cores,
+    build,
+    cpu_has_avx2,
+    interleaved_speedup,
+    render_seconds,
+    run_lab,
+)
 from grading.variants import build_pristine_skeleton, build_sources, pristine_skeleton_sources
 
 

@@ -7,8 +7,14 @@ import os
 import pytest
 
 from grading import checks
-from grading.harness import ROOT, available_cores, build, cpu_has_avx2, measure_parallel, \
-    render_seconds, run_lab
+from grading.harness import (
+    available_cores,
+    build,
+    cpu_has_avx2,
+    measure_parallel,
+    render_seconds,
+    run_lab,
+)
 from grading.variants import build_pristine_skeleton
 
 # Small renders for the bitwise comparisons: every pixel, sample and bounce is exercised.

@@ -13,8 +13,8 @@ import subprocess
 
 import numpy as np
 import pytest
-
 from cuda_env import gpu_name, missing_gpu
+
 from grading import checks
 from grading.compare import compare
 from grading.harness import ROOT, build, golden, run_lab
@@ -39,7 +39,7 @@ def test_without_nvcc_the_targets_fail_with_one_line():
         assert p.returncode != 0, target
         lines = p.stderr.strip().splitlines()
         assert lines and "needs the CUDA toolkit" in lines[0], p.stderr
-        assert len([l for l in lines if not l.startswith("make")]) == 1, p.stderr
+        assert len([ln for ln in lines if not ln.startswith("make")]) == 1, p.stderr
     assert make("-n", "lab01-ref", "NVCC=/no/such/nvcc").returncode == 0
 
 
@@ -64,7 +64,9 @@ def test_shared_gpu_headers_compile_alone(nvcc):
     uses), for sm_90 with warnings as errors."""
     p = make("-j2", "check-gpu-headers")
     assert p.returncode == 0, p.stdout + p.stderr
-    headers = sorted((ROOT / "common" / "cuda").glob("*.*h")) + sorted((ROOT / "common" / "wavefront").glob("*.cuh"))
+    headers = sorted((ROOT / "common" / "cuda").glob("*.*h")) + sorted(
+        (ROOT / "common" / "wavefront").glob("*.cuh")
+    )
     assert f"check-gpu-headers: {len(headers)} headers" in p.stdout, p.stdout
 
 
@@ -93,7 +95,7 @@ def test_kernel_report(nvcc):
     report = (ROOT / "build" / "kernel-report.md").read_text()
 
     def row(kernel):
-        line = next(l for l in report.splitlines() if f"`{kernel}`" in l)
+        line = next(ln for ln in report.splitlines() if f"`{kernel}`" in ln)
         cells = [c.strip() for c in line.strip("|").split("|")]
         return int(cells[2]), int(cells[3]) + int(cells[4]), int(cells[5])  # regs, spills, stack
 

@@ -19,12 +19,12 @@ import subprocess
 
 import numpy as np
 import pytest
-
 from cuda_env import gpu_name, missing_gpu
+from renderer_checks import CHECKS
+
 from grading import checks
 from grading.compare import compare
 from grading.harness import ROOT, build, golden, run_lab
-from renderer_checks import CHECKS
 
 LAB = "06-cuda-split"
 # The H200 test's bar: the reference's best recorded time on the baseline (reference/gpu/)
@@ -44,7 +44,7 @@ def targets_fail_without_nvcc(targets):
         assert p.returncode != 0, target
         lines = p.stderr.strip().splitlines()
         assert lines and "needs the CUDA toolkit" in lines[0], p.stderr
-        assert len([l for l in lines if not l.startswith("make")]) == 1, p.stderr
+        assert len([ln for ln in lines if not ln.startswith("make")]) == 1, p.stderr
 
 
 def no_gpu_is_one_line(binary, tmp_path):
@@ -139,7 +139,11 @@ def test_skeleton_in_sync():
     assert set(expected) == {"path_queue.cuh", "render.cu", "stage_loop.cuh"}
     for name, text in expected.items():
         assert (ROOT / "labs" / LAB / "skeleton" / name).read_text() == text, name
-    reserve = expected["path_queue.cuh"].split("int reserve(int* size, bool wants) {")[1].split("\n}\n")[0]
+    reserve = (
+        expected["path_queue.cuh"]
+        .split("int reserve(int* size, bool wants) {")[1]
+        .split("\n}\n")[0]
+    )
     code = "\n".join(line for line in reserve.splitlines() if not line.strip().startswith("//"))
     assert "atomicAdd" not in code and "__syncthreads" not in code, code
     assert "for (int bounce" not in expected["stage_loop.cuh"]
@@ -196,9 +200,11 @@ def test_benchmarks_end_a_failure_with_one_line(nvcc, bench):
     the lab binaries give (3 for the machine, 2 for the input), nothing on stdout."""
     binary = build(bench)[0]
     env = {**os.environ, "CUDA_VISIBLE_DEVICES": ""}
-    for args, status, fragment in [(["--width", "8", "--height", "8", "--spp", "1"], 3, "error: GPU: "),
-                                   (["--spp", "0"], 2, "error: --spp: "),
-                                   (["--scene", "/no/such/scene.json"], 2, "error: ")]:
+    for args, status, fragment in [
+        (["--width", "8", "--height", "8", "--spp", "1"], 3, "error: GPU: "),
+        (["--spp", "0"], 2, "error: --spp: "),
+        (["--scene", "/no/such/scene.json"], 2, "error: "),
+    ]:
         p = subprocess.run([str(binary), *args], capture_output=True, text=True, env=env,
                            timeout=120)
         lines = p.stderr.strip().splitlines()

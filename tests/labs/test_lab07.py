@@ -9,12 +9,18 @@ import os
 
 import numpy as np
 import pytest
+from test_lab06 import (
+    CHECKS,
+    no_gpu_is_one_line,
+    on_h200,
+    pristine_skeleton,
+    statistically_agrees_with,
+    targets_fail_without_nvcc,
+    waves_do_not_change_the_image,
+)
 
 from grading import checks
 from grading.harness import ROOT, build, golden, run_lab
-from test_lab06 import (CHECKS, best_seconds, make, no_gpu_is_one_line, on_h200,
-                        pristine_skeleton, statistically_agrees_with,
-                        targets_fail_without_nvcc, waves_do_not_change_the_image)
 
 LAB = "07-soa"
 

@@ -23,8 +23,8 @@ import subprocess
 
 import numpy as np
 import pytest
-
 from cuda_env import missing_gpu
+
 from grading import scenes
 from grading.compare import compare
 from grading.harness import ROOT, build, cpu_has_avx2, golden, run_lab
@@ -47,7 +47,7 @@ def rotation(axis, degrees):
     return np.eye(3) + math.sin(t) * k + (1 - math.cos(t)) * (k @ k)
 
 
-def transformed(scene: dict, matrix=np.eye(3), offset=(0, 0, 0), scale=1.0) -> dict:
+def transformed(scene: dict, matrix=np.eye(3), offset=(0, 0, 0), scale=1.0) -> dict:  # noqa: B008
     """The scene rotated by `matrix`, scaled by `scale` (intensity by its square) and moved by
     `offset`, computed in double: the image should not change."""
     s = json.loads(json.dumps(scene))
@@ -70,9 +70,14 @@ def transformed(scene: dict, matrix=np.eye(3), offset=(0, 0, 0), scale=1.0) -> d
 def box_quads(lo, hi, material):
     """The six faces of the box lo..hi as quads."""
     corner = lambda i, j, k: [(lo[0], hi[0])[i], (lo[1], hi[1])[j], (lo[2], hi[2])[k]]  # noqa: E731
-    faces = [[(0, 0, 0), (1, 0, 0), (1, 1, 0), (0, 1, 0)], [(0, 0, 1), (0, 1, 1), (1, 1, 1), (1, 0, 1)],
-             [(0, 0, 0), (0, 1, 0), (0, 1, 1), (0, 0, 1)], [(1, 0, 0), (1, 0, 1), (1, 1, 1), (1, 1, 0)],
-             [(0, 0, 0), (0, 0, 1), (1, 0, 1), (1, 0, 0)], [(0, 1, 0), (1, 1, 0), (1, 1, 1), (0, 1, 1)]]
+    faces = [
+        [(0, 0, 0), (1, 0, 0), (1, 1, 0), (0, 1, 0)],
+        [(0, 0, 1), (0, 1, 1), (1, 1, 1), (1, 0, 1)],
+        [(0, 0, 0), (0, 1, 0), (0, 1, 1), (0, 0, 1)],
+        [(1, 0, 0), (1, 0, 1), (1, 1, 1), (1, 1, 0)],
+        [(0, 0, 0), (0, 0, 1), (1, 0, 1), (1, 0, 0)],
+        [(0, 1, 0), (1, 1, 0), (1, 1, 1), (0, 1, 1)],
+    ]
     return [{"vertices": [corner(*c) for c in face], "material": material} for face in faces]
 
 
@@ -226,7 +231,10 @@ def same_image(moved, base):
     """The criterion of the scale check: same seed, so almost the same paths."""
     mean_err = abs(float(moved.mean()) / float(base.mean()) - 1.0)
     bad = float(((abs(moved - base) / (abs(base) + 1e-3 * base.mean())) > 0.05).mean())
-    return mean_err < 0.01 and bad < 0.02, f"mean off by {mean_err:.2%}, {bad:.2%} of values off by > 5%"
+    return (
+        mean_err < 0.01 and bad < 0.02,
+        f"mean off by {mean_err:.2%}, {bad:.2%} of values off by > 5%",
+    )
 
 
 def render_or_refusal(binary, scene, tmp_path, name, **settings):

@@ -34,7 +34,7 @@ TEST(DoubleBuild, ResolvesASphereFarFromTheOrigin) {
 // and the edge seen from the other side gets exactly the negated value.
 TEST(DoubleBuild, EdgeFunctionFallbackFindsTheSignOfADifferenceBelowRounding) {
     const double px = 1 + std::ldexp(1.0, -30), qy = 1 + std::ldexp(1.0, -30);  // 1 + 2^-29 + 2^-60
-    const double py = 1 + std::ldexp(1.0, -29), qx = 1;                         // 1 + 2^-29
+    const double py = 1 + std::ldexp(1.0, -29), qx = 1;  // 1 + 2^-29
     EXPECT_EQ(edge_function(px, py, qx, qy), 0.0);
     const double exact = edge_function_exact(px, py, qx, qy);
     EXPECT_EQ(exact, std::ldexp(1.0, -60));

@@ -39,8 +39,8 @@ def quick(tmp_path_factory):
 
 def cpu_model() -> str:
     out = subprocess.run(["lscpu"], capture_output=True, text=True).stdout
-    return next(l.split(":", 1)[1].strip() for l in out.splitlines()
-                if l.startswith("Model name"))
+    return next(ln.split(":", 1)[1].strip() for ln in out.splitlines()
+                if ln.startswith("Model name"))
 
 
 def test_quick_run_writes_csv_markdown_and_plots(quick):

@@ -43,13 +43,34 @@ def test_summary_lists_every_benchmark_shape_with_its_time():
 
 def test_speed_targets_are_tabulated_with_their_verdict():
     result = recorded()
-    result["bench"]["targets"] = [{"config": "reference", "bar": "at most 13 ms on an NVIDIA H200, the baseline",
-                                   "best_ms": 39.9, "met": False}]
-    result["bench_lab07"] = {"targets": [{"config": "SoA", "bar": "faster than AoS on an NVIDIA H200, the baseline",
-                                          "best_ms": 67.6, "met": None, "why_not": "not this GPU"}]}
+    result["bench"]["targets"] = [
+        {
+            "config": "reference",
+            "bar": "at most 13 ms on an NVIDIA H200, the baseline",
+            "best_ms": 39.9,
+            "met": False,
+        }
+    ]
+    result["bench_lab07"] = {
+        "targets": [
+            {
+                "config": "SoA",
+                "bar": "faster than AoS on an NVIDIA H200, the baseline",
+                "best_ms": 67.6,
+                "met": None,
+                "why_not": "not this GPU",
+            }
+        ]
+    }
     text = gpu_report.summary(result)
-    assert "| lab05-bench | reference | at most 13 ms on an NVIDIA H200, the baseline | 39.90 | **no** |" in text
-    assert "| lab07-bench | SoA | faster than AoS on an NVIDIA H200, the baseline | 67.60 | not judged (not this GPU) |" in text
+    assert (
+        "| lab05-bench | reference | at most 13 ms on an NVIDIA H200, the baseline"
+        " | 39.90 | **no** |" in text
+    )
+    assert (
+        "| lab07-bench | SoA | faster than AoS on an NVIDIA H200, the baseline"
+        " | 67.60 | not judged (not this GPU) |" in text
+    )
     assert "Speed targets" not in gpu_report.summary(recorded())
 
 
@@ -65,7 +86,10 @@ def test_missing_steps_are_said_not_crashed_on():
 def test_unreadable_json_is_one_line_and_status_2(tmp_path):
     bad = tmp_path / "gpu-check.json"
     bad.write_text("{not json")
-    p = subprocess.run([sys.executable, str(ROOT / "tools" / "gpu_report.py"), "--summary", str(bad)],
-                       capture_output=True, text=True)
+    p = subprocess.run(
+        [sys.executable, str(ROOT / "tools" / "gpu_report.py"), "--summary", str(bad)],
+        capture_output=True,
+        text=True,
+    )
     assert p.returncode == 2
     assert len(p.stderr.strip().splitlines()) == 1 and "cannot read" in p.stderr

@@ -148,8 +148,8 @@ def test_quick_mode_passes_without_matplotlib_and_replots(tmp_path):
         assert (out / png).read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
         assert f"]({png})" in report
     assert (out / "tradeoff.json").read_text() == record
-    drop = lambda text, *words: [l for l in text.splitlines()  # noqa: E731
-                                 if l and not any(w in l for w in words)]
+    drop = lambda text, *words: [ln for ln in text.splitlines()  # noqa: E731
+                                 if ln and not any(w in ln for w in words)]
     assert drop(report, *pngs) == drop(measured, "--replot")
 
 
@@ -286,7 +286,7 @@ def test_gpu_script_builds_for_the_gpu_present_and_runs_the_gpu_plan(tmp_path):
     p = run_gpu_script(out, fake_nvidia_smi(tmp_path / "h200-bin", True))
     assert p.returncode == 0, p.stdout + p.stderr
     assert "CUDA code for: -gencode arch=compute_90,code=sm_90 \n" in p.stdout, p.stdout
-    make_line = next(l for l in p.stdout.splitlines() if "would run: make" in l)
+    make_line = next(ln for ln in p.stdout.splitlines() if "would run: make" in ln)
     assert {"lab01-ref", "lab05-ref", "lab05-ref-double"} <= set(make_line.split()), make_line
     assert f"tools/tradeoff.py --plan gpu --no-plots --out {out}/tradeoff" in p.stdout
     assert {f.name for f in out.iterdir()} == {"log.txt", "machine.txt", "tradeoff"}

@@ -138,8 +138,7 @@ TEST(BounceStep, TracePathIsTheLoopAroundTheStep) {
     while (path.alive) {
         const Hit hit = closest_hit(v, path.ray);
         ShadowRay shadow;
-        if (bounce_step(v, hit, kRng, 3, path, shadow) &&
-            !occluded(v, shadow.ray, shadow.t_max))
+        if (bounce_step(v, hit, kRng, 3, path, shadow) && !occluded(v, shadow.ray, shadow.t_max))
             path.radiance += shadow.radiance;
     }
     const Vec3 l = trace_path(v, ray, kRng, 3);

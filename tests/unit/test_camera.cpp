@@ -51,12 +51,16 @@ TEST(Camera, VerticalFieldOfViewAndAspect) {
             const Camera cam = Camera::look_at({0, 0, 0}, {0, 0, -1}, {0, 1, 0}, vfov, w, h);
             const Vec3 fwd(0, 0, -1);
             // Top and bottom edge centres are vfov/2 away from the axis.
-            EXPECT_NEAR(angle_between(cam.ray_through(w / 2.0f, 0).direction, fwd), vfov / 2 * kDeg, 1e-5);
-            EXPECT_NEAR(angle_between(cam.ray_through(w / 2.0f, h).direction, fwd), vfov / 2 * kDeg, 1e-5);
+            EXPECT_NEAR(angle_between(cam.ray_through(w / 2.0f, 0).direction, fwd), vfov / 2 * kDeg,
+                        1e-5);
+            EXPECT_NEAR(angle_between(cam.ray_through(w / 2.0f, h).direction, fwd), vfov / 2 * kDeg,
+                        1e-5);
             // Left and right: the horizontal half-extent is aspect * tan(vfov/2).
             const double half_w = std::tan(vfov / 2 * kDeg) * w / h;
-            EXPECT_NEAR(angle_between(cam.ray_through(0, h / 2.0f).direction, fwd), std::atan(half_w), 1e-5);
-            EXPECT_NEAR(angle_between(cam.ray_through(w, h / 2.0f).direction, fwd), std::atan(half_w), 1e-5);
+            EXPECT_NEAR(angle_between(cam.ray_through(0, h / 2.0f).direction, fwd),
+                        std::atan(half_w), 1e-5);
+            EXPECT_NEAR(angle_between(cam.ray_through(w, h / 2.0f).direction, fwd),
+                        std::atan(half_w), 1e-5);
             // Corners, on the image plane at distance 1: (+-half_w, +-tan(vfov/2)).
             const Vec3 ul = cam.ray_through(0, 0).direction;
             EXPECT_NEAR(ul.x / -ul.z, -half_w, 1e-4 * (1 + half_w));
@@ -79,7 +83,8 @@ TEST(Camera, UpIsUpAndXGoesRight) {
     EXPECT_LT(cam.pixel_down.y, 0.0f);
     // The up hint need not be perpendicular to the view direction.
     const Camera tilted = Camera::look_at({0, 0, 0}, {0, -1, -1}, {0, 1, 0}, 60.0f, 100, 100);
-    const Vec3 top = tilted.ray_through(50, 0).direction, bottom = tilted.ray_through(50, 100).direction;
+    const Vec3 top = tilted.ray_through(50, 0).direction,
+               bottom = tilted.ray_through(50, 100).direction;
     EXPECT_GT(top.y, bottom.y);
     EXPECT_NEAR(dot(tilted.pixel_right, tilted.pixel_down), 0.0f, 1e-9f);
     EXPECT_NEAR(dot(tilted.pixel_right, Vec3(0, 1, 0)), 0.0f, 1e-9f);  // horizon stays level

@@ -57,9 +57,10 @@ TEST(Cli, Defaults) {
 }
 
 TEST(Cli, EveryFlag) {
-    const Options o = parse({"--scene", "a.json", "--width", "320", "--height", "200", "--spp", "7",
-                             "--bounces", "3", "--seed", "42", "--out", "x.ppm", "--pfm", "y.pfm",
-                             "--threads", "5", "--quiet", "--json"});
+    const Options o =
+        parse({"--scene", "a.json",    "--width",   "320",    "--height", "200",   "--spp",
+               "7",       "--bounces", "3",         "--seed", "42",       "--out", "x.ppm",
+               "--pfm",   "y.pfm",     "--threads", "5",      "--quiet",  "--json"});
     EXPECT_EQ(o.scene_path, "a.json");
     EXPECT_EQ(o.width.value_or(0), 320);
     EXPECT_EQ(o.height.value_or(0), 200);
@@ -158,8 +159,8 @@ TEST(Cli, SettingsForAppliesOverridesOnly) {
     EXPECT_EQ(over.spp, 8);
     EXPECT_EQ(over.bounces, 6);
     EXPECT_EQ(over.seed, 0u);  // an explicit 0 overrides too
-    const RenderSettings all = settings_for(
-        scene, parse({"--width", "1", "--height", "2", "--spp", "3", "--bounces", "4", "--seed", "5"}));
+    const RenderSettings all = settings_for(scene, parse({"--width", "1", "--height", "2", "--spp",
+                                                          "3", "--bounces", "4", "--seed", "5"}));
     EXPECT_EQ(all.width, 1);
     EXPECT_EQ(all.height, 2);
     EXPECT_EQ(all.spp, 3);

@@ -109,8 +109,8 @@ TEST(Image, EncodeSrgb8) {
 
 TEST(Image, PfmRoundTripIsExactIncludingNonSquareSizes) {
     TempDir dir;
-    for (auto [w, h] : {std::pair{1, 1}, std::pair{7, 3}, std::pair{3, 7}, std::pair{64, 1},
-                        std::pair{1, 33}}) {
+    for (auto [w, h] :
+         {std::pair{1, 1}, std::pair{7, 3}, std::pair{3, 7}, std::pair{64, 1}, std::pair{1, 33}}) {
         Image img = random_image(w, h, w * 100 + h);
         // Values a lossy path would change: tiny, huge, negative, non-finite.
         img.at(0, 0) = {1e-38f, 3.0e38f, -2.5f};
@@ -167,7 +167,8 @@ TEST(Image, PpmRoundTripWithinOneCode) {
     EXPECT_EQ(back.at(0, 0).y, 1.0f);
     EXPECT_EQ(back.at(0, 0).z, 0.0f);
     // The header is plain P6 with maxval 255.
-    EXPECT_EQ(ppm_bytes(img).substr(0, 14), "P6\n13 5\n255\n" + std::string(1, char(0)) + char(255));
+    EXPECT_EQ(ppm_bytes(img).substr(0, 14),
+              "P6\n13 5\n255\n" + std::string(1, char(0)) + char(255));
 }
 
 TEST(Image, AtomicFileUnwritablePathThrowsAtConstruction) {
@@ -263,7 +264,8 @@ TEST(Image, ReadGarbageThrows) {
         "hello world",
         "P6\n2 2\n255\n",                     // a PPM is not a PFM
         "Pf\n2 2\n-1.0\n",                    // greyscale PFM
-        "PF\n2 2\n1.0\n" "xxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxx",  // big endian
+        "PF\n2 2\n1.0\n"
+        "xxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxx",  // big endian
         "PF\n0 2\n-1.0\n",                    // zero size
         "PF\n-2 2\n-1.0\n",
         "PF\nabc 2\n-1.0\n",

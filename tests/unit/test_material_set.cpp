@@ -27,7 +27,8 @@ Scene diffuse_box() {
     const Vec3 a(-1, 0, -1), b(-1, 0, 1), c(1, 0, 1), d(1, 0, -1);
     const Vec3 up(0, 2, 0);
     s.triangles = {make_triangle(a, b, c, 0), make_triangle(a, c, d, 0),
-                   make_triangle(a + up, c + up, b + up, 0), make_triangle(a + up, d + up, c + up, 0)};
+                   make_triangle(a + up, c + up, b + up, 0),
+                   make_triangle(a + up, d + up, c + up, 0)};
     Sphere ball{};
     ball.center = {0.3f, 0.4f, 0.1f};
     ball.radius = 0.3f;

@@ -38,8 +38,8 @@ int self_hits(float half, Vec3 where, bool sphere, std::mt19937& gen, int surfac
         Surface s;
         s.is_sphere = sphere;
         s.sphere = {c0 - n * half, half, 0};
-        s.triangle = make_triangle(c0 - t * half - b * half, c0 + t * half - b * half,
-                                   c0 + b * half, 0);
+        s.triangle =
+            make_triangle(c0 - t * half - b * half, c0 + t * half - b * half, c0 + b * half, 0);
         const float extent = sphere ? sphere_extent(s.sphere) : s.triangle.extent;
         for (int i = 0; i < 100; ++i) {
             const Vec3 camera = c0 + n * (1.0f + 3.0f * u(gen)) + t * ((u(gen) - 0.5f) * 4.0f);
@@ -71,8 +71,8 @@ TEST(Offset, NoSelfHitLeavingHugeTriangles) {
     std::mt19937 gen(5);
     for (float half : {1e3f, 1e4f, 1e5f}) {
         for (const Vec3 where : {Vec3(0.0f), Vec3(1e4f, -7e3f, 3e3f)}) {
-            EXPECT_EQ(self_hits(half, where, false, gen), 0) << "half-size " << half
-                                                             << " at " << where.x;
+            EXPECT_EQ(self_hits(half, where, false, gen), 0)
+                << "half-size " << half << " at " << where.x;
         }
     }
 }
@@ -81,8 +81,8 @@ TEST(Offset, NoSelfHitLeavingHugeSpheres) {
     std::mt19937 gen(6);
     for (float radius : {1e3f, 1e4f, 1e5f}) {
         for (const Vec3 where : {Vec3(0.0f), Vec3(1e4f, -7e3f, 3e3f)}) {
-            EXPECT_EQ(self_hits(radius, where, true, gen), 0) << "radius " << radius << " at "
-                                                              << where.x;
+            EXPECT_EQ(self_hits(radius, where, true, gen), 0)
+                << "radius " << radius << " at " << where.x;
         }
     }
 }
@@ -99,7 +99,8 @@ TEST(Offset, TrianglesOfExtremeSizeKeepTheirNormal) {
         EXPECT_NEAR(length(tri.normal), 1.0f, 1e-6f) << "size " << size;
         EXPECT_GT(dot(tri.normal, normal), 0.9999f) << "size " << size;
         EXPECT_NEAR(tri.plane_offset, 0.0f, 1e-6f * size) << "size " << size;
-        EXPECT_EQ(tri.extent, max_float(max_component(abs(t * size)), max_component(abs(b * size))));
+        EXPECT_EQ(tri.extent,
+                  max_float(max_component(abs(t * size)), max_component(abs(b * size))));
     }
     // The largest sizes whose intersection test stays in float range (scene_limits.h) are hit.
     for (float size : {1e-9f, 1.0f, 1e9f}) {

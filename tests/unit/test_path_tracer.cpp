@@ -227,7 +227,8 @@ TEST(PathTracer, MirrorShowsWhatItFaces) {
     // A mirror floor under a diffuse sphere: the reflected ray lands on the sphere's bottom,
     // which the light (above the sphere) cannot see: black. Beside it: the sky.
     TestScene ts;
-    ts.floor(ts.material(MaterialType::Mirror, Vec3(1.0f)), 1e4f);  // wide: nothing escapes sideways
+    ts.floor(ts.material(MaterialType::Mirror, Vec3(1.0f)),
+             1e4f);  // wide: nothing escapes sideways
     ts.sphere({0, 2, 0}, 1.0f, ts.material(MaterialType::Diffuse, Vec3(0.5f)));
     ts.light({0, 5, 0}, Vec3(10.0f));
     ts.scene.background = Vec3(0.25f);
@@ -402,16 +403,20 @@ TEST(PathTracer, ClosedBoxDoesNotLeak) {
             const int mirror = ts.material(MaterialType::Mirror, Vec3(1.0f));
             Vec3 corner[8];
             for (int i = 0; i < 8; ++i)
-                corner[i] = (Vec3(i & 1 ? 1.0f : -1.0f, i & 2 ? 1.0f : -1.0f, i & 4 ? 1.0f : -1.0f) +
-                             offset) * scale;
+                corner[i] =
+                    (Vec3(i & 1 ? 1.0f : -1.0f, i & 2 ? 1.0f : -1.0f, i & 4 ? 1.0f : -1.0f) +
+                     offset) *
+                    scale;
             // Each face as a quad (v0 v1 v2 v3) split along v0-v2, facing inwards.
             const int faces[6][4] = {{0, 1, 3, 2}, {4, 6, 7, 5}, {0, 4, 5, 1},
                                      {2, 3, 7, 6}, {0, 2, 6, 4}, {1, 5, 7, 3}};
             for (int f = 0; f < 6; ++f) {
                 const int m = f == 1 ? mirror : wall;
                 const int* q = faces[f];
-                ts.scene.triangles.push_back(make_triangle(corner[q[0]], corner[q[1]], corner[q[2]], m));
-                ts.scene.triangles.push_back(make_triangle(corner[q[0]], corner[q[2]], corner[q[3]], m));
+                ts.scene.triangles.push_back(
+                    make_triangle(corner[q[0]], corner[q[1]], corner[q[2]], m));
+                ts.scene.triangles.push_back(
+                    make_triangle(corner[q[0]], corner[q[2]], corner[q[3]], m));
             }
             ts.sphere((Vec3(0.3f, -0.4f, 0.2f) + offset) * scale, 0.3f * scale, glass);
             ts.scene.background = Vec3(1.0f);
@@ -422,7 +427,9 @@ TEST(PathTracer, ClosedBoxDoesNotLeak) {
                 const SampleStream rng(0, 0, s);
                 // A point on one of the 12 edges (from corner i0 along one axis), and a corner.
                 const int e = s % 12, axis = e / 4, a = e & 1, b = (e >> 1) & 1;
-                const int i0 = axis == 0 ? (a << 1) | (b << 2) : axis == 1 ? a | (b << 2) : a | (b << 1);
+                const int i0 = axis == 0   ? (a << 1) | (b << 2)
+                               : axis == 1 ? a | (b << 2)
+                                           : a | (b << 1);
                 const Vec3 p0 = corner[i0], p1 = corner[i0 | (1 << axis)];
                 for (const Vec3 target : {p0 + (p1 - p0) * rng.at(100), corner[s % 8]}) {
                     if (!closest_hit(v, {centre, normalize(target - centre)}).found()) ++misses;

@@ -217,7 +217,8 @@ TEST(Rng, PairsAreUniformInTheSquare) {
     std::vector<long> count(100, 0);
     for (int i = 0; i < kN; ++i) {
         const SampleStream s(0, i, 0);
-        ++count[static_cast<int>(s.at(kDimPixelX) * 10) * 10 + static_cast<int>(s.at(kDimPixelY) * 10)];
+        ++count[static_cast<int>(s.at(kDimPixelX) * 10) * 10 +
+                static_cast<int>(s.at(kDimPixelY) * 10)];
     }
     double chi2 = 0;
     for (long c : count) chi2 += (c - 1000.0) * (c - 1000.0) / 1000.0;

@@ -9,9 +9,7 @@
 
 namespace {
 
-Scene cornell() {
-    return load_scene(std::string(RT_SOURCE_DIR) + "/common/scenes/cornell.json");
-}
+Scene cornell() { return load_scene(std::string(RT_SOURCE_DIR) + "/common/scenes/cornell.json"); }
 
 }  // namespace
 
@@ -19,7 +17,8 @@ TEST(SceneCentring, MovesEverythingByTheBoundingBoxCentre) {
     Scene far = cornell();
     const Vec3 shift(1.0e4f, -7.0e3f, 3.0e3f);
     for (Sphere& s : far.spheres) s.center += shift;
-    for (Triangle& t : far.triangles) t = make_triangle(t.v0 + shift, t.v1 + shift, t.v2 + shift, t.material);
+    for (Triangle& t : far.triangles)
+        t = make_triangle(t.v0 + shift, t.v1 + shift, t.v2 + shift, t.material);
     far.camera.position += shift;
     far.camera.look_at += shift;
     far.light.position += shift;

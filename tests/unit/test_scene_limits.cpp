@@ -61,7 +61,8 @@ TEST(SceneLimits, AcceptsTheRangeTheRendererHandles) {
 }
 
 TEST(SceneLimits, RefusesCoordinatesPast1e9) {
-    expect_refused(scene(sphere("[0, 2e9, 0]", "1")), {"/spheres/0/center/1", "1e9", "scale the scene down"});
+    expect_refused(scene(sphere("[0, 2e9, 0]", "1")),
+                   {"/spheres/0/center/1", "1e9", "scale the scene down"});
     expect_refused(scene(triangle("[0, 0, 0]", "[1, 0, 0]", "[0, 0, -3e9]")),
                    {"/triangles/0/vertices/2/2", "1e9"});
     expect_refused(scene(sphere("[0, 0, 0]", "1"), "[0, 0, 1e10]"), {"/camera/position/2", "1e9"});
@@ -72,12 +73,14 @@ TEST(SceneLimits, RefusesCoordinatesPast1e9) {
 }
 
 TEST(SceneLimits, RefusesPrimitivesTooSmallForFloat) {
-    expect_refused(scene(sphere("[0, 0, 0]", "1e-10")), {"/spheres/0/radius", "below 1e-9", "scale the scene up"});
+    expect_refused(scene(sphere("[0, 0, 0]", "1e-10")),
+                   {"/spheres/0/radius", "below 1e-9", "scale the scene up"});
     expect_refused(scene(triangle("[0, 0, 0]", "[1e-12, 0, 0]", "[0, 1e-12, 0]")),
                    {"/triangles/0/vertices", "below 1e-9"});
-    expect_refused(scene("  \"quads\": [ { \"vertices\": [[0, 0, 0], [1e-10, 0, 0], [1e-10, 1e-10, 0], "
-                         "[0, 1e-10, 0]], \"material\": \"m\" } ]"),
-                   {"/quads/0/vertices", "below 1e-9"});
+    expect_refused(
+        scene("  \"quads\": [ { \"vertices\": [[0, 0, 0], [1e-10, 0, 0], [1e-10, 1e-10, 0], "
+              "[0, 1e-10, 0]], \"material\": \"m\" } ]"),
+        {"/quads/0/vertices", "below 1e-9"});
 }
 
 // Float spacing near 1e5 is ~0.008: a sphere of radius 0.2 there is a few ray offsets across.

@@ -303,9 +303,10 @@ TEST(SceneLoaderErrors, BadLiteral) {
 }
 
 TEST(SceneLoaderErrors, UnterminatedString) {
-    expect_error("{\n  \"camera\": { \"position\": [0, 0, 5], \"look_at\": [0, 0, 0] },\n"
-                 "  \"materials: {}@\n}\n",
-                 {"invalid JSON"});
+    expect_error(
+        "{\n  \"camera\": { \"position\": [0, 0, 5], \"look_at\": [0, 0, 0] },\n"
+        "  \"materials: {}@\n}\n",
+        {"invalid JSON"});
 }
 
 TEST(SceneLoaderErrors, EmptyText) {
@@ -500,8 +501,9 @@ TEST(SceneLoaderErrors, NegativeRadius) {
 TEST(SceneLoaderErrors, ZeroRadius) {
     expect_error(scene_with("\"center\": [0, 0, 0], \"radius\": @0, \"material\": \"white\""),
                  {"expected a radius > 0"});
-    expect_error(scene_with("\"center\": [0, 0, 0], \"radius\":\n        @0.0, \"material\": \"white\""),
-                 {"expected a radius > 0"});
+    expect_error(
+        scene_with("\"center\": [0, 0, 0], \"radius\":\n        @0.0, \"material\": \"white\""),
+        {"expected a radius > 0"});
 }
 
 TEST(SceneLoaderErrors, AlbedoAboveOne) {
@@ -536,9 +538,10 @@ TEST(SceneLoaderErrors, NegativeAlbedoAndIntensity) {
         "  }\n"
         "}\n",
         {"expected components >= 0"});
-    expect_error(scene_with(kGoodSphere,
-                            "  \"light\": { \"position\": [0, 9, 0], \"intensity\": @[1, 1, -1] },\n"),
-                 {"expected components >= 0"});
+    expect_error(
+        scene_with(kGoodSphere,
+                   "  \"light\": { \"position\": [0, 9, 0], \"intensity\": @[1, 1, -1] },\n"),
+        {"expected components >= 0"});
 }
 
 TEST(SceneLoaderErrors, IorOutOfRange) {
@@ -615,7 +618,8 @@ TEST(SceneLoaderErrors, HugeIntegerReportedAsWritten) {
 
 TEST(SceneLoaderErrors, RenderLimitsAreInclusive) {
     const Scene s = parse_scene(
-        scene_with(kGoodSphere, "  \"render\": { \"width\": 16384, \"height\": 1, \"bounces\": 64 },\n"),
+        scene_with(kGoodSphere,
+                   "  \"render\": { \"width\": 16384, \"height\": 1, \"bounces\": 64 },\n"),
         kName);
     EXPECT_EQ(s.render.width, 16384);
     EXPECT_EQ(s.render.height, 1);
@@ -647,11 +651,10 @@ TEST(SceneLoaderErrors, MaterialNameWithSlashIsLocated) {
 // Seeds have one range, in scene files and on the command line alike (0 .. 2^53 - 1).
 TEST(SceneLoader, SeedRangeIsTheCommandLines) {
     const std::string top = std::to_string(kMaxSeed);
-    const Scene s = parse_scene(scene_with(kGoodSphere, "  \"render\": { \"seed\": " + top + " },\n"),
-                                kName);
+    const Scene s =
+        parse_scene(scene_with(kGoodSphere, "  \"render\": { \"seed\": " + top + " },\n"), kName);
     EXPECT_EQ(s.render.seed, static_cast<uint64_t>(kMaxSeed));
-    const std::string message =
-        error_of(scene_with(kGoodSphere, "  \"render\": { \"seed\": " + std::to_string(kMaxSeed + 1) +
-                                             " },\n"));
+    const std::string message = error_of(scene_with(
+        kGoodSphere, "  \"render\": { \"seed\": " + std::to_string(kMaxSeed + 1) + " },\n"));
     EXPECT_NE(message.find("expected an integer in 0.." + top), std::string::npos) << message;
 }

@@ -136,8 +136,8 @@ TEST(SampleLight, ALightAtTheSurfacePointGivesNoSample) {
     const Vec3 p(0.25f, 0.0f, -0.5f);
     scene.light.position = p + n * 1e-6f;
     ShadowRay shadow;
-    ASSERT_TRUE(sample_light(scene.view(), p, offset_ray_origin(p, n, 1.0f, 1.0f), n,
-                             Vec3(0.5f), shadow));
+    ASSERT_TRUE(
+        sample_light(scene.view(), p, offset_ray_origin(p, n, 1.0f, 1.0f), n, Vec3(0.5f), shadow));
     EXPECT_TRUE(std::isfinite(shadow.radiance.x) && shadow.radiance.x > 0.0f);
 }
 
@@ -150,12 +150,13 @@ TEST(WrittenCoordinates, AGenericOffsetCentresToTheUnmovedScene) {
             std::snprintf(text, sizeof text, "[%.17g, %.17g, %.17g]", x + dx, y + dy, z + dz);
             return std::string(text);
         };
-        return "{\"camera\": {\"position\": " + p(0, 1, 0) + ", \"look_at\": " +
-               p(0, 1 - 0.8e-3, -0.6e-3) + "}, \"light\": {\"position\": " + p(0.3, 1e-2, -0.7) +
+        return "{\"camera\": {\"position\": " + p(0, 1, 0) +
+               ", \"look_at\": " + p(0, 1 - 0.8e-3, -0.6e-3) +
+               "}, \"light\": {\"position\": " + p(0.3, 1e-2, -0.7) +
                ", \"intensity\": [1, 1, 1]}, \"materials\": {\"w\": {\"type\": \"diffuse\", "
                "\"albedo\": [0.5, 0.5, 0.5]}}, \"quads\": [{\"vertices\": [" +
-               p(-10, 0, -10) + ", " + p(-10, 0, 10) + ", " + p(10, 0, 10) + ", " +
-               p(10, 0, -10) + "], \"material\": \"w\"}]}";
+               p(-10, 0, -10) + ", " + p(-10, 0, 10) + ", " + p(10, 0, 10) + ", " + p(10, 0, -10) +
+               "], \"material\": \"w\"}]}";
     };
     const Scene base = centre_scene(parse_scene(scene_text(0, 0, 0), "base.json"));
     const Scene moved =

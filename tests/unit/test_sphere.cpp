@@ -217,7 +217,8 @@ TEST(Sphere, NoSelfIntersectionLeavingOutward) {
                 do {
                     d = random_unit(gen);
                 } while (dot(d, n) < 0.02f);
-                const Ray ray{offset_ray_origin(p, n, u01(gen) * 10.0f * scale, sphere_extent(s)), d};
+                const Ray ray{offset_ray_origin(p, n, u01(gen) * 10.0f * scale, sphere_extent(s)),
+                              d};
                 if (intersect_sphere(ray, s, FLT_MAX) < FLT_MAX) ++hits;
             }
             EXPECT_EQ(hits, 0) << "scale " << scale << " centre " << centre_unit.x;

@@ -47,7 +47,8 @@ struct Quad {
 };
 Quad make_quad(float scale, Vec3 offset, Vec3 tilt) {
     Quad q;
-    const Vec3 corners[4] = {{0, 0, 0}, {1, 0.1f, 0}, {1.1f, 1, 0}, {-0.1f, 0.9f, 0}};  // planar, convex
+    const Vec3 corners[4] = {
+        {0, 0, 0}, {1, 0.1f, 0}, {1.1f, 1, 0}, {-0.1f, 0.9f, 0}};  // planar, convex
     for (int i = 0; i < 4; ++i) {
         const Vec3 c = corners[i];
         q.p[i] = (Vec3(c.x, c.y, c.z + tilt.x * c.x + tilt.y * c.y) + offset) * scale;
@@ -168,7 +169,8 @@ TEST(Triangle, ParallelRaysInThePlaneMiss) {
 TEST(Triangle, NearlyParallelRaysNeverGiveNaN) {
     std::mt19937 gen(9);
     std::uniform_real_distribution<float> u(-1.0f, 1.0f);
-    const Triangle tri = make_triangle({0.1f, -0.3f, 0.2f}, {1.2f, 0.4f, -0.5f}, {-0.4f, 1.1f, 0.3f}, 0);
+    const Triangle tri =
+        make_triangle({0.1f, -0.3f, 0.2f}, {1.2f, 0.4f, -0.5f}, {-0.4f, 1.1f, 0.3f}, 0);
     Vec3 e1, e2;
     orthonormal_basis(tri.normal, e1, e2);
     for (int i = 0; i < 20000; ++i) {
@@ -205,15 +207,16 @@ TEST(Triangle, DegenerateTrianglesHaveZeroNormalAndNeverHit) {
     std::mt19937 gen(4);
     std::uniform_real_distribution<float> u(-2.0f, 2.0f);
     const Triangle degenerate[] = {
-        make_triangle({0, 0, 0}, {0, 0, 0}, {1, 1, 0}, 0),        // repeated vertex
-        make_triangle({1, 2, 3}, {1, 2, 3}, {1, 2, 3}, 0),        // a point
-        make_triangle({0, 0, 0}, {1, 1, 1}, {2, 2, 2}, 0),        // collinear
-        make_triangle({0.125f, 0.25f, 0.3f}, {0.875f, 0.75f, 0.3f}, {0.5f, 0.5f, 0.3f}, 0),  // collinear
+        make_triangle({0, 0, 0}, {0, 0, 0}, {1, 1, 0}, 0),  // repeated vertex
+        make_triangle({1, 2, 3}, {1, 2, 3}, {1, 2, 3}, 0),  // a point
+        make_triangle({0, 0, 0}, {1, 1, 1}, {2, 2, 2}, 0),  // collinear
+        make_triangle({0.125f, 0.25f, 0.3f}, {0.875f, 0.75f, 0.3f}, {0.5f, 0.5f, 0.3f},
+                      0),  // collinear
         make_triangle({-1, 0.5f, 0}, {3, 0.5f, 0}, {1, 0.5f, 0}, 0),  // collinear, middle last
     };
     for (const Triangle& tri : degenerate) {
-        EXPECT_TRUE(is_black(tri.normal)) << tri.v2.x << " " << tri.normal.x << " "
-                                          << tri.normal.y << " " << tri.normal.z;
+        EXPECT_TRUE(is_black(tri.normal))
+            << tri.v2.x << " " << tri.normal.x << " " << tri.normal.y << " " << tri.normal.z;
         int hits = 0;
         for (int i = 0; i < 20000; ++i) {
             // Rays aimed at points on the segment (where a hit would be reported, if at all).
@@ -242,7 +245,8 @@ TEST(Triangle, RandomCollinearTrianglesNeverHit) {
     for (int k = 0; k < 400; ++k) {
         const Vec3 a(grid(gen) / 8.0f, grid(gen) / 8.0f, grid(gen) / 8.0f);
         const Vec3 e(grid(gen) / 8.0f, grid(gen) / 8.0f, grid(gen) / 8.0f);
-        const Triangle tri = make_triangle(a, a + e * float(step(gen)), a + e * float(step(gen)), 0);
+        const Triangle tri =
+            make_triangle(a, a + e * float(step(gen)), a + e * float(step(gen)), 0);
         ASSERT_TRUE(is_black(tri.normal));
         ++triangles;
         for (int i = 0; i < 100; ++i) {
@@ -269,9 +273,12 @@ TEST(Triangle, WatertightSharedDiagonal) {
         Vec3 tilt;
     };
     const Case cases[] = {
-        {1.0f, {0, 0, 0}, {0, 0, 0}},        {1.0f, {0.3f, -0.7f, 2.0f}, {0.3f, -0.5f, 0}},
-        {1e-4f, {0.3f, -0.7f, 2.0f}, {0.3f, -0.5f, 0}}, {1e5f, {0.3f, -0.7f, 2.0f}, {0.3f, -0.5f, 0}},
-        {1e-4f, {100, 0, 0}, {1, 1, 0}},     {1e5f, {0, 0, -30}, {-2, 0.5f, 0}},
+        {1.0f, {0, 0, 0}, {0, 0, 0}},
+        {1.0f, {0.3f, -0.7f, 2.0f}, {0.3f, -0.5f, 0}},
+        {1e-4f, {0.3f, -0.7f, 2.0f}, {0.3f, -0.5f, 0}},
+        {1e5f, {0.3f, -0.7f, 2.0f}, {0.3f, -0.5f, 0}},
+        {1e-4f, {100, 0, 0}, {1, 1, 0}},
+        {1e5f, {0, 0, -30}, {-2, 0.5f, 0}},
     };
     long total = 0;
     for (const Case& c : cases) {
@@ -323,7 +330,8 @@ TEST(Triangle, WatertightFanAroundVertex) {
                 rim.push_back(centre + Vec3(std::cos(phi), std::sin(phi), lift) * scale);
             }
             std::vector<Triangle> fan;
-            for (int i = 0; i < k; ++i) fan.push_back(make_triangle(centre, rim[i], rim[(i + 1) % k], 0));
+            for (int i = 0; i < k; ++i)
+                fan.push_back(make_triangle(centre, rim[i], rim[(i + 1) % k], 0));
             int leaks = 0;
             for (int i = 0; i < 20000; ++i) {
                 // Origins above, within 35 degrees of the axis, so that the (possibly bent)

@@ -200,8 +200,8 @@ RT_HD inline Vec3 render_pixel(const SceneView& scene, const Geometry& geometry,
     // (SampleStream(settings.seed, pixel, s), dimensions kDimPixelX/kDimPixelY).
     // Until then: one path through the pixel's corner.
     const SampleStream rng(settings.seed, pixel, 0);
-    sum.add(trace_path<Materials>(scene, geometry, camera.ray_through(x, y), rng,
-                                  settings.bounces));
+    sum.add(
+        trace_path<Materials>(scene, geometry, camera.ray_through(x, y), rng, settings.bounces));
     return sum.mean(1);
 }
 

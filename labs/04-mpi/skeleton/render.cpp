@@ -118,8 +118,8 @@ void render_static(Distribution distribution, const PixelRenderer& pixel, const 
 // Dynamic, rank 0: the master. It hands rows to the workers as they finish earlier ones and
 // renders rows itself in between, collecting results after each unit of its own. With one
 // rank it simply renders everything.
-void dynamic_master(const PixelRenderer& pixel, const Team& team, Image& image,
-                    Progress& progress, RankReport& report) {
+void dynamic_master(const PixelRenderer& pixel, const Team& team, Image& image, Progress& progress,
+                    RankReport& report) {
     // TODO(lab04): the dynamic master-worker distribution (see the handout). Until then:
     // contiguous blocks.
     render_static(Distribution::block, pixel, team, image, progress, report);
@@ -127,8 +127,8 @@ void dynamic_master(const PixelRenderer& pixel, const Team& team, Image& image,
 
 // Dynamic, ranks 1...: a worker. It renders the rows it is given and sends them back, until
 // told to stop.
-void dynamic_worker(const PixelRenderer& pixel, const Team& team, Image& image,
-                    Progress& progress, RankReport& report) {
+void dynamic_worker(const PixelRenderer& pixel, const Team& team, Image& image, Progress& progress,
+                    RankReport& report) {
     // TODO(lab04): the dynamic master-worker distribution (see the handout). Until then:
     // contiguous blocks.
     render_static(Distribution::block, pixel, team, image, progress, report);

@@ -32,8 +32,8 @@ struct CameraSample {
 __device__ inline CameraSample camera_sample(const KernelArgs& args, int x, int y, uint64_t pixel,
                                              int s) {
     const SampleStream rng(args.settings.seed, pixel, static_cast<uint64_t>(s));
-    return {rng, args.camera.ray_through(x + real(rng.at(kDimPixelX)),
-                                         y + real(rng.at(kDimPixelY)))};
+    return {rng,
+            args.camera.ray_through(x + real(rng.at(kDimPixelX)), y + real(rng.at(kDimPixelY)))};
 }
 
 // One thread's samples of pixel (x, y): s = first, first + stride, ... below spp, one after

@@ -39,8 +39,8 @@ constexpr int kMaxRegisters = 72;
 // material kinds (material_set.h): a scene without mirrors or glass gets a kernel without
 // their code.
 template <SceneMemory kMemory, class Materials>
-constexpr auto kernel_for = render_kernel<kThreadsPerPixel, kMemory, kBlockThreads, kRegenerate,
-                                          kMaxRegisters, Materials>;
+constexpr auto kernel_for =
+    render_kernel<kThreadsPerPixel, kMemory, kBlockThreads, kRegenerate, kMaxRegisters, Materials>;
 
 // The most bytes of device memory the image's pixels may take at once; more rows than that
 // are rendered in several bands. RT_LAB05_BAND_BYTES lowers it (the tests force bands so).
@@ -95,16 +95,15 @@ static double render_band(const KernelArgs& args, size_t shared_bytes) {
 }
 
 template <SceneMemory kMemory, class Materials>
-static double render_bands(KernelArgs args, size_t shared_bytes, Image& image,
-                           Progress& progress) {
+static double render_bands(KernelArgs args, size_t shared_bytes, Image& image, Progress& progress) {
     prepare_kernel<kMemory, Materials>(shared_bytes);
     const int width = args.settings.width, height = args.settings.height;
     const size_t row_bytes = static_cast<size_t>(width) * sizeof(Vec3);
     const size_t budget = band_budget_bytes();
     if (budget < row_bytes) {
         throw GpuError("GPU: not enough free device memory for even one row of the image (" +
-                       std::to_string(row_bytes) + " bytes needed, " +
-                       std::to_string(budget) + " available)");
+                       std::to_string(row_bytes) + " bytes needed, " + std::to_string(budget) +
+                       " available)");
     }
     const int band_rows = static_cast<int>(std::min<size_t>(height, budget / row_bytes));
     DeviceArray<Vec3> band(static_cast<size_t>(band_rows) * width, "allocating the image band");
@@ -148,11 +147,14 @@ RenderStats render(const RenderJob& job, Image& image) {
     double seconds = 0;
     if (memory == SceneMemory::Shared) {
         const size_t bytes = layout.bytes();
-        seconds = specular ? render_bands<SceneMemory::Shared, AnyMaterial>(args, bytes, image, job.progress)
-                           : render_bands<SceneMemory::Shared, DiffuseOnly>(args, bytes, image, job.progress);
+        seconds =
+            specular
+                ? render_bands<SceneMemory::Shared, AnyMaterial>(args, bytes, image, job.progress)
+                : render_bands<SceneMemory::Shared, DiffuseOnly>(args, bytes, image, job.progress);
     } else {
-        seconds = specular ? render_bands<SceneMemory::Global, AnyMaterial>(args, 0, image, job.progress)
-                           : render_bands<SceneMemory::Global, DiffuseOnly>(args, 0, image, job.progress);
+        seconds =
+            specular ? render_bands<SceneMemory::Global, AnyMaterial>(args, 0, image, job.progress)
+                     : render_bands<SceneMemory::Global, DiffuseOnly>(args, 0, image, job.progress);
     }
     return {seconds, describe(prop), kKernelTimeOnly};
 }

@@ -62,7 +62,9 @@ __device__ inline int reserve_per_warp(int* size, bool wants) {
 }
 
 // And with one atomic add per thread (the compiler may still combine a warp's additions).
-__device__ inline int reserve_per_thread(int* size, bool wants) { return wants ? atomicAdd(size, 1) : -1; }
+__device__ inline int reserve_per_thread(int* size, bool wants) {
+    return wants ? atomicAdd(size, 1) : -1;
+}
 
 // Pushes `item` (a QueuedPath or a QueuedShadowRay) for each thread that `wants` to; every
 // thread of the block calls it together (see reserve).
