@@ -53,7 +53,7 @@ PACKETS = [
     ("16 compacted", "lab02-bench", {"RT_SIMD_LANES": "16", "RT_SIMD_COMPACT": "1"},
      "AVX-512, survivors repacked"),
 ]
-# The targets for lab02-ref (the widest compacted packets), per scene: AVX-512, AVX2.
+# The handout's targets for lab02-ref (the widest compacted packets), per scene: AVX-512, AVX2.
 TARGETS = {"cornell": (3.5, 2.4), "showcase": (3.2, 2.2)}
 # --packets: each scene at the size its target is stated for.
 PACKET_SCENES = [("cornell", 400, 64, 4), ("showcase", 300, 64, 8)]

@@ -1,5 +1,5 @@
 """tools/gpu_report.py's summary, on the CPU: the tables it makes of a recorded gpu-check.json
-(the H200 call of reference/gpu/h200-2026-12-02-labs05-07), and its one-line error."""
+(the H200 run recorded in reference/gpu/h200-2026-12-02-labs05-07), and its one-line error."""
 import copy
 import json
 import pathlib
