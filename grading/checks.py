@@ -622,26 +622,30 @@ def rows_differing(a: np.ndarray, b: np.ndarray) -> list[int]:
 
 
 def why_different(binary, settings: dict, runs: dict, images: dict, differing: list[str]) -> str:
-    """Renders twice more the way that differed with the most threads or ranks (the last one
-    differing) and tells the two causes apart: images that change from run to run at the
-    same count (a data race, a generator shared by threads), or the same image every time
-    that depends on the count (random numbers drawn by thread, rank or chunk instead of by
-    pixel: how the work is split)."""
-    label = differing[-1]
-    first = images[label]
-    again = [run_lab(binary, **settings, **runs[label]).image for _ in range(2)]
-    rows = sorted({y for image in again for y in rows_differing(first, image)})
-    if rows:
-        return (f"nondeterministic: a data race or shared generator: two renders at {label} "
-                f"differ from each other in {len(rows)} of {first.shape[0]} rows "
-                f"(rows {row_ranges(rows)}); each pixel's random numbers must depend on the "
-                f"pixel alone, and each pixel be written by one thread")
+    """Tells the two causes of other bits apart by rendering twice more each way that
+    differed, the most threads or ranks first: renders that change from run to run at one
+    count (a data race, a generator shared by threads), or the same image every time that
+    depends on the count (random numbers drawn by thread, rank or chunk instead of by pixel:
+    how the work is split). A race need not show in every run, so every differing count is
+    tried before an image is called deterministic."""
+    for label in reversed(differing):
+        first = images[label]
+        again = [run_lab(binary, **settings, **runs[label]).image for _ in range(2)]
+        rows = sorted({y for image in again for y in rows_differing(first, image)})
+        if rows:
+            return (f"nondeterministic: a data race or shared generator: renders at {label} "
+                    f"differ from each other in {len(rows)} of {first.shape[0]} rows (rows "
+                    f"{row_ranges(rows)}); each pixel's random numbers must depend on the "
+                    f"pixel alone, and each pixel be written by one thread")
     same = [label for label in runs if label not in differing]
-    return (f"deterministic but different: work split: each count gives the same image run "
-            f"after run, but {', '.join(differing)} give other bits than lab 01"
-            + (f" ({', '.join(same)} match)" if same else "")
-            + ": the random numbers depend on how the rows are split (drawn by thread, rank "
-              "or chunk, not by pixel?)")
+    if not same:  # even the first way (1 thread, 1 rank) is not lab 01's image
+        return (f"deterministic but different from lab 01 even at {differing[0]}: the same "
+                f"image run after run at each count, but not lab 01's: are the random numbers "
+                f"drawn by pixel and sample as lab 01 draws them?")
+    return (f"deterministic but different: work split: the same image run after run at each "
+            f"count, but {', '.join(differing)} give other bits than lab 01 ({', '.join(same)} "
+            f"match): the random numbers depend on how the rows are split (drawn by thread, "
+            f"rank or chunk, not by pixel?)")
 
 
 def mpirun(ranks: int) -> list[str]:

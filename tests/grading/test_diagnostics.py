@@ -113,3 +113,35 @@ def test_lab03_bit_check_runs_while_the_speedup_fails(tmp_path):
     results = grade("03", build("lab03-shared-rng-race")[0], tmp_path, trusted=True)
     bitwise = output_of(results, "bitwise")
     assert "nondeterministic" in bitwise and "rows " in bitwise, describe(results)
+
+
+def test_make_grade_shows_progress_and_this_run_only(lab01_ref, tmp_path):
+    """Each check is printed as it finishes, before the table; an earlier grade's images are
+    gone from the report folder, and nothing else there is touched."""
+    import subprocess
+    import sys
+    maps = tmp_path / "maps"
+    maps.mkdir()
+    (maps / "stale-yours.png").write_bytes(b"old")
+    (maps / "stale-diff.png").write_bytes(b"old")
+    (maps / "notes.txt").write_text("mine")
+    p = subprocess.run([sys.executable, "-m", "grading.grade", "01", "--binary", str(lab01_ref),
+                        "--trusted", "--results", str(tmp_path / "r.json"),
+                        "--heatmaps", str(maps)], cwd=ROOT, capture_output=True, text=True,
+                       timeout=300)
+    assert p.returncode == 0, p.stderr
+    lines = p.stdout.splitlines()
+    progress = [i for i, line in enumerate(lines) if line.startswith("  analytic sphere interior")]
+    table = [i for i, line in enumerate(lines) if line.startswith("total")]
+    assert progress and table and progress[0] < table[0], p.stdout
+    assert "PASS 15/15" in lines[progress[0]], p.stdout
+    assert not (maps / "stale-yours.png").exists() and not (maps / "stale-diff.png").exists()
+    assert (maps / "notes.txt").read_text() == "mine"
+    assert (maps / "cornell-yours.png").exists()
+
+
+def test_build_warnings_are_kept():
+    from grading.grade import build_warnings
+    text = "render.cpp:12:9: warning: unused variable 'x' [-Wunused-variable]\n   12 | int x;\n"
+    assert "unused variable" in build_warnings(text)
+    assert build_warnings("") == "" and build_warnings("g++ -O2 -c render.cpp\n") == ""
