@@ -140,24 +140,40 @@ def black_pixels(image: np.ndarray) -> str:
     black = int((image == 0).all(axis=2).sum())
     if not black:
         return ""
+    why = ("pixels never written, or copied back before the kernel had written them (a "
+           "missing synchronisation?)" if symptoms.gpu_lab() else
+           "pixels never written (a loop that skips some?)")
     return (f"; {black} of {image.shape[0] * image.shape[1]} pixels are exactly black in a "
-            f"scene lit everywhere: pixels never written, or copied back before the kernel "
-            f"had written them (a missing synchronisation?)")
+            f"scene lit everywhere: {why}")
 
 
 @image_checked("analytic sphere interior")
 def check_sphere_interior(binary, bounces=(1, 2, 4)) -> CheckResult:
-    """Closed form: camera and light inside a diffuse sphere (grading/scenes.py)."""
+    """Closed form: camera and light inside a diffuse sphere (grading/scenes.py). The
+    estimator has zero variance there, so a wrong render is identified, not guessed: the
+    closed form of one bounce more or fewer, a factor of pi, a gamma curve
+    (symptoms.identified)."""
     worst, symptom = 0.0, ""
     interior = drawn_interior()
     images = render_interior(binary, {b: dict(width=16, height=16, spp=4, bounces=b,
                                               seed=draws.seed("interior"))
                                       for b in bounces}, interior)
+    causes: dict[str, list[int]] = {}  # what each failing render is identified as
     for b, image in images.items():
         want = scenes.sphere_interior_radiance(**interior, bounces=b)
-        worst = worst_of(worst, np.max(np.abs(image.astype(np.float64) / want - 1.0)))
+        error = np.max(np.abs(image.astype(np.float64) / want - 1.0))
+        worst = worst_of(worst, error)
         symptom = symptom or black_pixels(image)
+        if not (error <= 3e-4):
+            cause = symptoms.identified(
+                image, lambda k: scenes.sphere_interior_radiance(**interior, bounces=k), b)
+            causes.setdefault(cause, []).append(b)
     ok = worst <= 3e-4
+    if len(causes) == 1 and "" not in causes:
+        # One cause explains every failing render: identified, it outranks the black pixels.
+        cause, found = next(iter(causes.items()))
+        symptoms.record(cause)
+        symptom = f"; {cause} (identified at bounces {found})"
     return CheckResult("analytic sphere interior", ok,
                        f"largest relative error {worst:.2e} over bounces {list(bounces)}"
                        f" (allowed 3e-4)" + ("" if ok else symptom))
@@ -205,7 +221,7 @@ def check_lit_plane(binary) -> CheckResult:
         # The light stands off the axes, so the image has no symmetry: a flipped or transposed
         # image that matches once turned back means the pixels went to the wrong places, not
         # the light to the wrong values (grading/symptoms.py).
-        symptom = black_pixels(image) or symptoms.named(image, want)
+        symptom = black_pixels(image) or symptoms.named(image, want, closed_form=True)
     return CheckResult("analytic lit plane", ok,
                        f"relative error mean {err.mean():.2e}, max {err.max():.2e}"
                        f" (allowed 3e-3, 2e-2)" + symptom)
@@ -500,7 +516,8 @@ def check_parallel_speedup(binary, baseline, *, threads=None, launcher=(),
     def yours() -> float:
         run = run_lab(binary, threads=threads, launcher=launcher, **settings)
         if want and run.image.tobytes() != want[0] and not wrong:
-            wrong.append("the timed render differs from the serial reference's image")
+            wrong.append("the timed render differs from the serial reference's image (the bit "
+                         "check says why)")
         used.append(cores_used(run))
         return max(run.wall_seconds - overhead, 1e-3)
 
@@ -574,15 +591,61 @@ def together_launcher(n: int) -> list[str]:
 def check_bitwise_equal(binary, baseline, *, runs=None) -> CheckResult:
     """The image is the baseline's, bit for bit, for every way of running it (thread counts,
     rank counts): what a counter-based RNG and a race-free parallel loop guarantee. `runs`
-    maps a label to run_lab keyword arguments; default: 1, 2, 3 and 7 threads."""
+    maps a label to run_lab keyword arguments; default: 1, 2, 3 and 7 threads. On a mismatch
+    it says which of the two causes it is (why_different)."""
     runs = runs or {f"{t} threads": {"threads": t} for t in (1, 2, 3, 7)}
     settings = dict(width=48, height=40, spp=8, seed=draws.seed("bitwise"))
-    want = run_lab(baseline, **settings).image.tobytes()
-    differing = [label for label, how in runs.items()
-                 if run_lab(binary, **settings, **how).image.tobytes() != want]
-    return CheckResult("bit-identical to lab 01", not differing,
-                       "identical for " + ", ".join(runs) if not differing
-                       else "differs for " + ", ".join(differing))
+    want = run_lab(baseline, **settings).image
+    images = {label: run_lab(binary, **settings, **how).image for label, how in runs.items()}
+    differing = [label for label, image in images.items()
+                 if image.tobytes() != want.tobytes()]
+    if not differing:
+        return CheckResult("bit-identical to lab 01", True, "identical for " + ", ".join(runs))
+    return CheckResult("bit-identical to lab 01", False,
+                       f"differs for {', '.join(differing)}; "
+                       + why_different(binary, settings, runs, images, differing))
+
+
+def row_ranges(rows: list[int]) -> str:
+    """[0, 1, 2, 7, 9, 10] -> "0-2, 7, 9-10"."""
+    spans: list[list[int]] = []
+    for r in rows:
+        if spans and r == spans[-1][1] + 1:
+            spans[-1][1] = r
+        else:
+            spans.append([r, r])
+    return ", ".join(f"{a}-{b}" if b > a else f"{a}" for a, b in spans)
+
+
+def rows_differing(a: np.ndarray, b: np.ndarray) -> list[int]:
+    return [int(y) for y in np.nonzero(np.any((a != b).reshape(a.shape[0], -1), axis=1))[0]]
+
+
+def why_different(binary, settings: dict, runs: dict, images: dict, differing: list[str]) -> str:
+    """Tells the two causes of other bits apart by rendering twice more each way that
+    differed, the most threads or ranks first: renders that change from run to run at one
+    count (a data race, a generator shared by threads), or the same image every time that
+    depends on the count (random numbers drawn by thread, rank or chunk instead of by pixel:
+    how the work is split). A race need not show in every run, so every differing count is
+    tried before an image is called deterministic."""
+    for label in reversed(differing):
+        first = images[label]
+        again = [run_lab(binary, **settings, **runs[label]).image for _ in range(2)]
+        rows = sorted({y for image in again for y in rows_differing(first, image)})
+        if rows:
+            return (f"nondeterministic: a data race or shared generator: renders at {label} "
+                    f"differ from each other in {len(rows)} of {first.shape[0]} rows (rows "
+                    f"{row_ranges(rows)}); each pixel's random numbers must depend on the "
+                    f"pixel alone, and each pixel be written by one thread")
+    same = [label for label in runs if label not in differing]
+    if not same:  # even the first way (1 thread, 1 rank) is not lab 01's image
+        return (f"deterministic but different from lab 01 even at {differing[0]}: the same "
+                f"image run after run at each count, but not lab 01's: are the random numbers "
+                f"drawn by pixel and sample as lab 01 draws them?")
+    return (f"deterministic but different: work split: the same image run after run at each "
+            f"count, but {', '.join(differing)} give other bits than lab 01 ({', '.join(same)} "
+            f"match): the random numbers depend on how the rows are split (drawn by thread, "
+            f"rank or chunk, not by pixel?)")
 
 
 def mpirun(ranks: int) -> list[str]:

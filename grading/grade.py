@@ -19,7 +19,7 @@ import sys
 import time
 from typing import Callable
 
-from grading import checks, draws, golden_sums, gpu, hidden, report_html, sandbox
+from grading import checks, draws, golden_sums, gpu, hidden, report_html, sandbox, symptoms
 from grading.harness import ROOT, RunPolicy, available_cores, build, policy
 from grading.results import Results, Test
 
@@ -36,7 +36,10 @@ class Item:
     points: int
     run: Callable  # run(binary, **kwargs) -> checks.CheckResult
     heatmaps: bool = False  # run() takes heatmap_dir=: an image comparison
-    requires: tuple[str, ...] = ()  # graded only once the items with these ids have passed
+    requires: tuple[str, ...] = ()  # counted only once the items with these ids have passed
+    # Runs even while a requirement fails (its points still wait for it): lab 03/04's bit
+    # check, whose diagnosis (a race, or the work split) is what a failing speedup needs.
+    always_runs: bool = False
     visibility: str = "visible"     # Gradescope's, for its results.json test
 
     def __post_init__(self):
@@ -51,7 +54,8 @@ def golden(scene: str, points: int, **options) -> Item:
 
 def bitwise(points: int, **options) -> Item:
     return Item("bitwise", "bit-identical to lab 01", points,
-                lambda b: checks.check_bitwise_equal(b, LAB01_REFERENCE, **options))
+                lambda b: checks.check_bitwise_equal(b, LAB01_REFERENCE, **options),
+                always_runs=True)
 
 
 def hidden_scene(**options) -> Item:
@@ -211,10 +215,14 @@ def grading_order(rubric: list[Item]) -> list[Item]:
 
 def grade(lab: str, binary: pathlib.Path, heatmap_dir: pathlib.Path, *, trusted: bool = False,
           budget_seconds: float = BUDGET_SECONDS, run_seconds: float = RUN_SECONDS,
-          results: Results | None = None, secret: str | None = None) -> dict:
+          results: Results | None = None, secret: str | None = None,
+          progress: Callable | None = None) -> dict:
     """Grade `binary` on lab `lab`'s rubric; returns results.json's content. `results` (if
     given) is updated after each item, so a caller can write it as it goes. `secret` makes
-    the hidden scene (default: $GRADING_SECRET, else a new one for this grade)."""
+    the hidden scene (default: $GRADING_SECRET, else a new one for this grade). Trusted (at
+    home), every check runs and says what it saw; a requirement decides only whether its
+    points count. `progress(item, test)` is called as each check starts (test None) and
+    finishes."""
     secret = secret or hidden.secret_from_environment()
     rubric = RUBRICS[lab]
     results = results or Results()
@@ -242,37 +250,53 @@ def grade(lab: str, binary: pathlib.Path, heatmap_dir: pathlib.Path, *, trusted:
             results.refuse(reason, regrade=True)
             return results.as_dict()
     start = time.perf_counter()
-    with draws.secret(secret):
+    with draws.secret(secret), symptoms.grading(lab):
         grade_items(rubric, binary, heatmap_dir, secret, results, run_policy, limits,
-                    budget_seconds, start)
+                    budget_seconds, start, progress)
     results.complete(time.perf_counter() - start)
     return results.as_dict()
 
 
 def grade_items(rubric, binary, heatmap_dir, secret, results, run_policy, limits,
-                budget_seconds, start) -> None:
-    """Each item of the rubric in grading order, results updated after each."""
+                budget_seconds, start, progress=None) -> None:
+    """Each item of the rubric in grading order, results updated after each. A check whose
+    requirements failed is not run (untrusted: the grade's time goes to what counts), unless
+    the grade is trusted or the check always runs: then it runs and shows what it saw, its
+    points "not counted until" the requirements pass."""
     for item in grading_order(rubric):
         test = results.test(item.id)
+        labels = [i.label for i in rubric if i.id in item.requires
+                  and not results.test(i.id).passed]
+        waiting = (f"the {' and the '.join(labels)} "
+                   f"{'passes' if len(labels) == 1 else 'pass'}") if labels else ""
         if time.perf_counter() - start > budget_seconds:
             test.finish(0, "not graded: the grading budget of "
                            f"{budget_seconds:g} s was spent on the checks before it")
-        elif any(not results.test(r).passed for r in item.requires):
-            labels = [i.label for i in rubric if i.id in item.requires]
-            test.finish(0, f"not graded until the {' and the '.join(labels)} "
-                           f"{'passes' if len(labels) == 1 else 'pass'}")
+        elif waiting and not (run_policy.trusted or item.always_runs):
+            test.finish(0, f"not graded until {waiting}")
         else:
+            if progress:
+                progress(item, None)
             t0 = time.perf_counter()
             with policy(dataclasses.replace(run_policy, limits=limits)):
                 result = run_check(item, binary, heatmap_dir, secret)
             credit = result.credit if result.credit is not None else float(result.passed)
-            test.finish(round(item.points * credit), result.detail,
-                        seconds=time.perf_counter() - t0, regrade=result.regrade,
-                        ok=result.passed,
-                        provisional=round(item.points * result.provisional) if result.regrade else 0)
+            if waiting:  # it ran, and says what it saw; its points wait for the gate
+                mark = "" if result.detail.startswith(("PASS", "FAIL")) else \
+                    ("PASS " if result.passed else "FAIL ")
+                test.finish(0, f"not counted until {waiting}; it saw: {mark}{result.detail}",
+                            seconds=time.perf_counter() - t0)
+            else:
+                test.finish(round(item.points * credit), result.detail,
+                            seconds=time.perf_counter() - t0, regrade=result.regrade,
+                            ok=result.passed,
+                            provisional=round(item.points * result.provisional)
+                            if result.regrade else 0)
             if "timed out after" in result.detail:
                 limits = dataclasses.replace(
                     limits, wall_seconds=min(limits.wall_seconds, SHORT_RUN_SECONDS))
+            if progress:
+                progress(item, test)
         results.changed()
 
 
@@ -386,6 +410,37 @@ def first_errors(text: str, lines: int = 20) -> str:
     return "\n".join(errors[:lines])[:4000]
 
 
+def build_warnings(text: str, lines: int = 20) -> str:
+    """The compiler's warnings of a build that succeeded, with where they point: what a
+    student should read before the points (an uninitialised variable, a sign mix-up)."""
+    kept = [line for line in text.splitlines() if line.strip()]
+    if not any("warning" in line.lower() for line in kept):
+        return ""
+    return "the build's warnings:\n" + "\n".join(kept[:lines])[:4000]
+
+
+def clear_report(folder: pathlib.Path) -> None:
+    """Removes what an earlier grade wrote in the report folder (its images, heatmaps and
+    page), and nothing else: the page must show the images of this run only."""
+    if not folder.is_dir():
+        return
+    for pattern in ("*-yours.png", "*-golden.png", "*-diff.png", "report.html"):
+        for path in folder.glob(pattern):
+            if path.is_file() and not path.is_symlink():
+                path.unlink()
+
+
+def print_progress(item: Item, test) -> None:
+    """One line per check as it finishes (lab 03's speedup takes 15-50 s): the table at the
+    end repeats them with what each saw."""
+    if test is None:
+        print(f"  {item.label} ...", end="", flush=True)
+        return
+    mark = "PASS" if test.passed else "not counted" if test.output.startswith(
+        "not counted") else "FAIL"
+    print(f" {mark} {test.score}/{test.max_score} ({test.seconds:.1f} s)", flush=True)
+
+
 def build_lab(lab: str, sources: pathlib.Path | None = None, trusted: bool = True,
               notes: list[str] | None = None) -> tuple[pathlib.Path | None, str]:
     """Build ./labNN, or a submission's folder of sources as a student of lab NN would build
@@ -407,6 +462,9 @@ def build_lab(lab: str, sources: pathlib.Path | None = None, trusted: bool = Tru
     p = subprocess.run(["make", "-s", "-C", str(ROOT), f"lab{lab}"], capture_output=True,
                        text=True, errors="replace")
     if p.returncode == 0:
+        warnings = build_warnings(p.stdout + p.stderr)
+        if warnings and notes is not None:
+            notes.append(warnings)
         return ROOT / f"lab{lab}", ""
     return None, first_errors(p.stdout + p.stderr)
 
@@ -465,6 +523,9 @@ def main(argv=None) -> int:
             binary, errors = build_lab(a.lab, pathlib.Path(a.sources) if a.sources else None,
                                        trusted=a.trusted, notes=notes)
             results.notes.extend(notes)
+            for note in notes:
+                if note.startswith("the build's warnings"):
+                    print(note)
             if binary is None and errors.startswith("refused: "):
                 results.refuse(f"the hand-in was {errors}")
                 print(f"error: the hand-in was {errors}", file=sys.stderr)
@@ -475,9 +536,12 @@ def main(argv=None) -> int:
                 print_table(a.lab, pathlib.Path(f"lab{a.lab}"), results.as_dict())
                 return 1
         heatmaps = pathlib.Path(a.heatmaps)
+        clear_report(heatmaps)
         heatmaps.mkdir(parents=True, exist_ok=True)
+        print(f"grading lab {a.lab}: {binary}", flush=True)
         grade(a.lab, binary.resolve(), heatmaps, trusted=a.trusted, results=results,
-              budget_seconds=a.budget_seconds, run_seconds=a.run_seconds)
+              budget_seconds=a.budget_seconds, run_seconds=a.run_seconds,
+              progress=print_progress)
         print_table(a.lab, binary, results.as_dict())
         if not any(heatmaps.iterdir()):
             heatmaps.rmdir()

@@ -50,3 +50,65 @@ def test_the_reference_is_named_nothing(lab01_ref, tmp_path):
     noisy = want * rng.normal(1.0, 0.1, size=want.shape)
     assert symptoms.named(noisy, want) == ""
     assert "upside down" in symptoms.named(noisy[::-1], want)
+
+
+# ---- closed forms identify; guesses defer; hints speak the lab's words ----------------------
+
+def interior(bounces: int) -> float:
+    """The sphere interior's closed form (albedo 0.6, radius 2, intensity 3)."""
+    from grading.scenes import sphere_interior_radiance
+    return sphere_interior_radiance(0.6, 2.0, 3.0, bounces)
+
+
+@pytest.mark.parametrize("value, words", [
+    (lambda b: interior(b + 1), "one bounce too many"),
+    (lambda b: interior(b - 1), "one bounce too few"),
+    (lambda b: interior(b) * np.pi, "1/pi is missing"),
+    (lambda b: interior(b) / np.pi, "an extra 1/pi"),
+    (lambda b: interior(b) ** (1 / 2.2), "gamma-encoded"),
+])
+def test_a_closed_form_identifies_the_mistake(value, words):
+    for b in (2, 4):
+        image = np.full((4, 4, 3), value(b), dtype=np.float32)
+        assert words in symptoms.identified(image, interior, b)
+
+
+def test_a_closed_form_identifies_nothing_else():
+    """Off by 1% (no known mistake), or all black: nothing is identified."""
+    for image in (np.full((4, 4, 3), interior(2) * 1.01), np.zeros((4, 4, 3))):
+        assert symptoms.identified(image, interior, 2) == ""
+
+
+def test_guesses_defer_to_what_a_closed_form_identified():
+    rng = np.random.default_rng(7)
+    want = rng.uniform(0.05, 0.5, size=(32, 32, 3))
+    gamma_like = want ** (1 / 2.2)
+    assert "gamma" in symptoms.named(gamma_like, want)  # a guess, alone
+    with symptoms.grading("01"):
+        symptoms.record(symptoms.PI_MISSING)
+        hint = symptoms.named(gamma_like, want)
+    assert "1/pi is missing" in hint and "gamma" not in hint, hint
+
+
+def test_a_factor_of_pi_on_a_per_pixel_closed_form_is_not_called_gamma():
+    rng = np.random.default_rng(8)
+    want = rng.uniform(0.05, 0.3, size=(24, 24))
+    noisy = want[..., None] * np.pi * rng.normal(1.0, 1e-3, size=(24, 24, 3))
+    hint = symptoms.named(noisy, want, closed_form=True)
+    assert "1/pi is missing" in hint and "gamma" not in hint, hint
+
+
+@pytest.mark.parametrize("lab, said, unsaid", [
+    ("01", "loop bound", ("rank", "thread", "kernel", "gathered")),
+    ("03", "threads", ("rank", "kernel", "gathered")),
+    ("04", "ranks", ("kernel",)),
+])
+def test_black_rows_are_named_in_the_lab_s_words(lab, said, unsaid):
+    want = np.full((16, 16, 3), 0.5)
+    image = want.copy()
+    image[-3:] = 0
+    with symptoms.grading(lab):
+        hint = symptoms.named(image, want)
+    assert "rows are exactly black" in hint and said in hint, hint
+    for word in unsaid:
+        assert word not in hint, hint
