@@ -14,7 +14,7 @@ files, at the top or in one folder below: grading/handin.py finds them); SUBMISS
 each student's results.json; REPORT/grades.csv and REPORT/report.html sum them up: per
 student the points, the provisional points apart (a check the machine was too busy to
 measure), the timed seconds, speedup and capacity, and the cause of a failure (compile
-error, crash, timeout, race, which image check); a last row sums up the class and counts
+error, crash, timeout, race, work split, which image check); a last row sums up the class and counts
 the flagged (provisional, or not graded for the machine's sake: regrade those on a quiet
 machine). Progress goes to stdout as `[k/N] name ...` with an estimate of the time left.
 """
@@ -73,6 +73,7 @@ CAUSES = [
     ("compile error", re.compile(r"does not compile")),
     ("no hand-in", re.compile(r"the hand-in holds (none|lab)")),
     ("timeout", re.compile(r"timed out")),
+    ("work split", re.compile(r"deterministic but different")),
     ("race", re.compile(r"nondeterministic|data race|differs? for|differs from the serial")),
     ("signal", re.compile(r"killed by|signal|SIG[A-Z]+")),
     ("crash", re.compile(r"exit status|exited with|could not run")),

@@ -316,9 +316,10 @@ def check_structure_of_arrays(binary) -> CheckResult:
         return CheckResult("structure of arrays", False,
                            "a queued path stored at places 0 and 1 was not found in the pool's "
                            "memory: the pool does not store what it is given")
+    verdict = "a structure of arrays" if apart == 4 else "want 4: one array per field"
     return CheckResult("structure of arrays", apart == 4,
                        f"the same field of neighbouring paths lies {apart} bytes apart "
-                       f"({'a structure of arrays' if apart == 4 else 'want 4: one array per field'})")
+                       f"({verdict})")
 
 
 # The timed renders: the golden 'cornell' view with enough paths that process start-up is a
@@ -488,6 +489,7 @@ def check_parallel_speedup(binary, baseline, *, threads=None, launcher=(),
       busy to reach a verdict, the test is marked for regrade and only the points measured
       count: the rest is shown apart, never in the score."""
     import threading
+
     from grading.harness import cpu_capacity, measure_parallel
     capacity_here = cpu_capacity()
     if capacity_here < QUOTA_TOO_SMALL:
@@ -658,7 +660,8 @@ def mpirun(ranks: int) -> list[str]:
 # float rounding, which a renderer must keep from showing (ray offsets that grow with the
 # primitive, light measured from the surface point, not the offset origin).
 
-TRANSLATIONS = (1e2, 1e4)  # in units of the scene's size: the interior's radius, the camera's height
+# In units of the scene's size: the interior's radius, the camera's height.
+TRANSLATIONS = (1e2, 1e4)
 
 
 def _direction(distance: float) -> list[float]:

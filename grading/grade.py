@@ -81,7 +81,8 @@ def needs(item: Item, *ids: str) -> Item:
     return dataclasses.replace(item, requires=item.requires + ids)
 
 
-SPHERE_INTERIOR = Item("sphere-interior", "analytic sphere interior", 0, checks.check_sphere_interior)
+SPHERE_INTERIOR = Item("sphere-interior", "analytic sphere interior", 0,
+                       checks.check_sphere_interior)
 LIT_PLANE = Item("lit-plane", "analytic lit plane", 0, checks.check_lit_plane)
 GLASS_PANE = Item("glass-pane", "analytic glass pane (Fresnel)", 0, checks.check_glass_slab)
 # Robustness counts only for a renderer that renders light: a flat-colour skeleton is

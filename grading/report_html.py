@@ -44,7 +44,8 @@ def write_report(folder: pathlib.Path, lab: str, who: str, results: dict) -> pat
     for yours in sorted(folder.glob("*-yours.png")):
         scene = yours.name[: -len("-yours.png")]
         cells = [f'<figure><img src="{e(yours.name)}"><figcaption>yours</figcaption></figure>',
-                 f'<figure><img src="{e(scene)}-golden.png"><figcaption>golden</figcaption></figure>']
+                 f'<figure><img src="{e(scene)}-golden.png">'
+                 f'<figcaption>golden</figcaption></figure>']
         if (folder / f"{scene}-diff.png").exists():
             cells.append(f'<figure><img src="{e(scene)}-diff.png"><figcaption>where they differ '
                          f'(blue: within the noise, red: beyond it)</figcaption></figure>')
@@ -54,7 +55,8 @@ def write_report(folder: pathlib.Path, lab: str, who: str, results: dict) -> pat
     page.write_text(f"""<!doctype html><meta charset="utf-8"><title>Lab {e(lab)}: {e(who)}</title>
 <style>body{{font-family:sans-serif}} td{{padding:2px 8px;border:1px solid #ccc;vertical-align:top}}
 table{{border-collapse:collapse}} .passed{{background:#cfc}} .failed{{background:#fcc}}
-.regrade{{background:#ffc}} .waiting{{background:#eee}} figure{{display:inline-block;margin:4px}} img{{image-rendering:pixelated}}</style>
+.regrade{{background:#ffc}} .waiting{{background:#eee}}
+figure{{display:inline-block;margin:4px}} img{{image-rendering:pixelated}}</style>
 <h1>Lab {e(lab)}: {e(who)}, {results.get("score", 0)}/{results.get("max_score", 0)}</h1>
 <p>{note}</p>
 <table><tr><th>check</th><th>points</th><th>what it saw</th></tr>

@@ -59,7 +59,9 @@ class Test:
 
 
 def clip(text: str, limit: int = MAX_OUTPUT_CHARS) -> str:
-    return text if len(text) <= limit else text[:limit] + f" ... [{len(text) - limit} characters cut]"
+    if len(text) <= limit:
+        return text
+    return text[:limit] + f" ... [{len(text) - limit} characters cut]"
 
 
 class Results:
@@ -114,7 +116,8 @@ class Results:
             most = sum(t.max_score for t in self.tests)
             extra = sum(t.provisional for t in self.tests)
             self.notes.append(f"{score}/{most}, +{extra} if the regrade confirms; marked for "
-                              f"regrade (the machine could not measure them): " + ", ".join(regrade))
+                              f"regrade (the machine could not measure them): "
+                              + ", ".join(regrade))
         self.changed()
 
     def as_dict(self) -> dict:

@@ -216,3 +216,14 @@ def test_a_gpu_lab_grades_one_submission_per_gpu_at_once(tmp_path, monkeypatch):
     most[0] = 0
     assert batch.main(["03", str(subs), "--out", str(tmp_path / "r3")]) == 0
     assert most[0] == 1  # a CPU lab: one at a time
+
+
+def test_a_race_and_a_work_split_are_told_apart():
+    """The bit check's two diagnoses (grading/checks.py) become two causes in grades.csv."""
+    def failed(output):
+        return {"score": 40, "tests": [{"name": "bit for bit", "score": 0, "max_score": 20,
+                                        "output": output}]}
+    race = failed("FAIL: nondeterministic: a data race or shared generator: rows 3-9 differ")
+    split = failed("FAIL: deterministic but different: work split: 2 threads differ from 1")
+    assert batch.failure_cause(race).startswith("race: ")
+    assert batch.failure_cause(split).startswith("work split: ")
