@@ -3,12 +3,15 @@
 # Compilers (g++, nvcc where present) come with the machine; this adds the JSON library,
 # GoogleTest, Google Benchmark, OpenMPI, bubblewrap (the grader's sandbox), util-linux's setpriv,
 # prlimit and taskset and python3-seccomp (the grader's sandbox where namespaces cannot be had:
-# grading/README.md) and the Python packages of tools/requirements.txt at their pinned versions
-# (matplotlib: the plots of `make tradeoff`; ruff and clang-format: `make lint`).
+# grading/README.md), Slurm (`make grade-slurm`, tested on a one-node Slurm the test starts),
+# debootstrap (`make test-gradescope`'s base image) and the Python packages of
+# tools/requirements.txt at their pinned versions (matplotlib: the plots of `make tradeoff`;
+# ruff and clang-format: `make lint`).
 set -euo pipefail
 
 debian_packages=(g++ make nlohmann-json3-dev libgtest-dev libbenchmark-dev openmpi-bin
-                 libopenmpi-dev iproute2 bubblewrap util-linux python3-seccomp)
+                 libopenmpi-dev iproute2 bubblewrap util-linux python3-seccomp slurm-wlm
+                 debootstrap)
 requirements="$(dirname "$0")/requirements.txt"
 [ -f "$requirements" ] || { echo "deps: $requirements is missing" >&2; exit 2; }
 
