@@ -5,7 +5,7 @@ That record holds no test results (its `tests` entry is the error of a missing j
 and every benchmark in it has speed targets, so the tests that count passes and failures,
 and that a run without targets prints no targets table, read fixtures/gpu-check-h200.json:
 an earlier H200 run's gpu-check.json (77 GPU tests passed, 1 failed; no targets), from
-`git show 1fdebed:reference/gpu/h200-2026-12-02-labs05-07/gpu-check.json`."""
+`reference/gpu/` at commit `1fdebed`."""
 import copy
 import json
 import pathlib
