@@ -116,8 +116,9 @@ def gpu_info() -> str | None:
 def does_not_run(binary: pathlib.Path) -> str | None:
     """Why `binary` cannot render one pixel here, or None. A GPU build can compile where the
     GPU cannot be used (no driver, too old a driver, a GPU another job holds); finding out with
-    a 1x1 render costs a CUDA start-up (0.31 s on the H200: reference/gpu/h200-2026-12-02-final/
-    report-cuda.txt), finding out after minutes of reference renders costs those minutes."""
+    a 1x1 render costs a CUDA start-up (0.31 s on the H200:
+    `reference/gpu/` at commit `1fdebed`), finding out after
+    minutes of reference renders costs those minutes."""
     try:
         p = subprocess.run([str(binary), "--quiet", "--width", "1", "--height", "1", "--spp",
                             "1"], capture_output=True, text=True, timeout=120)

@@ -1,5 +1,11 @@
 """tools/gpu_report.py's summary, on the CPU: the tables it makes of a recorded gpu-check.json
-(the H200 run recorded in reference/gpu/h200-2026-12-02-labs05-07), and its one-line error."""
+(the H200 record in reference/gpu/h200), and its one-line error.
+
+That record holds no test results (its `tests` entry is the error of a missing junit file)
+and every benchmark in it has speed targets, so the tests that count passes and failures,
+and that a run without targets prints no targets table, read fixtures/gpu-check-h200.json:
+an earlier H200 run's gpu-check.json (77 GPU tests passed, 1 failed; no targets), from
+`reference/gpu/` at commit `1fdebed`."""
 import copy
 import json
 import pathlib
@@ -10,11 +16,16 @@ ROOT = pathlib.Path(__file__).resolve().parents[2]
 sys.path.insert(0, str(ROOT / "tools"))
 import gpu_report  # noqa: E402
 
-RECORDED = ROOT / "reference" / "gpu" / "h200-2026-12-02-labs05-07"
+RECORDED = ROOT / "reference" / "gpu" / "h200"
+WITH_TESTS = pathlib.Path(__file__).resolve().parent / "fixtures" / "gpu-check-h200.json"
 
 
 def recorded() -> dict:
     return json.loads((RECORDED / "gpu-check.json").read_text())
+
+
+def recorded_with_tests() -> dict:
+    return json.loads(WITH_TESTS.read_text())
 
 
 def test_summary_of_a_recorded_call_is_the_recorded_summary():
@@ -22,7 +33,7 @@ def test_summary_of_a_recorded_call_is_the_recorded_summary():
 
 
 def test_summary_counts_tests_and_names_each_failure():
-    result = recorded()
+    result = recorded_with_tests()
     text = gpu_report.summary(result)
     assert "Tests: 77 passed, 1 failed, 0 errors, 0 skipped" in text
     assert "- test_h200_bar: failure" in text
@@ -71,7 +82,7 @@ def test_speed_targets_are_tabulated_with_their_verdict():
         "| lab07-bench | SoA | faster than AoS on an NVIDIA H200, the baseline"
         " | 67.60 | not judged (not this GPU) |" in text
     )
-    assert "Speed targets" not in gpu_report.summary(recorded())
+    assert "Speed targets" not in gpu_report.summary(recorded_with_tests())
 
 
 def test_missing_steps_are_said_not_crashed_on():
