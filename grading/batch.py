@@ -40,6 +40,7 @@ import zipfile
 from grading import gpu, hidden
 from grading.grade import RUBRICS
 from grading.harness import ROOT
+from grading.speed_numbers import speed_numbers
 
 
 def grade_one(lab: str, folder: pathlib.Path, out: pathlib.Path, extra: list[str],
@@ -58,15 +59,6 @@ def grade_one(lab: str, folder: pathlib.Path, out: pathlib.Path, extra: list[str
         return {"score": 0, "output": f"the grader left no results.json: {e}", "tests": []}
 
 
-SPEED_CHECKS = ("parallel-speedup", "speedup", "speed")
-# What the speed checks print (grading/checks.py): "... 1.85x over the serial reference
-# (0.600 s -> 0.324 s) on 2 cores giving 1.98x capacity ..." and "1.62x (0.412 s -> 0.254 s
-# wall clock ...)". Structured numbers in a test's extra_data, where the grader gives them,
-# come first.
-SPEED = re.compile(r"(?P<speedup>\d+(?:\.\d+)?)x (?:over the serial reference )?"
-                   r"\((?P<reference>\d+(?:\.\d+)?) s -> (?P<yours>\d+(?:\.\d+)?) s")
-CAPACITY = re.compile(r"giving (?P<capacity>\d+(?:\.\d+)?)x capacity|"
-                      r"gave only (?P<busy>\d+(?:\.\d+)?) cores")
 # The cause of a failure, from what the failing check or the grader said: first match wins.
 CAUSES = [
     ("no results", re.compile(r"left no results\.json")),
@@ -80,32 +72,6 @@ CAUSES = [
     ("no sandbox", re.compile(r"without a sandbox")),
     ("no GPU", re.compile(r"NVIDIA GPU|cannot render on this machine's GPU")),
 ]
-
-
-def speed_numbers(results: dict) -> dict[str, str]:
-    """Times, speedup and capacity of the speed check, as strings ("" where not measured)."""
-    found = dict(reference_s="", yours_s="", speedup="", capacity="")
-    for t in results.get("tests", []):
-        if t.get("extra_data", {}).get("check") not in SPEED_CHECKS:
-            continue
-        extra = t.get("extra_data", {})
-        m = SPEED.search(t.get("output", ""))
-        if m:
-            found.update(reference_s=m["reference"], yours_s=m["yours"], speedup=m["speedup"])
-        c = CAPACITY.search(t.get("output", ""))
-        if c:
-            found["capacity"] = c["capacity"] or c["busy"]
-        for key, name in (
-            ("reference_seconds", "reference_s"),
-            ("seconds_reference", "reference_s"),
-            ("yours_seconds", "yours_s"),
-            ("seconds_yours", "yours_s"),
-            ("speedup", "speedup"),
-            ("capacity", "capacity"),
-        ):
-            if isinstance(extra.get(key), (int, float)):
-                found[name] = f"{extra[key]:.3f}"
-    return found
 
 
 def provisional_points(results: dict) -> int:

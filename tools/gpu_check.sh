@@ -114,7 +114,7 @@ fi
 skipped() { [[ " ${GPU_CHECK_SKIP:-} " == *" $1 "* ]] && { step[$1]=skipped; say "$1: skipped (GPU_CHECK_SKIP)"; }; }
 
 # ---- 4. the GPU tests -------------------------------------------------------------------
-gpu_tests=${GPU_CHECK_TESTS:-"tests/labs/test_lab05.py tests/labs/test_lab06.py tests/labs/test_lab07.py tests/labs/test_device_code.py tests/grading/test_gpu_rubrics.py"}
+gpu_tests=${GPU_CHECK_TESTS:-"tests/labs/test_lab05.py tests/labs/test_lab06.py tests/labs/test_lab07.py tests/labs/test_device_code.py tests/labs/test_properties.py tests/grading/test_gpu_rubrics.py"}
 rm -f /tmp/gpu-check-junit.xml
 if ! skipped tests; then
     say "tests: pytest $gpu_tests"

@@ -227,3 +227,20 @@ def test_a_race_and_a_work_split_are_told_apart():
     split = failed("FAIL: deterministic but different: work split: 2 threads differ from 1")
     assert batch.failure_cause(race).startswith("race: ")
     assert batch.failure_cause(split).startswith("work split: ")
+
+
+def test_leaderboard_only_for_a_measured_correct_speed():
+    """Gradescope's leaderboard (results.json) ranks the speed the grader measured on a
+    correct image; a failed, unmeasured or provisional speed check gives no entry."""
+    from grading.speed_numbers import leaderboard
+
+    def graded(score, output, regrade=False):
+        return {"tests": [{"name": "speed", "score": score, "max_score": 30, "output": output,
+                           "extra_data": {"check": "speed", "regrade": regrade}}]}
+    measured = "1.62x (0.412 s -> 0.254 s wall clock measured by the grader, best of 3)"
+    assert leaderboard(graded(30, measured)) == [
+        {"name": "speedup", "value": 1.62, "order": "desc"},
+        {"name": "time (s)", "value": 0.254, "order": "asc"}]
+    assert leaderboard(graded(0, "wrong image: speed is graded only for a correct image")) == []
+    assert leaderboard(graded(0, measured)) == []
+    assert leaderboard(graded(30, measured, regrade=True)) == []
