@@ -40,7 +40,12 @@ class HandInError(Exception):
 
 
 def _skeletons():
-    spec = importlib.util.spec_from_file_location("skeletons", ROOT / "tools" / "skeletons.py")
+    """tools/skeletons.py, or None in a student release, which ships neither it nor the
+    solutions it reads: there every file already is what a student holds."""
+    path = ROOT / "tools" / "skeletons.py"
+    if not path.is_file():
+        return None
+    spec = importlib.util.spec_from_file_location("skeletons", path)
     module = importlib.util.module_from_spec(spec)
     spec.loader.exec_module(module)
     return module
@@ -52,18 +57,35 @@ def lab_number(lab_folder: str) -> str:
 
 def skeleton_form(lab_folder: str) -> set[str]:
     """Shared files (paths from the root) that a student of `lab_folder` holds as skeletons:
-    those of this lab and of every later one, as in a release (grading/release.py)."""
-    shared = _skeletons().SHARED_SOURCES
-    return {path for name, paths in shared.items() if name >= lab_folder for path in paths}
+    those of this lab and of every later one, as in a release (grading/release.py). Empty in
+    a release, whose shared files are skeletons already."""
+    skeletons = _skeletons()
+    if skeletons is None:
+        return set()
+    return {path for name, paths in skeletons.SHARED_SOURCES.items() if name >= lab_folder
+            for path in paths}
 
 
 def pristine_skeleton(lab_folder: str) -> dict[str, str]:
     """The skeleton's top-level files as tools/skeletons.py makes them from the solutions
-    (not the checkout's skeleton/ folder, which an instructor may have edited)."""
+    (not the checkout's skeleton/ folder, which an instructor may have edited). In a release,
+    the skeleton as its one commit holds it (the student's edits are their hand-in)."""
     base = ROOT / "labs" / lab_folder / "skeleton"
+    skeletons = _skeletons()
+    if skeletons is None:
+        return {name: _committed(base / name) for name in sorted(
+            p.name for p in base.iterdir() if p.is_file() and not p.is_symlink())}
     return {path.relative_to(base).as_posix(): text
-            for path, text in _skeletons().generated_files()
+            for path, text in skeletons.generated_files()
             if path.is_relative_to(base) and "/" not in path.relative_to(base).as_posix()}
+
+
+def _committed(path: pathlib.Path) -> str:
+    """A file as the release's commit holds it, else as it is."""
+    rel = path.relative_to(ROOT).as_posix()
+    p = subprocess.run(["git", "-C", str(ROOT), "show", f"HEAD:{rel}"], capture_output=True,
+                       text=True)
+    return p.stdout if p.returncode == 0 else path.read_text()
 
 
 def expected_files(lab_folder: str) -> list[str]:
