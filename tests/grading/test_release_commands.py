@@ -52,8 +52,10 @@ REDUCED = {
     "python3 tools/bench_openmp.py --mine --no-rng":
         f"python3 tools/bench_openmp.py --mine --no-rng {QUICK_OPENMP}",
     "python3 tools/bench_simd.py": "python3 tools/bench_simd.py --size 32 --spp 8 --repeat 1",
-    "python3 tools/bench_simd.py --full --only lab02-ref":
-        "python3 tools/bench_simd.py --size 32 --spp 8 --repeat 1 --only lab02-ref",
+    "python3 tools/bench_simd.py --full --only lab02-ref-avx2":
+        "python3 tools/bench_simd.py --size 32 --spp 8 --repeat 1 --only lab02-ref-avx2",
+    "python3 tools/bench_simd.py --packets":
+        "python3 tools/bench_simd.py --packets --size 32 --spp 8 --repeat 1",
     "python3 tools/bench_simd.py --full --only lab02":
         "python3 tools/bench_simd.py --size 32 --spp 8 --repeat 1 --only lab02",
     "python3 tools/bench_simd.py --only lab02 --only lab02a":
