@@ -174,17 +174,24 @@ def _seccomp_active() -> bool:
     return any(line.split() == ["Seccomp:", "2"] for line in status.splitlines())
 
 
+def _trial_run(isolation):
+    """A trivial command run under `isolation` alone: its result, or the OSError that stopped it."""
+    _isolation[:] = [isolation]
+    try:
+        with Runner(trusted=False) as r:
+            return r.run(["/bin/sh", "-c", "exit 0"], Limits(wall_seconds=20))
+    except OSError as e:
+        return e
+    finally:
+        _isolation.clear()
+
+
 def _probe_bubblewrap() -> str | None:
     if not bwrap_path():
         return "bubblewrap (bwrap) is not installed: run `make deps`"
-    _isolation[:] = [BUBBLEWRAP]
-    try:
-        with Runner(trusted=False) as r:
-            out = r.run(["/bin/sh", "-c", "exit 0"], Limits(wall_seconds=20))
-    except OSError as e:
-        return f"bubblewrap cannot start: {e}"
-    finally:
-        _isolation.clear()
+    out = _trial_run(BUBBLEWRAP)
+    if isinstance(out, OSError):
+        return f"bubblewrap cannot start: {out}"
     if out.returncode != 0:
         if _seccomp_active():
             return ("namespaces are refused here by a seccomp filter (as in a Docker container "
@@ -220,14 +227,9 @@ def _probe_user() -> str | None:
         if sandbox_user() is None:
             return (f"there is no sandbox user '{SANDBOX_USER}' and it cannot be made "
                     f"(useradd failed; setup.sh makes it)")
-    _isolation[:] = [USER]
-    try:
-        with Runner(trusted=False) as r:
-            out = r.run(["/bin/sh", "-c", "exit 0"], Limits(wall_seconds=20))
-    except OSError as e:
-        return f"the user sandbox cannot start: {e}"
-    finally:
-        _isolation.clear()
+    out = _trial_run(USER)
+    if isinstance(out, OSError):
+        return f"the user sandbox cannot start: {out}"
     if out.returncode != 0:
         return f"the user sandbox cannot start: {(out.stderr.strip() or out.failure)[:200]}"
     return None
