@@ -53,6 +53,7 @@ DOUBLE_COMMON_OBJ := $(COMMON_OBJ:$(BUILD)/%=$(DOUBLE_BUILD)/%)
 
 PHONY_EXTRA := variant
 PHONY_EXTRA += render grade handin check-nvcc bench-micro bench-cpu bench-serial count-work bench-precision
+PHONY_EXTRA += bench-simd bench-openmp bench-mpi extremes-report
 PHONY_EXTRA += lint format
 .PHONY: all help deps labs $(PHONY_EXTRA) test test-unit test-labs skeletons check-skeletons golden bench tradeoff \
         clean
@@ -70,6 +71,9 @@ help:
 	@echo "  make deps         install what is missing (JSON library, OpenMPI, tools/requirements.txt)"
 	@echo "  make bench-serial time the lab-01 reference on the Cornell baseline (minutes)"
 	@echo "  make bench-cpu    the CPU labs side by side with load and capacity (Table 4 here)"
+	@echo "  make bench-simd   lab 02's variants against lab01-ref on one core (BENCH_ARGS=--full)"
+	@echo "  make bench-openmp lab 03's schedules x threads and the shared-RNG rows (minutes)"
+	@echo "  make bench-mpi    lab 04's distributions x ranks against lab01-ref (minutes)"
 	@echo "  make tradeoff     speed against accuracy: error vs time of every lab here, bias vs"
 	@echo "                    bounces, fast math, ray offsets (QUICK=1: CI size; PLOTS=0: no plots)"
 	@echo "  make lab05-bench  the lab-05 kernel shapes the handout measures (needs a GPU)"
@@ -87,9 +91,11 @@ help:
 	@echo "  make count-work   instructions per camera path, split by query (needs valgrind)"
 	@echo "  make lab01-ref-double  lab 01's reference in double (lab05-ref-double: GPU)"
 	@echo "  make bench-precision  float against double: time and error of lab 01's reference"
+	@echo "  make extremes-report  the extreme scenes in float and double (docs/extremes.md's table)"
 	@echo "  make check-nvcc   compile every header of common/core for the GPU (needs nvcc)"
 	@echo "  make kernel-report registers, spills, stack and shared memory of every CUDA kernel"
 	@echo "  make gpu-check OUT=DIR  on a GPU machine: build, test and benchmark the CUDA labs"
+	@echo "  make tradeoff-gpu OUT=DIR  on a GPU machine: make tradeoff's GPU rows (no plots)"
 	@echo "  make golden       regenerate the golden images in reference/ (minutes)"
 	@echo "  make skeletons    regenerate the skeletons from the solutions (check-skeletons: check)"
 	@echo "  make lint         ruff on the Python, clang-format --dry-run on the C++/CUDA (make test runs it)"
@@ -172,7 +178,7 @@ render: deps
 	@MAKE="$(MAKE)" bash tools/render.sh
 
 skeletons:
-	$(PYTHON) tools/skeletons.py
+	$(PYTHON) -m labkit.skeletons
 
 # Style: ruff (pyproject.toml) on the Python, clang-format (.clang-format) on every tracked
 # C++/CUDA file, both at the versions of tools/requirements.txt (make deps). The skeletons are
@@ -187,10 +193,10 @@ lint:
 format:
 	$(PYTHON) -m ruff check --quiet --fix .
 	@$(CLANG_FORMAT) -i $(CXX_SOURCES)
-	$(PYTHON) tools/skeletons.py
+	$(PYTHON) -m labkit.skeletons
 
 check-skeletons:
-	$(PYTHON) tools/skeletons.py --check
+	$(PYTHON) -m labkit.skeletons --check
 
 # common/core/ is exactly what runs on the GPU too: every header of it must compile under nvcc
 # on its own, with nothing but core/ on the include path, in the float and the double build
@@ -222,45 +228,61 @@ handin:
 	@$(PYTHON) -m grading.handin $(LAB)
 
 golden: lab01-ref
-	$(PYTHON) tools/make_golden.py
+	$(PYTHON) -m tools.make_golden
 
-# The course report's Tables 4-7 for this machine (tools/bench_report.py): every lab this host
+# The course report's Tables 4-7 for this machine (tools/bench/report.py): every lab this host
 # runs, baseline and three sweeps, beside the report's numbers; CSV, Markdown and PNG plots go
 # to REPORTS/bench. QUICK=1 is the CI size; SCALE=K divides every image side by K.
 bench: lab01-ref
-	$(PYTHON) tools/bench_report.py --out $(REPORTS)/bench \
+	$(PYTHON) -m tools.bench.report --out $(REPORTS)/bench \
 	    $(if $(filter 1 true yes,$(QUICK)),--quick) $(if $(SCALE),--scale $(SCALE))
 
-# BENCH_ARGS: more options of tools/bench_serial.py (--repeat N, --small)
+# BENCH_ARGS: more options of the bench-* tools, e.g. --repeat N (each lists its own with
+# `python3 -m tools.bench.NAME --help`; tools/bench/__init__.py names them).
 bench-serial: lab01-ref
-	$(PYTHON) tools/bench_serial.py baseline $(BENCH_ARGS)
+	$(PYTHON) -m tools.bench.serial baseline $(BENCH_ARGS)
+
+# The handouts' tables of labs 02-04; each builds what it times.
+bench-simd:
+	$(PYTHON) -m tools.bench.simd $(BENCH_ARGS)
+
+bench-openmp:
+	$(PYTHON) -m tools.bench.openmp $(BENCH_ARGS)
+
+bench-mpi:
+	$(PYTHON) -m tools.bench.mpi table $(BENCH_ARGS)
 
 $(BUILD)/intersect_bench: $(BUILD)/bench/intersect_bench.o $(LIB_OBJ)
 	$(CXX) $(CXXFLAGS) $^ -o $@ -lbenchmark -pthread
 
-# Builds only the binaries it times (tools/bench_cpu.py), each that builds here.
+# Builds only the binaries it times (tools/bench/cpu.py), each that builds here.
 bench-cpu:
-	$(PYTHON) tools/bench_cpu.py
+	$(PYTHON) -m tools.bench.cpu
 
 count-work:
-	$(PYTHON) tools/count_work.py
+	$(PYTHON) -m tools.bench.count_work $(BENCH_ARGS)
+
+# The extreme scenes in float and double, as docs/extremes.md's Markdown table (builds what it
+# needs).
+extremes-report:
+	$(PYTHON) -m tools.extremes_report
 
 bench-micro: $(BUILD)/intersect_bench
 	$(BUILD)/intersect_bench --benchmark_min_time=0.2
 
-# Speed against accuracy (tools/tradeoff.py): error against time for every renderer here,
+# Speed against accuracy (tools/tradeoff/): error against time for every renderer here,
 # bias against bounces, fast math and ray offsets; fails when a check does. CSV, Markdown,
 # JSON and PNG plots go to REPORTS. QUICK=1 is the CI size (tests/tools/test_tradeoff.py runs
-# it); PLAN=gpu the GPU machine's (tools/tradeoff_gpu.sh); PLOTS=0 needs no matplotlib and
-# draws nothing (`tools/tradeoff.py --replot DIR` draws the plots later).
+# it); PLAN=gpu the GPU machine's (tools/gpu/tradeoff.sh); PLOTS=0 needs no matplotlib and
+# draws nothing (`python3 -m tools.tradeoff --replot DIR` draws the plots later).
 REPORTS ?= $(BUILD)/reports
 tradeoff: lab01-ref
-	$(PYTHON) tools/tradeoff.py --out $(REPORTS) $(if $(filter 1 true yes,$(QUICK)),--quick) \
+	$(PYTHON) -m tools.tradeoff --out $(REPORTS) $(if $(filter 1 true yes,$(QUICK)),--quick) \
 	    $(if $(PLAN),--plan $(PLAN)) $(if $(filter 0 false no,$(PLOTS)),--no-plots)
 
-# Float against double: time and error of lab01-ref and lab01-ref-double (tools/bench_precision.py).
+# Float against double: time and error of lab01-ref and lab01-ref-double (tools/bench/precision.py).
 bench-precision: lab01-ref lab01-ref-double
-	$(PYTHON) tools/bench_precision.py
+	$(PYTHON) -m tools.bench.precision
 
 # ---- variants -----------------------------------------------------------------------------
 # A lab built from a folder of edited sources outside the tree: the pristine skeleton as

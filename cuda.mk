@@ -5,7 +5,8 @@
 #   make kernel-report           registers, spills, stack and shared memory of every kernel
 #   make check-gpu-headers       every header of common/cuda and common/wavefront compiles alone
 #   make check-speed-targets     the benchmarks' speed-target verdicts, on the host (no GPU needed)
-#   make gpu-check OUT=DIR       on a GPU machine: build, test, benchmark, report (tools/gpu_check.sh)
+#   make gpu-check OUT=DIR       on a GPU machine: build, test, benchmark, report (tools/gpu/check.sh)
+#   make tradeoff-gpu OUT=DIR    on a GPU machine: make tradeoff's GPU rows (tools/gpu/tradeoff.sh)
 #
 # The shared GPU code is on the include path of every CUDA build, after the lab's own folder:
 # common/cuda/ (error checks, device memory, timers, the scene upload, the reference
@@ -53,7 +54,7 @@ print-cuda-build-command:
 
 # $(1): binary stem (lab05), $(2): lab folder (05-cuda-mega), $(3): the shared GPU folders
 # the lab builds on besides common/cuda (common/wavefront), $(4): the files its students
-# write that stand in for shared ones (megakernel.cuh; tools/skeletons.py's SHARED_SOURCES).
+# write that stand in for shared ones (megakernel.cuh; labkit/skeletons.py's SHARED_SOURCES).
 # skeleton/ or solution/ comes first on the include path, then $(3), then CUDA_INCLUDES.
 define cuda_lab
 CUDA_LAB_FOLDERS += $(2)
@@ -127,7 +128,13 @@ kernel-report:
 	    --arch $(KERNEL_REPORT_ARCH) --out $(BUILD)/kernel-report.md
 endif
 
-# Everything a GPU machine should check, in one call: tools/gpu_check.sh OUT.
+# Everything a GPU machine should check, in one call: tools/gpu/check.sh OUT.
 OUT ?= $(BUILD)/gpu-check
 gpu-check:
-	bash tools/gpu_check.sh $(OUT)
+	bash tools/gpu/check.sh $(OUT)
+
+# make tradeoff's GPU rows on a GPU machine without matplotlib (tools/gpu/tradeoff.sh); the
+# plots are drawn afterwards elsewhere (python3 -m tools.tradeoff --replot DIR/tradeoff).
+.PHONY: tradeoff-gpu
+tradeoff-gpu:
+	bash tools/gpu/tradeoff.sh $(if $(filter command line,$(origin OUT)),$(OUT))

@@ -39,8 +39,8 @@ import zipfile
 
 from grading import gpu, hidden
 from grading.grade import RUBRICS
-from grading.harness import ROOT
 from grading.speed_numbers import speed_numbers
+from labkit.harness import ROOT
 
 
 def grade_one(lab: str, folder: pathlib.Path, out: pathlib.Path, extra: list[str],

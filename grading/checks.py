@@ -3,7 +3,7 @@ grader. Each returns a CheckResult: whether it passed and a line saying what it 
 
 How often a correct renderer fails each check (its false-failure rate), and why:
 - golden images: at most alpha = 1e-4 per comparison, by the Bonferroni bound over every
-  block and global z-test (grading/compare.py explains the model and its assumptions).
+  block and global z-test (labkit/compare.py explains the model and its assumptions).
 - sphere interior: the estimator has zero variance there (every next-event estimate is the
   same), so only float rounding differs from the closed form: ~1e-5 relative, bound 3e-4.
 - millions of samples: the same zero-variance scene at 2^22 and 2^12 spp; a double sum keeps
@@ -30,9 +30,10 @@ import time
 
 import numpy as np
 
-from grading import draws, report_html, scenes, symptoms
-from grading.compare import compare
-from grading.harness import GOLDEN, ImageError, golden, run_lab
+from grading import draws, report_html, symptoms
+from labkit import scenes
+from labkit.compare import compare
+from labkit.harness import GOLDEN, ImageError, golden, run_lab
 
 
 @dataclasses.dataclass
@@ -82,7 +83,7 @@ GOLDEN_TEST_SPP = 64
 def check_golden(binary, scene: str, *, seed: int | None = None, spp: int = GOLDEN_TEST_SPP,
                  heatmap_dir: pathlib.Path | None = None, launcher=(), threads=None,
                  extra=()) -> CheckResult:
-    """Noise-aware comparison with the converged golden image (grading/compare.py), rendered
+    """Noise-aware comparison with the converged golden image (labkit/compare.py), rendered
     at a seed drawn from the grading secret (grading/draws.py)."""
     g = golden(scene)
     seed = draws.seed(f"golden-{scene}") if seed is None else seed
@@ -149,7 +150,7 @@ def black_pixels(image: np.ndarray) -> str:
 
 @image_checked("analytic sphere interior")
 def check_sphere_interior(binary, bounces=(1, 2, 4)) -> CheckResult:
-    """Closed form: camera and light inside a diffuse sphere (grading/scenes.py). The
+    """Closed form: camera and light inside a diffuse sphere (labkit/scenes.py). The
     estimator has zero variance there, so a wrong render is identified, not guessed: the
     closed form of one bounce more or fewer, a factor of pi, a gamma curve
     (symptoms.identified)."""
@@ -232,7 +233,7 @@ def check_glass_slab(binary, angles=None, ior: float | None = None) -> CheckResu
     """Closed form: a glass pane's Fresnel reflectance, head-on and at an oblique angle
     (35-55 degrees, drawn from the grading secret, as is the index of refraction, 1.4-1.7),
     where the reflectance is that of the exact Fresnel equations and the refracted path
-    follows Snell's law through the pane and back (grading/scenes.py, glass_slab)."""
+    follows Snell's law through the pane and back (labkit/scenes.py, glass_slab)."""
     angles = angles or (0.0, round(draws.uniform("pane-angle", 35.0, 55.0), 3))
     ior = ior or round(draws.uniform("pane-ior", 1.4, 1.7), 4)
     worst, where = 0.0, ""
@@ -478,7 +479,7 @@ def check_parallel_speedup(binary, baseline, *, threads=None, launcher=(),
                            fraction: float = 0.75, spp: int = 512, attempts: int = 3,
                            overhead_reference=None) -> CheckResult:
     """Speedup of a parallel lab over the serial baseline, in wall-clock time measured by the
-    grader, against the machine's capacity measured alongside (grading.harness.
+    grader, against the machine's capacity measured alongside (labkit.harness.
     measure_parallel). Every timed image must be the baseline's, bit for bit (what labs 03 and
     04 promise). It fails closed:
     - a program whose timed runs never used more than SERIAL_CORES cores' worth of CPU time
@@ -490,7 +491,7 @@ def check_parallel_speedup(binary, baseline, *, threads=None, launcher=(),
       count: the rest is shown apart, never in the score."""
     import threading
 
-    from grading.harness import cpu_capacity, measure_parallel
+    from labkit.harness import cpu_capacity, measure_parallel
     capacity_here = cpu_capacity()
     if capacity_here < QUOTA_TOO_SMALL:
         # Nothing to time: no program can show a speedup here. Correctness is graded (the
@@ -670,7 +671,7 @@ def _direction(distance: float) -> list[float]:
 
 
 def render_floor(binary, scene: dict, width: int = 32, height: int = 32, spp: int = 64):
-    """floor_view (grading/scenes.py) rendered with one bounce, with its relative error per
+    """floor_view (labkit/scenes.py) rendered with one bounce, with its relative error per
     pixel where it is smooth: the lower half of the image, the floor within ~4 units of the
     camera, where every subsample sees the floor (the upper half reaches the horizon, where a
     finite floor ends and a pixel spans a huge range of distances)."""

@@ -11,7 +11,7 @@ import hashlib
 import json
 import pathlib
 
-from grading.harness import GOLDEN, ROOT
+from labkit.harness import GOLDEN, ROOT
 
 RECORD = GOLDEN / "SHA256SUMS"
 

@@ -20,8 +20,8 @@ import time
 from typing import Callable
 
 from grading import checks, draws, golden_sums, gpu, hidden, report_html, sandbox, symptoms
-from grading.harness import ROOT, RunPolicy, available_cores, build, policy
 from grading.results import Results, Test
+from labkit.harness import ROOT, RunPolicy, available_cores, build, policy
 
 LAB01_REFERENCE = ROOT / "lab01-ref"
 LAB04_REFERENCE = ROOT / "lab04-ref"
@@ -177,7 +177,7 @@ RUBRICS = {
         needs(checked_golden("cornell", 20), "parallel-speedup"),
         needs(checked_golden("showcase", 10), "parallel-speedup"),
         # 75% of the cores' worth of throughput the machine gives during the run; the
-        # handout's bar, 0.9 x cores, is measured by tools/bench_openmp.py on a quiet machine.
+        # handout's bar, 0.9 x cores, is measured by tools/bench/openmp.py on a quiet machine.
         parallel_speedup(40),
     ],
     "04": [
@@ -340,7 +340,7 @@ def gpu_problem(lab: str, run_policy: RunPolicy) -> str | None:
     reason = gpu.missing_gpu()
     if reason:
         return no_gpu_line(lab, reason)
-    from grading.harness import run_lab
+    from labkit.harness import run_lab
     policies = [dataclasses.replace(run_policy, trusted=True)]
     if not run_policy.trusted:
         policies.append(run_policy)

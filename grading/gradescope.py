@@ -19,7 +19,7 @@ import sys
 import zipfile
 
 from grading.grade import RUBRICS
-from grading.harness import ROOT
+from labkit.harness import ROOT
 
 SETUP = """#!/usr/bin/env bash
 # Gradescope runs this once, as root, when it builds the autograder image. The image is built

@@ -34,9 +34,11 @@ cuda-variant-driver: $(COMMON_OBJ)
 # make test-gradescope: the lab-01 Gradescope bundle built into a Docker image on a debootstrap
 # Debian base and graded in containers with Docker's default seccomp at 0.5 CPU and 768 MB
 # (grading/gradescope/test_gradescope.py). Needs Docker and debootstrap; not part of make test.
+# A script beside grading/gradescope.py (a module of the same name), so it is run by path,
+# with the repository on the import path.
 .PHONY: test-gradescope
 test-gradescope:
-	$(PYTHON) grading/gradescope/test_gradescope.py
+	PYTHONPATH=$(CURDIR) $(PYTHON) grading/gradescope/test_gradescope.py
 # make grade-slurm LAB=NN SUBMISSIONS=DIR [REPORT=DIR] [PARTITION=P]: the same as a Slurm job
 # array, one task per submission, and a merge job for grades.csv and report.html
 # (grading/slurm.py).

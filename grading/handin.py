@@ -19,7 +19,7 @@ import subprocess
 import sys
 import zipfile
 
-from grading.harness import ROOT
+from labkit.harness import ROOT
 
 LAB_FOLDERS = {"01": "01-serial", "02": "02-simd", "03": "03-openmp", "04": "04-mpi",
                "05": "05-cuda-mega", "06": "06-cuda-split", "07": "07-soa"}

@@ -17,8 +17,9 @@ import pathlib
 import re
 import sys
 
-from grading import checks, grade, harness
-from grading.harness import ROOT
+from grading import checks, grade
+from labkit import harness
+from labkit.harness import ROOT
 
 BEGIN = ("<!-- grading table: generated from grading/grade.py's RUBRICS by "
          "`python3 -m grading.handout_tables`; edit the rubric, not this table -->")

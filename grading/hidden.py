@@ -7,7 +7,7 @@ The scene is the Cornell box with its light moved and dimmed or brightened, its 
 its colours changed and a glass and a mirror ball added, all drawn from the secret. Its golden
 data follow tools/make_golden.py (K renders with distinct seeds: their mean, and their spread
 times n as the variance of one path), only smaller, so that it takes about a second on two
-cores; with K = 32 estimated variances, grading/compare.py's false-failure bound grows by about
+cores; with K = 32 estimated variances, labkit/compare.py's false-failure bound grows by about
 1.1x.
 """
 from __future__ import annotations
@@ -22,9 +22,10 @@ import tempfile
 
 import numpy as np
 
-from grading import scenes, symptoms
-from grading.compare import compare
-from grading.harness import RunPolicy, available_cores, policy, run_lab
+from grading import symptoms
+from labkit import scenes
+from labkit.compare import compare
+from labkit.harness import RunPolicy, available_cores, policy, run_lab
 
 SIZE = 32          # pixels a side
 BOUNCES = 4

@@ -5,7 +5,7 @@ pasted into a shared file or a secret committed by accident is caught all the sa
 
 A release for lab NN leaks when it holds
 - a solution folder of lab NN or later (labs/NN-name/solution/);
-- a solution region marker or an instructor-only line (tools/skeletons.py's markers and
+- a solution region marker or an instructor-only line (labkit/skeletons.py's markers and
   "//!" lines) in any file other than an earlier lab's solution: solution files of earlier
   labs and the shared files whose regions belong to earlier labs (SHARED_SOURCES) ship as
   they are, markers included. Markdown is not read for markers: the course's README.md and
@@ -20,30 +20,17 @@ A release for lab NN leaks when it holds
 from __future__ import annotations
 
 import fnmatch
-import importlib.util
 import json
 import pathlib
 
 from grading import hidden
-from grading.harness import ROOT
-
-
-def _load_skeletons():
-    """tools/skeletons.py, the one definition of the markers and of SHARED_SOURCES (a script,
-    not a package: loaded by path, as grading/variants.py does)."""
-    spec = importlib.util.spec_from_file_location("skeletons", ROOT / "tools" / "skeletons.py")
-    module = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(module)
-    return module
-
-
-skeletons = _load_skeletons()
+from labkit import skeletons  # the one definition of the markers and of SHARED_SOURCES
 
 # The instructor's side of the kit: the skeleton generator (it documents the markers), the
 # golden-image generator, the grader's own tests (hostile submissions, the sandbox, the
 # Gradescope bundle), the labs' tests (they test the references, mutants of the solutions and
 # the skeletons' sync with them), CI, and this release tool itself.
-NEVER_SHIPPED = ("tools/skeletons.py", "tools/make_golden.py", "tests/grading/*",
+NEVER_SHIPPED = ("labkit/skeletons.py", "tools/make_golden.py", "tests/grading/*",
                  "tests/labs/test_lab0*", ".ci/*", "grading/release.py", "grading/leaks.py",
                  "grading/reference_bins.py")
 # Tests students get: the shared command-line contract (run on the reference binaries) and

@@ -31,7 +31,7 @@ import pathlib
 import shutil
 import subprocess
 
-from grading.harness import ROOT
+from labkit.harness import ROOT
 
 # The binaries a lab ships when its solution does not: what the grader runs and what students
 # time themselves against. Lab 02 has two parts, and Part B two references: lab02-ref-avx2 is

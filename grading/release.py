@@ -4,7 +4,7 @@
 
 A release for lab NN holds the skeletons of lab NN and every later lab, the solutions of the
 earlier labs (lab NN builds on them), common/ with the solution regions of lab NN and later
-replaced by their skeleton form (tools/skeletons.py), the scenes, the golden images, the
+replaced by their skeleton form (labkit/skeletons.py), the scenes, the golden images, the
 handouts, the public tests, the grader (students run `make grade LAB=NN`, trusted) and the
 reference binaries of lab NN and later, prebuilt (grading/reference_bins.py says why and how).
 It holds no solution source of lab NN or later, no test that is not public, no instructor
@@ -29,12 +29,14 @@ import textwrap
 
 from grading import handin, leaks, reference_bins
 from grading.gradescope import repository_files
-from grading.harness import ROOT
+from labkit.harness import ROOT
 
 # Top-level entries of the repository that ship (then filtered by leaks.NEVER_SHIPPED and
 # leaks.PUBLIC_TESTS): anything else, such as a stray binary at the root, does not.
-SHIPPED_TOP = ("Makefile", "cuda.mk", "README.md", "DESIGN.md", ".gitignore", "common", "labs",
-               "grading", "handouts", "reference", "tests", "tools", "bench")
+# pyproject.toml puts the root on pytest's import path (labkit, grading, tools are packages).
+SHIPPED_TOP = ("Makefile", "cuda.mk", "README.md", "DESIGN.md", ".gitignore", "pyproject.toml",
+               "common", "labs", "labkit", "grading", "handouts", "reference", "tests", "tools",
+               "bench")
 
 
 class ReleaseError(Exception):
@@ -166,7 +168,7 @@ what you changed. Commit your work as you go.
 
 
 def check_skeletons() -> None:
-    """The shipped skeletons must be what tools/skeletons.py makes of the solutions now: a
+    """The shipped skeletons must be what labkit/skeletons.py makes of the solutions now: a
     solution changed without `make skeletons` would give students a skeleton of the old one."""
     try:
         generated = list(leaks.skeletons.generated_files())

@@ -11,7 +11,7 @@ import pathlib
 
 import numpy as np
 
-from grading.heatmap import heatmap_scale, write_png
+from labkit.heatmap import heatmap_scale, write_png
 
 
 def display_rgb(image: np.ndarray) -> np.ndarray:

@@ -26,7 +26,7 @@ import tempfile
 
 from grading import batch
 from grading.grade import RUBRICS
-from grading.harness import ROOT
+from labkit.harness import ROOT
 
 
 def count(submissions: pathlib.Path, out: pathlib.Path) -> int:

@@ -20,6 +20,7 @@ build/ are the references'. So a submission is compiled in a students' tree made
 from __future__ import annotations
 
 import hashlib
+import importlib
 import importlib.util
 import os
 import pathlib
@@ -28,7 +29,7 @@ import stat
 import subprocess
 import tempfile
 
-from grading.harness import ROOT
+from labkit.harness import ROOT
 
 SOURCE_SUFFIXES = (".cpp", ".h", ".hpp", ".cu", ".cuh")
 MAX_FILE_BYTES = 1 << 20      # a source file of a lab is tens of KiB
@@ -40,15 +41,11 @@ class HandInError(Exception):
 
 
 def _skeletons():
-    """tools/skeletons.py, or None in a student release, which ships neither it nor the
+    """labkit.skeletons, or None in a student release, which ships neither it nor the
     solutions it reads: there every file already is what a student holds."""
-    path = ROOT / "tools" / "skeletons.py"
-    if not path.is_file():
+    if importlib.util.find_spec("labkit.skeletons") is None:
         return None
-    spec = importlib.util.spec_from_file_location("skeletons", path)
-    module = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(module)
-    return module
+    return importlib.import_module("labkit.skeletons")
 
 
 def lab_number(lab_folder: str) -> str:
@@ -67,7 +64,7 @@ def skeleton_form(lab_folder: str) -> set[str]:
 
 
 def pristine_skeleton(lab_folder: str) -> dict[str, str]:
-    """The skeleton's top-level files as tools/skeletons.py makes them from the solutions
+    """The skeleton's top-level files as labkit/skeletons.py makes them from the solutions
     (not the checkout's skeleton/ folder, which an instructor may have edited). In a release,
     the skeleton as its one commit holds it (the student's edits are their hand-in)."""
     base = ROOT / "labs" / lab_folder / "skeleton"

@@ -2,7 +2,7 @@
 
 Usage from the command line::
 
-    python3 -m grading.compare IMAGE.pfm --golden DIR --spp N [--alpha A] [--heatmap PNG]
+    python3 -m labkit.compare IMAGE.pfm --golden DIR --spp N [--alpha A] [--heatmap PNG]
 
 DIR holds ``golden.pfm`` (the converged mean of ``golden_spp`` paths per pixel),
 ``variance.pfm`` (the variance of ONE path's radiance, per pixel and channel) and
@@ -766,7 +766,7 @@ def _default_heatmap_path(image_path: str) -> str:
 
 def main(argv: Sequence[str] | None = None) -> int:
     parser = argparse.ArgumentParser(
-        prog="python3 -m grading.compare",
+        prog="python3 -m labkit.compare",
         description="Compare a Monte Carlo render with a golden reference (exit 0 pass,"
                     " 1 fail, 2 bad input).")
     parser.add_argument("image", help="the render, a PFM file")

@@ -17,8 +17,8 @@ from typing import Callable, Sequence
 
 import numpy as np
 
-from grading.pfm import read_pfm
 from grading.sandbox import Limits, Runner
+from labkit.pfm import read_pfm
 
 ROOT = pathlib.Path(__file__).resolve().parent.parent
 SCENES = ROOT / "common" / "scenes"

@@ -5,7 +5,7 @@ import json
 import math
 import pathlib
 
-from grading.harness import SCENES
+from labkit.harness import SCENES
 
 
 def write_scene(path: pathlib.Path, scene: dict) -> pathlib.Path:

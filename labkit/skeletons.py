@@ -1,4 +1,3 @@
-#!/usr/bin/env python3
 """Generate each lab's skeleton from its solution (the single source).
 
 A solution file marks what students write:
@@ -18,8 +17,13 @@ but later labs reuse, such as common/core/path_tracer.h) become skeleton/ files 
 lab's build puts skeleton/ first on the include path, so there they stand in for the shared
 file.
 
-    tools/skeletons.py           regenerate every skeleton
-    tools/skeletons.py --check   exit 1 and name the files that differ (used by the tests)
+    python3 -m labkit.skeletons           regenerate every skeleton (make skeletons)
+    python3 -m labkit.skeletons --check   exit 1 and name the files that differ (make
+                                          check-skeletons, the tests)
+
+The grader and the release tools import it (labkit/, not tools/): both need the markers and
+SHARED_SOURCES, and the grader imports nothing from tools/. A student release ships neither it
+nor the solutions it reads (grading/leaks.py).
 """
 import argparse
 import pathlib

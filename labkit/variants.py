@@ -7,11 +7,10 @@ lays out a folder of sources and asks it. A header in that folder stands in for 
 of the same name, because the folder comes first on the include path."""
 from __future__ import annotations
 
-import importlib.util
 import pathlib
 import subprocess
 
-from grading.harness import ROOT
+from labkit.harness import ROOT
 
 
 def lab_sources(lab: str, source_dir: str = "solution") -> dict[str, str]:
@@ -46,11 +45,9 @@ def build_variant(lab: str, workdir: pathlib.Path, overrides: dict[str, str],
 
 
 def pristine_skeleton_sources(lab: str) -> dict[str, str]:
-    """The skeleton files of a lab exactly as tools/skeletons.py generates them, by path
+    """The skeleton files of a lab exactly as labkit/skeletons.py generates them, by path
     below skeleton/ (lab 02's Part A is part-a/vec3.h)."""
-    spec = importlib.util.spec_from_file_location("skeletons", ROOT / "tools" / "skeletons.py")
-    skeletons = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(skeletons)
+    from labkit import skeletons  # not in a student release, which has no solutions to read
     base = ROOT / "labs" / lab / "skeleton"
     return {path.relative_to(base).as_posix(): text for path, text in skeletons.generated_files()
             if path.is_relative_to(base)}

@@ -1,13 +1,8 @@
-"""Shared pytest setup: import grading/ from the repository, build binaries once."""
-import pathlib
-import sys
-
+"""Shared pytest setup: build binaries once. The repository root is on the import path
+through pyproject.toml (pythonpath), so labkit and grading import as packages."""
 import pytest
 
-ROOT = pathlib.Path(__file__).resolve().parent.parent
-sys.path.insert(0, str(ROOT))
-
-from grading.harness import build  # noqa: E402
+from labkit.harness import build
 
 
 @pytest.fixture(scope="session")
@@ -24,5 +19,5 @@ def lab01():
 @pytest.fixture(scope="session")
 def lab01_pristine_skeleton(tmp_path_factory):
     """Lab 01's skeleton exactly as generated from the solution, untouched by students."""
-    from grading.variants import build_pristine_skeleton
+    from labkit.variants import build_pristine_skeleton
     return build_pristine_skeleton("01-serial", tmp_path_factory.mktemp("lab01-skeleton"))

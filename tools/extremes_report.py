@@ -1,10 +1,9 @@
-#!/usr/bin/env python3
 """The numerical-stability suite at the extremes, measured in float and in double: each case
 of the render-level suite (the checks of grading/checks.py and tests/labs/test_extremes.py),
 run with lab01-ref and lab01-ref-double, with its property, its tolerance and what each build
 measured; printed as the Markdown table of docs/extremes.md.
 
-    python3 tools/extremes_report.py > table.md      (about a minute; builds what is missing)
+    python3 -m tools.extremes_report > table.md      (about a minute; builds what is missing)
 
 The same cases are tests (tests/labs/test_extremes.py, for both builds); this prints numbers.
 """
@@ -15,11 +14,12 @@ import re
 import sys
 import tempfile
 
+from grading import checks
+from labkit import scenes
+from labkit.harness import build, run_lab
+from labkit.variants import build_sources, lab_sources
+
 ROOT = pathlib.Path(__file__).resolve().parent.parent
-sys.path.insert(0, str(ROOT))
-from grading import checks, scenes  # noqa: E402
-from grading.harness import build, run_lab  # noqa: E402
-from grading.variants import build_sources, lab_sources  # noqa: E402
 
 BUILDS = {"float": "lab01-ref", "double": "lab01-ref-double", "float, -ffast-math": None}
 SCALES = [10.0**k for k in range(-14, 15, 2)]

@@ -1,14 +1,13 @@
-#!/usr/bin/env python3
 """Regenerate the golden data in reference/golden/: for each scene, a converged mean image
 and the per-pixel variance of one path, both from the lab-01 reference.
 
 The variance comes from K independent renders of n spp each (distinct seeds): the spread of
 their means, times n, estimates the variance of a single path at every pixel. The mean of
 all K*n paths is the golden image. Tests then know, per pixel, how noisy a render of any spp
-should be (see grading/compare.py).
+should be (see labkit/compare.py).
 
     make golden          all scenes (a few minutes on two cores)
-    tools/make_golden.py --scene cornell
+    python3 -m tools.make_golden --scene cornell
 """
 import argparse
 import concurrent.futures
@@ -22,11 +21,11 @@ import tempfile
 
 import numpy as np
 
+from grading import golden_sums
+from labkit.harness import run_lab
+from labkit.pfm import write_pfm
+
 ROOT = pathlib.Path(__file__).resolve().parent.parent
-sys.path.insert(0, str(ROOT))
-from grading import golden_sums  # noqa: E402
-from grading.harness import run_lab  # noqa: E402
-from grading.pfm import write_pfm  # noqa: E402
 
 # Golden scenes and the settings tests render them at. Small on purpose: the files stay
 # small (64x64x3 float32 = 48 KiB each) and a test render takes well under a second.

@@ -25,8 +25,7 @@ import tempfile
 import time
 import zipfile
 
-ROOT = pathlib.Path(__file__).resolve().parents[2]
-sys.path.insert(0, str(ROOT))
+ROOT = pathlib.Path(__file__).resolve().parents[2]  # on the import path: make test-gradescope
 BASE = "prt-debian-base:bookworm"
 IMAGE = "prt-gradescope-lab01"
 LIMITS = ["--cpus=0.5", "--memory=768m"]  # Gradescope's defaults

@@ -4,7 +4,7 @@
 #   ./lab02-ref: the reference at the width the CPU has (16 AVX-512 lanes, else 8 of AVX2),
 #   with compacted packets (render_widest.cpp over the SIMD library, SIMD_OBJ in Makefile).
 #   ./lab02-bench: lab02-ref whose width and method RT_SIMD_LANES (8, 16) and RT_SIMD_COMPACT
-#   (0, 1) choose, for the handout's table (tools/bench_simd.py).
+#   (0, 1) choose, for the handout's table (tools/bench/simd.py).
 #   Part A, the lab-01 renderer with an SSE Vec3: ./lab02a (with skeleton/part-a/vec3.h) and
 #   ./lab02a-ref (with solution/part-a/vec3.h), each standing in for common/core/vec3.h.
 #   ./lab02-prims, a worked example: SIMD across primitives (one ray, 8 triangles).

@@ -1,7 +1,7 @@
 # Lab 03: OpenMP. ./lab03 (skeleton) and ./lab03-ref (solution), plus the variants the
 # handout measures, all with the shared command line:
 #   lab03-bench            the solution with schedule(runtime): OMP_SCHEDULE picks the loop
-#                          schedule (tools/bench_openmp.py; the default build keeps the best)
+#                          schedule (tools/bench/openmp.py; the default build keeps the best)
 #   lab03-simd-ref         the solution on lab 02's packet tracer at the CPU's width (16
 #                          AVX-512 lanes or 8 AVX2, compacted); only on x86-64
 #   lab03-shared-rng       the classic mistake: one generator shared by all threads, locked

@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # The measurements of handouts/06-cuda-split.md and 07-soa.md, on a GPU machine, after
-# `make lab06-ref lab07-ref lab07-bench` (tools/gpu_check.sh calls it; it runs alone too):
+# `make lab06-ref lab07-ref lab07-bench` (tools/gpu/check.sh calls it; it runs alone too):
 #   1. lab07-bench (both pool layouts and lab 05's megakernel, one process per scene): the
 #      Cornell baseline, the Cornell box at 16 bounces, the showcase (glass and mirrors, its
 #      8 bounces) and the showcase at 16 bounces;

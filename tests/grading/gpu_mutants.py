@@ -10,16 +10,16 @@ import dataclasses
 import pathlib
 import subprocess
 
-from grading.harness import ROOT
 from grading.leaks import skeletons
-from grading.variants import lab_sources
+from labkit.harness import ROOT
+from labkit.variants import lab_sources
 
 LAB = "05-cuda-mega"
 
 
 def reference_hand_in(lab: str) -> dict[str, str]:
     """What a student of `lab` hands in, as the reference has it: the solution folder's files
-    and the shared files the lab's students write (tools/skeletons.py's SHARED_SOURCES)."""
+    and the shared files the lab's students write (labkit/skeletons.py's SHARED_SOURCES)."""
     shared = {pathlib.Path(path).name: (ROOT / path).read_text()
               for path in skeletons.SHARED_SOURCES.get(lab, [])}
     return {**lab_sources(lab), **shared}

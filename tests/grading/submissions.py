@@ -6,10 +6,11 @@ repository, so a script cannot just exec ./lab01-ref) and unpack it into their s
 from __future__ import annotations
 
 import pathlib
+import shlex
 import subprocess
 import sys
 
-from grading.harness import ROOT
+from labkit.harness import ROOT
 
 REFERENCE = ROOT / "lab01-ref"
 
@@ -140,7 +141,7 @@ def golden_copier(folder) -> pathlib.Path:
     it cannot render."""
     import base64
 
-    from grading.harness import GOLDEN
+    from labkit.harness import GOLDEN
     cases = []
     for scene in ("cornell", "showcase"):
         data = base64.b64encode((GOLDEN / scene / "golden.pfm").read_bytes()).decode()
@@ -153,11 +154,11 @@ def golden_copier(folder) -> pathlib.Path:
 # `image`, the H x W x 3 array it wrote), as a mistake would have changed it: the symptoms'
 # tests. It runs the repository's Python and reference, so it is graded trusted (outside the
 # sandbox, which shows a submission none of that).
-ALTERED = """#!{python}
+ALTERED = """#!/bin/sh
+PYTHONPATH={root} exec {python} - "$@" <<'END'
 import subprocess, sys
 import numpy as np
-sys.path.insert(0, {root!r})
-from grading.pfm import read_pfm, write_pfm
+from labkit.pfm import read_pfm, write_pfm
 args = sys.argv[1:]
 p = subprocess.run([{reference!r}, *args])
 if p.returncode:
@@ -165,13 +166,14 @@ if p.returncode:
 pfm = args[args.index("--pfm") + 1]
 image = read_pfm(pfm)
 write_pfm(pfm, {change})
+END
 """
 
 
 def altered_reference(folder: pathlib.Path, change: str,
                       reference: pathlib.Path = REFERENCE) -> pathlib.Path:
     path = folder / "lab"
-    path.write_text(ALTERED.format(python=sys.executable, root=str(ROOT),
+    path.write_text(ALTERED.format(python=shlex.quote(sys.executable), root=shlex.quote(str(ROOT)),
                                    reference=str(reference), change=change))
     path.chmod(0o755)
     return path
@@ -215,23 +217,25 @@ def threads_on_every_cpu(folder, parallel_reference: pathlib.Path) -> pathlib.Pa
 # Prints, for every render, the published closed-form answer of the analytic scenes as they
 # were before their parameters came from the grading secret (sphere interior: albedo 0.6,
 # radius 2, intensity 3, the bounces asked), at the size asked: no renderer at all.
-PUBLISHED_ANSWER = """#!{python}
+PUBLISHED_ANSWER = """#!/bin/sh
+PYTHONPATH={root} exec {python} - "$@" <<'END'
 import sys
-sys.path.insert(0, {root!r})
 import numpy as np
-from grading import scenes
-from grading.pfm import write_pfm
+from labkit import scenes
+from labkit.pfm import write_pfm
 args = sys.argv[1:]
 value = lambda flag, default: int(args[args.index(flag) + 1]) if flag in args else default
 w, h, b = value("--width", 8), value("--height", 8), value("--bounces", 4)
 radiance = scenes.sphere_interior_radiance(0.6, 2.0, 3.0, b)
 write_pfm(args[args.index("--pfm") + 1], np.full((h, w, 3), radiance, dtype=np.float32))
 print('{{"lab": "answers", "seconds": 0.001}}')
+END
 """
 
 
 def published_answers(folder: pathlib.Path) -> pathlib.Path:
     path = folder / "lab"
-    path.write_text(PUBLISHED_ANSWER.format(python=sys.executable, root=str(ROOT)))
+    path.write_text(PUBLISHED_ANSWER.format(python=shlex.quote(sys.executable),
+                                            root=shlex.quote(str(ROOT))))
     path.chmod(0o755)
     return path

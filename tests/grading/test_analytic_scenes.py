@@ -1,4 +1,4 @@
-"""The analytic scenes' closed forms (grading/scenes.py): the glass pane wound as the core
+"""The analytic scenes' closed forms (labkit/scenes.py): the glass pane wound as the core
 reads glass, its Fresnel and Snell geometry, and the reference matching it head-on and at an
 oblique angle, where an approximate reflectance would not."""
 import math
@@ -6,8 +6,9 @@ import math
 import numpy as np
 import pytest
 
-from grading import checks, scenes
-from grading.harness import build
+from grading import checks
+from labkit import scenes
+from labkit.harness import build
 
 
 def normal(quad):

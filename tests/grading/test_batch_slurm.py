@@ -15,7 +15,7 @@ import time
 import pytest
 
 from grading import sandbox
-from grading.harness import ROOT
+from labkit.harness import ROOT
 
 DAEMONS = ("munged", "slurmctld", "slurmd", "sbatch")
 

@@ -1,4 +1,4 @@
-"""Tests of grading.compare / grading.pfm / grading.heatmap on synthetic images.
+"""Tests of labkit.compare / labkit.pfm / labkit.heatmap on synthetic images.
 
 No renderer is needed: "renders" are drawn from the statistical model the comparison assumes
 (and, in one test, from a skewed Monte Carlo model with an estimated variance)."""
@@ -14,12 +14,8 @@ import zlib
 import numpy as np
 import pytest
 
-REPO = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
-if REPO not in sys.path:
-    sys.path.insert(0, REPO)
-
-from grading import compare as cmp  # noqa: E402
-from grading.compare import (  # noqa: E402
+from labkit import compare as cmp
+from labkit.compare import (
     InputError,
     compare,
     count_tests,
@@ -28,8 +24,9 @@ from grading.compare import (  # noqa: E402
     heatmap_png,
     normal_quantile,
 )
-from grading.heatmap import heatmap_scale  # noqa: E402
-from grading.pfm import PFMError, read_pfm, write_pfm  # noqa: E402
+from labkit.harness import ROOT
+from labkit.heatmap import heatmap_scale
+from labkit.pfm import PFMError, read_pfm, write_pfm
 
 # ---------------------------------------------------------------------------------------
 # Synthetic scenes
@@ -404,8 +401,8 @@ def write_reference(directory, golden, variance, golden_spp):
 
 
 def run_cli(*args):
-    return subprocess.run([sys.executable, "-m", "grading.compare", *map(str, args)],
-                          cwd=REPO, capture_output=True, text=True, timeout=60)
+    return subprocess.run([sys.executable, "-m", "labkit.compare", *map(str, args)],
+                          cwd=ROOT, capture_output=True, text=True, timeout=60)
 
 
 def test_cli_exit_codes(tmp_path):

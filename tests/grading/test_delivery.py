@@ -14,7 +14,7 @@ import zipfile
 import pytest
 
 from grading import sandbox
-from grading.harness import ROOT
+from labkit.harness import ROOT
 from tests.grading import submissions as sub
 
 

@@ -6,8 +6,8 @@ import pytest
 
 from grading import checks, draws
 from grading.grade import LAB01_REFERENCE, describe, grade
-from grading.harness import ROOT, build
-from grading.variants import build_variant
+from labkit.harness import ROOT, build
+from labkit.variants import build_variant
 from tests.grading import submissions as sub
 
 PATH_TRACER = (ROOT / "common" / "core" / "path_tracer.h").read_text()

@@ -7,7 +7,7 @@ import pytest
 
 from grading import golden_sums
 from grading.grade import grade
-from grading.harness import GOLDEN, ROOT
+from labkit.harness import GOLDEN, ROOT
 
 
 def test_the_record_matches_the_golden_data():

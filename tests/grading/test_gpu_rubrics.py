@@ -9,7 +9,7 @@ that exist and reach a sandboxed process; the symptoms the GPU mutants show are 
 (checked on lab 01's reference made to show them); and the whole rubric runs on a CPU
 stand-in.
 
-On a GPU (tools/gpu_check.sh runs these; elsewhere they skip and say why): each lab's
+On a GPU (tools/gpu/check.sh runs these; elsewhere they skip and say why): each lab's
 reference scores 100 in the sandbox, each pristine skeleton at most 10%, and each classic GPU
 bug (tests/grading/gpu_mutants.py) loses the points it should, with a message naming the
 symptom, and lab 06's reference handed in for lab 07 loses the layout's points. Renders are
@@ -36,7 +36,7 @@ from grading.grade import (
     grading_order,
     passed_by_check,
 )
-from grading.harness import ROOT, build
+from labkit.harness import ROOT, build
 from tests.grading import submissions
 from tests.grading.gpu_mutants import (
     LAB,
@@ -125,7 +125,7 @@ def test_lab07_sources_build_in_the_sandbox(nvcc_and_sandbox, tmp_path):
     """Lab 07's build reads lab 06's reference queue and stage loop (common/wavefront/);
     without them in view its skeleton does not compile in the sandbox."""
     from grading.grade import build_lab
-    from grading.variants import pristine_skeleton_sources
+    from labkit.variants import pristine_skeleton_sources
     for name, text in pristine_skeleton_sources(GPU_LABS["07"]).items():
         (tmp_path / name).write_text(text)
     binary, errors = build_lab("07", tmp_path, trusted=False)
@@ -136,7 +136,7 @@ def test_a_gpu_submission_including_the_solution_does_not_compile(nvcc_and_sandb
     """As for the CPU labs: the solution is out of the sandboxed compiler's view (a lab 05
     render.cu that #includes it), and in view when trusted, so the test can fail."""
     from grading.grade import build_lab
-    from grading.variants import pristine_skeleton_sources
+    from labkit.variants import pristine_skeleton_sources
     solution = ROOT / "labs" / GPU_LABS["05"] / "solution"
     (tmp_path / "render.cu").write_text(f'#include "{solution}/render.cu"\n')
     # The other file lab 05's students write: a hand-in without it does not build at all.
@@ -386,7 +386,7 @@ def test_a_timed_render_is_checked_at_the_golden_size():
     is the golden image (here: the golden image itself, upsampled), a transposed one is not."""
     import numpy as np
 
-    from grading.harness import golden
+    from labkit.harness import golden
     g = golden("cornell")
     big = np.kron(g.mean, np.ones((GPU_TIMED_SCALE, GPU_TIMED_SCALE, 1), np.float32))
     assert checks.box_filtered(big, GPU_TIMED_SCALE).shape == g.mean.shape
@@ -430,7 +430,7 @@ def on_gpu():
 def gpu_builds(on_gpu, tmp_path_factory):
     """Every pristine skeleton and every mutant, built at once (one nvcc each, in parallel):
     name -> binary."""
-    from grading.variants import pristine_skeleton_sources
+    from labkit.variants import pristine_skeleton_sources
     root = tmp_path_factory.mktemp("gpu-builds")
     folders = {f"skeleton-{lab}": (GPU_LABS[lab], pristine_skeleton_sources(GPU_LABS[lab]))
                for lab in GPU_LABS}

@@ -9,7 +9,7 @@ import pytest
 
 from grading.grade import describe, passed_by_check, unmeasurable
 from grading.grade import grade as grade_in_process
-from grading.harness import ROOT, build, cpu_has_avx2
+from labkit.harness import ROOT, build, cpu_has_avx2
 
 
 def grade(binary, tmp_path):
@@ -71,7 +71,7 @@ def test_lab03_shared_generator_loses_the_bits(tmp_path):
     statistically, but not lab 01's bits. What the lock costs in speed depends on the machine
     (on one two-core AMD EPYC it still reached 1.62x where 1.49x was required), and the golden
     images count only with the speedup shown, so only the bit check is asserted outright;
-    tools/bench_openmp.py prints the shared generator's speedup."""
+    tools/bench/openmp.py prints the shared generator's speedup."""
     results = grade_in_process("03", build("lab03-shared-rng")[0], tmp_path)
     passed = passed_by_check(results)
     assert not passed["bitwise"], describe(results)

@@ -9,7 +9,7 @@ import zipfile
 import pytest
 
 from grading import handin, students_tree
-from grading.harness import ROOT
+from labkit.harness import ROOT
 
 
 def write_files(folder, lab, skip=()):

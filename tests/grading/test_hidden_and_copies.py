@@ -5,7 +5,7 @@ names the copy)."""
 import sys
 
 from grading.grade import describe, grade, passed_by_check
-from grading.harness import GOLDEN, ROOT
+from labkit.harness import GOLDEN, ROOT
 
 # Renders as the reference does, except that the golden Cornell view gets the stored golden
 # image itself (a submission that recognises the graded scene and prints what it should be).

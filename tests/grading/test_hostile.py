@@ -15,7 +15,7 @@ import pytest
 
 from grading import sandbox
 from grading.grade import describe, grade, passed_by_check
-from grading.harness import GOLDEN, ROOT
+from labkit.harness import GOLDEN, ROOT
 from tests.grading import submissions as sub
 
 
@@ -140,7 +140,7 @@ def test_the_sandbox_hides_solutions_golden_data_and_the_repository(tmp_path):
     before = tree_digest(GOLDEN)
     meta = targets["write golden"].read_bytes()
     binary = sub.spy(tmp_path, targets)
-    from grading.harness import RunPolicy, policy, run_lab
+    from labkit.harness import RunPolicy, policy, run_lab
     try:
         with policy(RunPolicy(trusted=False)):
             run = run_lab(binary, width=8, height=8, spp=1)
@@ -313,8 +313,8 @@ def test_a_missing_shared_file_is_the_skeletons_not_the_solution(tmp_path):
 
 
 def test_lab02_skeleton_without_its_header_scores_as_the_skeleton(tmp_path):
-    from grading.harness import cpu_has_avx2
     from grading.students_tree import pristine_skeleton
+    from labkit.harness import cpu_has_avx2
     if not cpu_has_avx2():
         pytest.skip("this CPU has no AVX2/FMA: lab 02's Part B cannot run")
     files = {n: t for n, t in pristine_skeleton("02-simd").items() if n.endswith(".cpp")}
@@ -386,7 +386,7 @@ def test_build_folders_are_removed(tmp_path):
     assert not list(tmp.iterdir()), list(tmp.iterdir())
 
 
-# ---- images that block means alone would pass (grading/compare.py, the per-pixel test) ----
+# ---- images that block means alone would pass (labkit/compare.py, the per-pixel test) ----
 
 def golden_points(results) -> int:
     return sum(t["score"] for t in results["tests"] if t["extra_data"]["check"] in
@@ -419,8 +419,8 @@ def test_too_smooth_is_named_on_the_golden_image():
     means pass, its per-pixel noise is too small."""
     import numpy as np
 
-    from grading.compare import compare
-    from grading.harness import build, golden, run_lab
+    from labkit.compare import compare
+    from labkit.harness import build, golden, run_lab
     reference, = build("lab01-ref")
     g = golden("cornell")
     image = run_lab(reference, g.scene, width=g.meta["width"], height=g.meta["height"], spp=64,
@@ -446,7 +446,7 @@ def test_values_at_the_float_limit_fail_every_image_check(tmp_path):
 def test_threads_in_the_simd_lab_earn_no_speed(tmp_path):
     """Scalar code on every core, handed in for lab 02: the timed runs are confined to one
     CPU and their CPU time is measured, so widening the affinity again earns nothing."""
-    from grading.harness import build
+    from labkit.harness import build
     lab03_ref, = build("lab03-ref")
     results = grade("02", sub.threads_on_every_cpu(tmp_path, lab03_ref), tmp_path)
     speed = next(t for t in results["tests"] if t["extra_data"]["check"] == "speedup")

@@ -19,7 +19,7 @@ import time
 import pytest
 
 from grading import leaks
-from grading.harness import ROOT
+from labkit.harness import ROOT
 
 FOLDERS = leaks.lab_folders(ROOT)
 # A make that runs this test passes its command line on (MAKEFLAGS); the release and its
@@ -142,7 +142,7 @@ def test_lab01_release_layout(pristine01):
         ]
         + [f"lab{n}-ref" for n in ("05", "06", "07") if shutil.which("nvcc")]
     )
-    for gone in ("tests/grading", "tools/skeletons.py", "grading/release.py", "ref", ".ci"):
+    for gone in ("tests/grading", "labkit/skeletons.py", "grading/release.py", "ref", ".ci"):
         assert not (release01 / gone).exists(), gone
     assert not list(pristine01.parent.glob(".*partial*")), "a partial release was left behind"
 
@@ -326,7 +326,8 @@ def test_leak_check_finds_a_planted_leak(tmp_path, pristine01, plant):
 
 def test_leak_check_finds_the_hidden_scene(tmp_path, pristine01):
     """The secret's scene saved among the scenes leaks the secret as surely as the secret."""
-    from grading import hidden, scenes
+    from grading import hidden
+    from labkit import scenes
     release = tmp_path / "release"
     shutil.copytree(pristine01, release, symlinks=True)
     secret = "0123456789abcdef0123456789abcdef"

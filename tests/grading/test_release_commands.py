@@ -25,7 +25,7 @@ import subprocess
 import pytest
 
 from grading import leaks
-from grading.harness import ROOT
+from labkit.harness import ROOT
 
 LABS = os.environ.get("RT_RELEASE_LABS", "01,02,03,04").split(",")
 FOLDERS = leaks.lab_folders(ROOT)
@@ -45,29 +45,29 @@ QUICK_MPI = "--width 48 --height 48 --spp 4 --repeat 1 --no-capacity"
 REDUCED = {
     "make bench-serial": "make bench-serial BENCH_ARGS='--repeat 1 --small'",
     "make tradeoff": "make tradeoff QUICK=1 PLOTS=0",
-    "python3 tools/bench_openmp.py": f"python3 tools/bench_openmp.py {QUICK_OPENMP}",
-    "python3 tools/bench_openmp.py --min-capacity 1.8":
-        f"python3 tools/bench_openmp.py {QUICK_OPENMP}",
-    "python3 tools/bench_openmp.py --mine": f"python3 tools/bench_openmp.py --mine {QUICK_OPENMP}",
-    "python3 tools/bench_openmp.py --mine --no-rng":
-        f"python3 tools/bench_openmp.py --mine --no-rng {QUICK_OPENMP}",
-    "python3 tools/bench_simd.py": "python3 tools/bench_simd.py --size 32 --spp 8 --repeat 1",
-    "python3 tools/bench_simd.py --full --only lab02-ref-avx2":
-        "python3 tools/bench_simd.py --size 32 --spp 8 --repeat 1 --only lab02-ref-avx2",
-    "python3 tools/bench_simd.py --packets":
-        "python3 tools/bench_simd.py --packets --size 32 --spp 8 --repeat 1",
-    "python3 tools/bench_simd.py --full --only lab02":
-        "python3 tools/bench_simd.py --size 32 --spp 8 --repeat 1 --only lab02",
-    "python3 tools/bench_simd.py --only lab02 --only lab02a":
-        "python3 tools/bench_simd.py --size 32 --spp 8 --repeat 1 --only lab02 --only lab02a",
-    "python3 tools/bench_mpi.py table": f"python3 tools/bench_mpi.py table {QUICK_MPI} "
+    "python3 -m tools.bench.openmp": f"python3 -m tools.bench.openmp {QUICK_OPENMP}",
+    "python3 -m tools.bench.openmp --min-capacity 1.8":
+        f"python3 -m tools.bench.openmp {QUICK_OPENMP}",
+    "python3 -m tools.bench.openmp --mine": f"python3 -m tools.bench.openmp --mine {QUICK_OPENMP}",
+    "python3 -m tools.bench.openmp --mine --no-rng":
+        f"python3 -m tools.bench.openmp --mine --no-rng {QUICK_OPENMP}",
+    "python3 -m tools.bench.simd": "python3 -m tools.bench.simd --size 32 --spp 8 --repeat 1",
+    "python3 -m tools.bench.simd --full --only lab02-ref-avx2":
+        "python3 -m tools.bench.simd --size 32 --spp 8 --repeat 1 --only lab02-ref-avx2",
+    "python3 -m tools.bench.simd --packets":
+        "python3 -m tools.bench.simd --packets --size 32 --spp 8 --repeat 1",
+    "python3 -m tools.bench.simd --full --only lab02":
+        "python3 -m tools.bench.simd --size 32 --spp 8 --repeat 1 --only lab02",
+    "python3 -m tools.bench.simd --only lab02 --only lab02a":
+        "python3 -m tools.bench.simd --size 32 --spp 8 --repeat 1 --only lab02 --only lab02a",
+    "python3 -m tools.bench.mpi table": f"python3 -m tools.bench.mpi table {QUICK_MPI} "
                                        f"--ranks 1,2 --hybrid 1x2",
-    "python3 tools/bench_mpi.py table --repeat 5 --ranks 2 --hybrid 1x2":
-        f"python3 tools/bench_mpi.py table {QUICK_MPI} --ranks 2 --hybrid 1x2",
-    "python3 tools/bench_mpi.py table --ranks 1,2,4,8,16 --hybrid 1x16,2x8,4x4,8x2":
-        f"python3 tools/bench_mpi.py table {QUICK_MPI} --ranks 1,2,4 --hybrid 1x2,2x1",
-    "python3 tools/bench_mpi.py rows --bands 8 --width 600 --height 600 --spp 32":
-        "python3 tools/bench_mpi.py rows --bands 4 --width 48 --height 48 --spp 4 --repeat 1",
+    "python3 -m tools.bench.mpi table --repeat 5 --ranks 2 --hybrid 1x2":
+        f"python3 -m tools.bench.mpi table {QUICK_MPI} --ranks 2 --hybrid 1x2",
+    "python3 -m tools.bench.mpi table --ranks 1,2,4,8,16 --hybrid 1x16,2x8,4x4,8x2":
+        f"python3 -m tools.bench.mpi table {QUICK_MPI} --ranks 1,2,4 --hybrid 1x2,2x1",
+    "python3 -m tools.bench.mpi rows --bands 8 --width 600 --height 600 --spp 32":
+        "python3 -m tools.bench.mpi rows --bands 4 --width 48 --height 48 --spp 4 --repeat 1",
     # run by the tests below, once each
     "make grade": None, "make grade LAB=01": None, "make grade LAB=02": None,
     "make grade LAB=03": None, "make grade LAB=04": None, "make test": None, "make render": None,
@@ -78,8 +78,9 @@ REDUCED = {
 NOT_HERE = {
     "mpirun --hostfile hosts -np 16 ./lab04-ref --out cornell.ppm": "needs several hosts",
     "for h in node2 node3; do ssh $h mkdir -p $PWD/common/scenes; \\": "needs several hosts",
-    "sudo tools/netns_hosts.sh up rt": "creates network namespaces: root, and a test of its own "
-                                       "(tests/labs/test_lab04.py::test_two_hosts)",
+    "sudo labs/04-mpi/netns_hosts.sh up rt":
+        "creates network namespaces: root, and a test of its own "
+        "(tests/labs/test_lab04.py::test_two_hosts)",
     "mpirun -np 2 --map-by slot:PE=4 ./lab04 --threads 4": "needs 8 cores",
 }
 # Commands that must fail, with this exit status (showing what an error looks like).
@@ -266,7 +267,7 @@ def test_bench_cpu_builds_only_what_it_times():
     no prerequisite of bench-cpu, and the tool names the CPU binaries it builds."""
     p = subprocess.run(["make", "-n", "-C", str(ROOT), "bench-cpu"], capture_output=True,
                        text=True, check=True, env=CLEAN_ENV)
-    assert [line for line in p.stdout.splitlines() if "bench_cpu.py" in line] and \
+    assert [line for line in p.stdout.splitlines() if "tools.bench.cpu" in line] and \
         "nvcc" not in p.stdout and "g++" not in p.stdout, p.stdout
-    source = (ROOT / "tools" / "bench_cpu.py").read_text()
+    source = (ROOT / "tools" / "bench" / "cpu.py").read_text()
     assert "load average" in source and "capacity" in source

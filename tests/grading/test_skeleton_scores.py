@@ -5,8 +5,8 @@ test_grade.py."""
 import pytest
 
 from grading.grade import describe, grade
-from grading.harness import build, cpu_has_avx2
-from grading.variants import build_pristine_skeleton
+from labkit.harness import build, cpu_has_avx2
+from labkit.variants import build_pristine_skeleton
 
 # Lab 03's skeleton renders lab 01's bits on one core, as lab01-ref does, and lab01-ref handed
 # in for lab 03 is graded in test_grade.py: not again here, a speedup measurement is slow.

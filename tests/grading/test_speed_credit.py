@@ -46,7 +46,8 @@ def test_a_cpu_quota_below_two_cores_times_nothing(monkeypatch):
     """Gradescope's default container (--cpus=0.5) sees every CPU of the host, but may use
     half of one: the capacity is the cgroup's quota, and a parallel lab is not timed there:
     correctness is graded, the speed marked for regrade with its points shown apart."""
-    from grading import checks, harness
+    from grading import checks
+    from labkit import harness
     monkeypatch.setattr(harness, "cpu_quota", lambda: 0.5)
     assert harness.cpu_capacity() == 0.5 and harness.available_cores() == 1
     result = checks.check_parallel_speedup("/nonexistent", "/nonexistent")
@@ -58,7 +59,7 @@ def test_the_quota_is_read_from_the_cgroup():
     """Whatever this machine's quota, the capacity never exceeds the CPUs it may run on."""
     import os
 
-    from grading import harness
+    from labkit import harness
     quota = harness.cpu_quota()
     assert quota is None or quota > 0
     assert 0 < harness.cpu_capacity() <= len(os.sched_getaffinity(0))

@@ -7,7 +7,7 @@ import pytest
 
 from grading import symptoms
 from grading.grade import describe, grade, passed_by_check
-from grading.harness import build
+from labkit.harness import build
 from tests.grading.submissions import altered_reference
 
 # mistake -> (the change to the image, a check that must fail, words its message must hold).
@@ -56,7 +56,7 @@ def test_the_reference_is_named_nothing(lab01_ref, tmp_path):
 
 def interior(bounces: int) -> float:
     """The sphere interior's closed form (albedo 0.6, radius 2, intensity 3)."""
-    from grading.scenes import sphere_interior_radiance
+    from labkit.scenes import sphere_interior_radiance
     return sphere_interior_radiance(0.6, 2.0, 3.0, bounces)
 
 

@@ -10,7 +10,7 @@ import sys
 import pytest
 
 from grading import sandbox
-from grading.harness import GOLDEN, ROOT, build
+from labkit.harness import GOLDEN, ROOT, build
 from tests.grading import submissions as sub
 
 NO_NAMESPACES = [

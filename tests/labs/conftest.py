@@ -2,11 +2,11 @@
 
 Tests that need only nvcc (building, the compiler's report, bad input, which the shared main
 rejects before any GPU work) run wherever nvcc is, CI included. Tests that render need an
-NVIDIA GPU; elsewhere they skip and say why. tools/gpu_check.sh runs them on a GPU machine."""
+NVIDIA GPU; elsewhere they skip and say why. tools/gpu/check.sh runs them on a GPU machine."""
 import pytest
 from cuda_env import missing_gpu, missing_nvcc
 
-from grading.harness import build
+from labkit.harness import build
 
 
 @pytest.fixture(scope="session")

@@ -3,7 +3,7 @@ import functools
 import shutil
 import subprocess
 
-NO_GPU_HINT = "tools/gpu_check.sh runs the GPU tests on a machine with one"
+NO_GPU_HINT = "tools/gpu/check.sh runs the GPU tests on a machine with one"
 
 
 @functools.lru_cache(maxsize=None)

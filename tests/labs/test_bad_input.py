@@ -7,7 +7,7 @@ import time
 
 import pytest
 
-from grading.harness import ROOT
+from labkit.harness import ROOT
 
 GOOD = json.loads((ROOT / "common" / "scenes" / "cornell.json").read_text())
 

@@ -1,11 +1,11 @@
 """The host+device code in common/ compiles under nvcc (the CUDA labs reuse it). Nothing runs
-on a GPU here; the CUDA labs' own tests do that on a machine with a GPU (tools/gpu_check.sh)."""
+on a GPU here; the CUDA labs' own tests do that on a machine with a GPU (tools/gpu/check.sh)."""
 import shutil
 import subprocess
 
 import pytest
 
-from grading.harness import ROOT
+from labkit.harness import ROOT
 
 
 @pytest.mark.skipif(shutil.which("nvcc") is None, reason="no CUDA toolkit (nvcc) on this machine")

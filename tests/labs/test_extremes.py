@@ -13,9 +13,10 @@ common/core/real.h); docs/extremes.md tabulates what each measured
 """
 import pytest
 
-from grading import checks, scenes
-from grading.compare import compare
-from grading.harness import build, golden, run_lab
+from grading import checks
+from labkit import scenes
+from labkit.compare import compare
+from labkit.harness import build, golden, run_lab
 
 
 @pytest.fixture(scope="module", params=["lab01-ref", "lab01-ref-double"])

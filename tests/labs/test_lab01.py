@@ -1,11 +1,12 @@
 """Lab 01 (serial): the reference passes every correctness check, the skeleton visibly does
 not, and both honour the shared command line."""
 import subprocess
+import sys
 
 import pytest
 
 from grading import checks
-from grading.harness import ROOT, run_lab
+from labkit.harness import ROOT, run_lab
 
 
 @pytest.mark.parametrize("check", [
@@ -58,7 +59,7 @@ def test_summary_line_and_json(lab01_ref):
 
 def test_default_scene_settings_are_the_baseline():
     """The report's baseline lives in the default scene: 600x600, 512 spp, 4 bounces."""
-    from grading import scenes
+    from labkit import scenes
     assert scenes.load("cornell")["render"] == {"width": 600, "height": 600, "spp": 512,
                                                 "bounces": 4}
 
@@ -69,7 +70,7 @@ def test_ppm_is_srgb_of_pfm(lab01_ref, tmp_path):
                     "--out", str(ppm), "--pfm", str(pfm)], check=True)
     import numpy as np
 
-    from grading.pfm import read_pfm
+    from labkit.pfm import read_pfm
     linear = np.clip(read_pfm(pfm), 0, 1)
     srgb = np.where(linear <= 0.0031308, 12.92 * linear, 1.055 * linear ** (1 / 2.4) - 0.055)
     data = ppm.read_bytes()
@@ -79,8 +80,8 @@ def test_ppm_is_srgb_of_pfm(lab01_ref, tmp_path):
 
 
 def test_skeletons_in_sync():
-    """The committed skeletons are exactly what tools/skeletons.py makes from the solutions."""
-    p = subprocess.run(["python3", str(ROOT / "tools" / "skeletons.py"), "--check"],
+    """The committed skeletons are exactly what labkit/skeletons.py makes from the solutions."""
+    p = subprocess.run([sys.executable, "-m", "labkit.skeletons", "--check"], cwd=ROOT,
                        capture_output=True, text=True)
     assert p.returncode == 0, p.stderr
 
@@ -88,7 +89,7 @@ def test_skeletons_in_sync():
 def test_skeletons_carry_no_instructor_text():
     """What students receive says nothing of solutions: no markers, no instructor-only ('//!')
     lines, no path into a solution folder."""
-    from grading.variants import pristine_skeleton_sources
+    from labkit.variants import pristine_skeleton_sources
     leaks = ["BEGIN SOLUTION", "END SOLUTION", "//!", "solution/", "skeletons.py"]
     for lab in sorted(p.name for p in (ROOT / "labs").iterdir() if (p / "solution").is_dir()):
         for name, text in pristine_skeleton_sources(lab).items():

@@ -13,8 +13,8 @@ import pathlib
 import pytest
 
 from grading import checks
-from grading.harness import ROOT
-from grading.variants import build_variant
+from labkit.harness import ROOT
+from labkit.variants import build_variant
 
 CHECKS = {
     "interior": checks.check_sphere_interior,

@@ -25,7 +25,7 @@ import subprocess
 import pytest
 
 from grading import checks
-from grading.harness import (
+from labkit.harness import (
     ROOT,
     available_cores,
     build,
@@ -34,7 +34,7 @@ from grading.harness import (
     render_seconds,
     run_lab,
 )
-from grading.variants import build_pristine_skeleton, build_sources, pristine_skeleton_sources
+from labkit.variants import build_pristine_skeleton, build_sources, pristine_skeleton_sources
 
 
 def cpu_has_avx512() -> bool:
@@ -313,7 +313,7 @@ def test_missing_avx2_is_one_clear_line(binary, tmp_path):
 def test_part_b_faster_than_lab01(lab01_ref, binary):
     """The references' speedup over lab 01 on one core, interleaved, best of 3. The bars (2.4x
     for 8 AVX2 lanes, 3.5x for lab02-ref on AVX-512, on the Cornell box) are measured by
-    tools/bench_simd.py --packets; the threshold here holds with a wide margin on a busy
+    python3 -m tools.bench.simd --packets; the threshold here holds with a wide margin on a busy
     two-core machine."""
     candidate = build(binary)[0]
     kwargs = dict(width=100, height=100, spp=32)

@@ -7,7 +7,7 @@ import os
 import pytest
 
 from grading import checks
-from grading.harness import (
+from labkit.harness import (
     available_cores,
     build,
     cpu_has_avx2,
@@ -15,7 +15,7 @@ from grading.harness import (
     render_seconds,
     run_lab,
 )
-from grading.variants import build_pristine_skeleton
+from labkit.variants import build_pristine_skeleton
 
 # Small renders for the bitwise comparisons: every pixel, sample and bounce is exercised.
 SMALL = dict(width=48, height=40, spp=8, seed=3)
@@ -99,7 +99,7 @@ def test_skeleton_is_correct(lab03_skeleton, lab01_bits, threads):
 @pytest.fixture(scope="module")
 def speedups(lab01_ref, lab03_ref, lab03_skeleton):
     """Speedups over lab01-ref of lab03-ref and of the skeleton with every core, measured with
-    the machine's capacity alongside (grading.harness.measure_parallel)."""
+    the machine's capacity alongside (labkit.harness.measure_parallel)."""
     if available_cores() < 2:
         pytest.skip("only one core available to this process: no parallel speedup to measure")
     timing = measure_parallel(lambda: render_seconds(lab01_ref, **TIMED),
@@ -159,7 +159,7 @@ def test_simd_variant_is_lab01_bit_for_bit(lab03_simd_ref, lab01_bits, monkeypat
 def test_shared_rng_is_not_lab01(variant, lab01_bits):
     """The classic mistake renders a plausible image, but not lab 01's: a stateful generator
     cannot give each (pixel, sample, dimension) its own number. (It is also slower and not
-    repeatable from run to run; tools/bench_openmp.py measures that rather than a test,
+    repeatable from run to run; tools/bench/openmp.py measures that rather than a test,
     since neither is guaranteed on every machine.)"""
     binary = build(variant)[0]
     run = run_lab(binary, threads=2, **SMALL)

@@ -22,11 +22,11 @@ import numpy as np
 import pytest
 
 from grading import checks
-from grading.harness import ROOT, available_cores, build, cpu_has_avx2, render_seconds, run_lab
+from labkit.harness import ROOT, available_cores, build, cpu_has_avx2, render_seconds, run_lab
 
 DISTRIBUTIONS = ["block", "interleaved", "dynamic"]
 SMALL = dict(width=40, height=30, spp=4)  # milliseconds of rendering: mpirun's start dominates
-NETNS = ROOT / "tools" / "netns_hosts.sh"
+NETNS = ROOT / "labs" / "04-mpi" / "netns_hosts.sh"
 
 
 def mpirun(ranks, *extra):
@@ -64,9 +64,9 @@ def lab04():
 
 @pytest.fixture(scope="module")
 def lab04_pristine_skeleton(tmp_path_factory, lab04_ref):
-    """The skeleton exactly as tools/skeletons.py generates it (students' edits to theirs do
+    """The skeleton exactly as labkit/skeletons.py generates it (students' edits to theirs do
     not matter here), built as `make lab04` builds it."""
-    from grading.variants import build_pristine_skeleton
+    from labkit.variants import build_pristine_skeleton
     return build_pristine_skeleton("04-mpi", tmp_path_factory.mktemp("lab04-skeleton"))
 
 
@@ -208,7 +208,7 @@ class Speed:
         """75% of the capacity measured alongside: 1.5x on an idle two-core machine, and
         still fair when other jobs share it (the kernel shares CPUs among sessions, so two
         processes may get little more than one). The lab's real bar, 1.8x at two ranks, is
-        what tools/bench_mpi.py and the handout measure on a quiet machine."""
+        what tools/bench/mpi.py and the handout measure on a quiet machine."""
         return 0.75 * self.capacity
 
     def check(self, name, seconds):
@@ -357,7 +357,7 @@ HOST_A, HOST_B = "10.213.0.1", "10.213.0.2"
 @pytest.fixture
 def two_hosts():
     """Two hosts on this machine: network namespaces with their own addresses and names, joined
-    by a veth pair (tools/netns_hosts.sh). Always removed afterwards."""
+    by a veth pair (labs/04-mpi/netns_hosts.sh). Always removed afterwards."""
     if os.geteuid() != 0:
         pytest.skip("the two-host test creates network namespaces, which needs root")
     for tool in ("ip", "unshare"):

@@ -16,8 +16,8 @@ import pytest
 from cuda_env import gpu_name, missing_gpu
 
 from grading import checks
-from grading.compare import compare
-from grading.harness import ROOT, build, golden, run_lab
+from labkit.compare import compare
+from labkit.harness import ROOT, build, golden, run_lab
 
 LAB = "05-cuda-mega"
 # The H200 test's bar: the reference's best recorded time on the baseline (reference/gpu/)
@@ -79,8 +79,8 @@ def test_speed_target_verdicts(nvcc):
 
 
 def test_skeleton_in_sync():
-    """The committed skeleton is exactly what tools/skeletons.py makes from the solution."""
-    from grading.variants import pristine_skeleton_sources
+    """The committed skeleton is exactly what labkit/skeletons.py makes from the solution."""
+    from labkit.variants import pristine_skeleton_sources
     expected = pristine_skeleton_sources(LAB)
     assert set(expected) == {"megakernel.cuh", "render.cu"}
     for name, text in expected.items():
@@ -128,7 +128,7 @@ def test_a_variant_needs_every_file_students_write(nvcc, tmp_path):
     """A CUDA lab built from a folder (a submission, the pristine skeleton) must hold each file
     its students write: without megakernel.cuh the shared reference of that name
     (common/cuda/megakernel.cuh) would be compiled in its place. One line, nothing built."""
-    from grading.variants import pristine_skeleton_sources
+    from labkit.variants import pristine_skeleton_sources
     (tmp_path / "render.cu").write_text(pristine_skeleton_sources(LAB)["render.cu"])
     p = make("cuda-variant", f"VARIANT_LAB={LAB}", f"VARIANT={tmp_path}")
     assert p.returncode != 0
@@ -247,7 +247,7 @@ def test_band_too_small_is_one_line(gpu, lab05_ref):
 @pytest.fixture(scope="module")
 def lab05_pristine_skeleton(nvcc, tmp_path_factory):
     """The skeleton as generated from the solution, built as `make lab05` builds it."""
-    from grading.variants import pristine_skeleton_sources
+    from labkit.variants import pristine_skeleton_sources
     folder = tmp_path_factory.mktemp("lab05-skeleton")
     for name, text in pristine_skeleton_sources(LAB).items():
         (folder / name).write_text(text)

@@ -23,8 +23,8 @@ from cuda_env import gpu_name, missing_gpu
 from renderer_checks import CHECKS
 
 from grading import checks
-from grading.compare import compare
-from grading.harness import ROOT, build, golden, run_lab
+from labkit.compare import compare
+from labkit.harness import ROOT, build, golden, run_lab
 
 LAB = "06-cuda-split"
 # The H200 test's bar: the reference's best recorded time on the baseline (reference/gpu/)
@@ -60,7 +60,7 @@ def no_gpu_is_one_line(binary, tmp_path):
 
 def pristine_skeleton(lab, tmp_path_factory):
     """The skeleton as generated from the solution, built as `make labNN` builds it."""
-    from grading.variants import pristine_skeleton_sources
+    from labkit.variants import pristine_skeleton_sources
     folder = tmp_path_factory.mktemp(lab + "-skeleton")
     for name, text in pristine_skeleton_sources(lab).items():
         (folder / name).write_text(text)
@@ -132,9 +132,9 @@ def test_targets_build_with_nvcc(lab06_ref):
 
 
 def test_skeleton_in_sync():
-    """The committed skeleton is exactly what tools/skeletons.py makes from the solution:
+    """The committed skeleton is exactly what labkit/skeletons.py makes from the solution:
     the queue's reserve and the stage loop are what students write."""
-    from grading.variants import pristine_skeleton_sources
+    from labkit.variants import pristine_skeleton_sources
     expected = pristine_skeleton_sources(LAB)
     assert set(expected) == {"path_queue.cuh", "render.cu", "stage_loop.cuh"}
     for name, text in expected.items():
@@ -181,7 +181,7 @@ def test_no_lab_reads_another_labs_folder(nvcc, folder):
 @pytest.mark.parametrize("folder", sorted(CUDA_LABS))
 def test_student_files_are_what_the_build_requires(folder):
     """The files a hand-in must hold (cuda.mk's CUDA_STUDENT_FILES_<lab>) are the shared files
-    the lab's students write (tools/skeletons.py's SHARED_SOURCES), each of which their
+    the lab's students write (labkit/skeletons.py's SHARED_SOURCES), each of which their
     skeleton/ holds and no solution/ does: the shared file is the reference."""
     from grading.leaks import skeletons
     p = make("--eval", f"print-student-files: ; @echo $(CUDA_STUDENT_FILES_{folder})",

@@ -20,7 +20,7 @@ from test_lab06 import (
 )
 
 from grading import checks
-from grading.harness import ROOT, build, golden, run_lab
+from labkit.harness import ROOT, build, golden, run_lab
 
 LAB = "07-soa"
 
@@ -42,7 +42,7 @@ def test_targets_build_with_nvcc(lab07_ref):
 
 
 def test_skeleton_in_sync():
-    from grading.variants import pristine_skeleton_sources
+    from labkit.variants import pristine_skeleton_sources
     expected = pristine_skeleton_sources(LAB)
     assert set(expected) == {"path_pool_soa.cuh", "render.cu"}
     for name, text in expected.items():

@@ -10,8 +10,9 @@ import subprocess
 import pytest
 from renderer_checks import CHECKS
 
-from grading import checks, scenes
-from grading.harness import ROOT, build, run_lab
+from grading import checks
+from labkit import scenes
+from labkit.harness import ROOT, build, run_lab
 
 
 @pytest.fixture(scope="module")
@@ -75,7 +76,7 @@ def test_double_build_accepts_wider_scales(lab01_ref, lab01_ref_double, tmp_path
 
 def test_lab05_double_builds(nvcc):
     """nvcc compiles the megakernel with real = double (CI has nvcc, not a GPU). Where a
-    GPU is, test_lab05.py's test_double_build_passes renders with it (tools/gpu_check.sh
+    GPU is, test_lab05.py's test_double_build_passes renders with it (tools/gpu/check.sh
     runs that file)."""
     binary = build("lab05-ref-double")[0]
     assert os.access(binary, os.X_OK)

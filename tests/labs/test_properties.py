@@ -25,10 +25,10 @@ import numpy as np
 import pytest
 from cuda_env import missing_gpu
 
-from grading import scenes
-from grading.compare import compare
-from grading.harness import ROOT, build, cpu_has_avx2, golden, run_lab
-from grading.variants import build_sources, lab_sources
+from labkit import scenes
+from labkit.compare import compare
+from labkit.harness import ROOT, build, cpu_has_avx2, golden, run_lab
+from labkit.variants import build_sources, lab_sources
 
 
 @pytest.fixture(scope="module", params=["lab01-ref", "lab01-ref-double"])

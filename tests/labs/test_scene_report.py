@@ -6,7 +6,7 @@ import copy
 import json
 import subprocess
 
-from grading.harness import ROOT, build
+from labkit.harness import ROOT, build
 
 CORNELL = json.loads((ROOT / "common" / "scenes" / "cornell.json").read_text())
 

@@ -1,4 +1,4 @@
-"""`make bench` (tools/bench_report.py): the quick mode runs end to end and writes a sane
+"""`make bench` (tools/bench/report.py): the quick mode runs end to end and writes a sane
 report; --merge adds made-up GPU rows; --gpu-only writes its rows with a stand-in GPU and
 binary and without matplotlib; bad input is one line and exit 2; the report's numbers as
 transcribed agree with the speedups the report prints.
@@ -15,18 +15,15 @@ import sys
 
 import pytest
 
-from grading.harness import ROOT, available_cores
+from labkit.harness import ROOT, available_cores
+from tools.bench import report_data as data
 
-sys.path.insert(0, str(ROOT / "tools"))
-import bench_report_data as data  # noqa: E402
-
-TOOL = ROOT / "tools" / "bench_report.py"
 SETTINGS = 7  # the baseline, and two more points of each of the three sweeps
 
 
 def tool(*args, env=None, timeout=600):
-    return subprocess.run([sys.executable, str(TOOL), *map(str, args)], capture_output=True,
-                          text=True, env=env, timeout=timeout)
+    return subprocess.run([sys.executable, "-m", "tools.bench.report", *map(str, args)],
+                          cwd=ROOT, capture_output=True, text=True, env=env, timeout=timeout)
 
 
 @pytest.fixture(scope="module")

@@ -1,4 +1,4 @@
-"""tools/gpu_report.py's summary, on the CPU: the tables it makes of a recorded gpu-check.json
+"""tools/gpu/report.py's summary, on the CPU: the tables it makes of a recorded gpu-check.json
 (the H200 record in reference/gpu/h200), and its one-line error.
 
 That record holds no test results (its `tests` entry is the error of a missing junit file)
@@ -12,9 +12,8 @@ import pathlib
 import subprocess
 import sys
 
-ROOT = pathlib.Path(__file__).resolve().parents[2]
-sys.path.insert(0, str(ROOT / "tools"))
-import gpu_report  # noqa: E402
+from labkit.harness import ROOT
+from tools.gpu import report as gpu_report
 
 RECORDED = ROOT / "reference" / "gpu" / "h200"
 WITH_TESTS = pathlib.Path(__file__).resolve().parent / "fixtures" / "gpu-check-h200.json"
@@ -98,7 +97,8 @@ def test_unreadable_json_is_one_line_and_status_2(tmp_path):
     bad = tmp_path / "gpu-check.json"
     bad.write_text("{not json")
     p = subprocess.run(
-        [sys.executable, str(ROOT / "tools" / "gpu_report.py"), "--summary", str(bad)],
+        [sys.executable, "-m", "tools.gpu.report", "--summary", str(bad)],
+        cwd=ROOT,
         capture_output=True,
         text=True,
     )

@@ -5,7 +5,7 @@ bounce early (the bias check's closed form catches it).
 
 Measuring without matplotlib (PLOTS=0, the GPU machine) and drawing later (--replot): the
 quick run is made with matplotlib blocked, then replotted; tradeoff.json reads back exactly.
-The GPU machine's plan (--plan gpu, tools/tradeoff_gpu.sh) stops in one line where no GPU
+The GPU machine's plan (--plan gpu, tools/gpu/tradeoff.sh) stops in one line where no GPU
 can run it, shown here with a stand-in nvidia-smi (skipped where a real GPU is present).
 
 CI cost, measured on a busy two-core machine: about a minute (the quick run, two mutants
@@ -23,17 +23,15 @@ import sys
 
 import pytest
 
-from grading import scenes
-from grading.harness import ROOT, build
-
-sys.path.insert(0, str(ROOT / "tools"))
-import tradeoff  # noqa: E402
-import tradeoff_bias  # noqa: E402
-import tradeoff_fit  # noqa: E402
-import tradeoff_record  # noqa: E402
-import tradeoff_report  # noqa: E402
-import tradeoff_series  # noqa: E402
-from tradeoff_sweep import Point, Sweep  # noqa: E402
+from labkit import scenes
+from labkit.harness import ROOT, build
+from tools.tradeoff import bias as tradeoff_bias
+from tools.tradeoff import fit as tradeoff_fit
+from tools.tradeoff import record as tradeoff_record
+from tools.tradeoff import report as tradeoff_report
+from tools.tradeoff import run as tradeoff
+from tools.tradeoff import series as tradeoff_series
+from tools.tradeoff.sweep import Point, Sweep
 
 SPP = [1 << k for k in range(11)]
 
@@ -80,7 +78,7 @@ def test_fit_refuses_bad_data():
 
 def test_bias_closed_form_agrees_with_the_centred_interior():
     """With the light at the centre, the render itself is known in closed form
-    (grading/scenes.py, checked by the grader): the difference of two bounce counts must be
+    (labkit/scenes.py, checked by the grader): the difference of two bounce counts must be
     the tool's closed form, which does not depend on where the light is."""
     params = dict(albedo=0.8, radius=2.0, intensity=3.0)
     for b, ref in [(1, 32), (5, 64), (16, 64)]:
@@ -102,7 +100,7 @@ def test_fixed_epsilon_variant_changes_only_the_offset():
 
 
 def run_tool(*args, env=None):
-    return subprocess.run([sys.executable, str(ROOT / "tools" / "tradeoff.py"), *map(str, args)],
+    return subprocess.run([sys.executable, "-m", "tools.tradeoff", *map(str, args)], cwd=ROOT,
                           capture_output=True, text=True, timeout=900, env=env)
 
 
@@ -208,7 +206,8 @@ def test_replot_refuses_what_is_not_a_record(tmp_path):
     p = run_tool("--replot", tmp_path)
     assert p.returncode == 2 and p.stdout == ""
     lines = p.stderr.strip().splitlines()
-    assert len(lines) == 1 and "not a record written by tools/tradeoff.py" in lines[0], lines
+    assert len(lines) == 1, lines
+    assert "not a record written by python3 -m tools.tradeoff" in lines[0], lines
 
 
 def test_gpu_plan_leaves_out_what_it_says():
@@ -222,8 +221,8 @@ def test_gpu_plan_leaves_out_what_it_says():
     assert [name for name, *_ in tradeoff_series.GPU_REFERENCES] == [
         "lab05-ref", "lab05 double", "lab05 fast-math", "lab06-ref", "lab07-ref"]
     targets = {target for _, target, *_ in tradeoff_series.GPU_REFERENCES}
-    script = (ROOT / "tools" / "tradeoff_gpu.sh").read_text()
-    assert all(t in script for t in targets), "tools/tradeoff_gpu.sh builds every GPU reference"
+    script = (ROOT / "tools" / "gpu" / "tradeoff.sh").read_text()
+    assert all(t in script for t in targets), "tools/gpu/tradeoff.sh builds every GPU reference"
     assert "lab05-ref" in tradeoff.EXTREME_CHECKED
 
 
@@ -269,14 +268,14 @@ def test_a_gpu_build_without_a_gpu_does_not_run(tmp_path):
 
 
 def run_gpu_script(out, env):
-    return subprocess.run(["bash", str(ROOT / "tools" / "tradeoff_gpu.sh"), str(out)],
+    return subprocess.run(["bash", str(ROOT / "tools" / "gpu" / "tradeoff.sh"), str(out)],
                           capture_output=True, text=True, timeout=300,
                           env={**env, "TRADEOFF_GPU_DRY_RUN": "1"})
 
 
 @pytest.mark.skipif(tradeoff_series.gpu_missing() is None, reason="a real GPU is present")
 def test_gpu_script_builds_for_the_gpu_present_and_runs_the_gpu_plan(tmp_path):
-    """tools/tradeoff_gpu.sh, dry: with an H200 listed it compiles CUDA code for sm_90 only
+    """tools/gpu/tradeoff.sh, dry: with an H200 listed it compiles CUDA code for sm_90 only
     and runs the gpu plan without plots into DIR/tradeoff; with none listed it stops at once."""
     p = run_gpu_script(tmp_path / "none", fake_nvidia_smi(tmp_path / "none-bin", False))
     assert p.returncode == 2 and "no NVIDIA GPU here" in p.stdout, p.stdout + p.stderr
@@ -288,7 +287,7 @@ def test_gpu_script_builds_for_the_gpu_present_and_runs_the_gpu_plan(tmp_path):
     assert "CUDA code for: -gencode arch=compute_90,code=sm_90 \n" in p.stdout, p.stdout
     make_line = next(ln for ln in p.stdout.splitlines() if "would run: make" in ln)
     assert {"lab01-ref", "lab05-ref", "lab05-ref-double"} <= set(make_line.split()), make_line
-    assert f"tools/tradeoff.py --plan gpu --no-plots --out {out}/tradeoff" in p.stdout
+    assert f"python3 -m tools.tradeoff --plan gpu --no-plots --out {out}/tradeoff" in p.stdout
     assert {f.name for f in out.iterdir()} == {"log.txt", "machine.txt", "tradeoff"}
 
 

@@ -1,7 +1,6 @@
-#!/usr/bin/env python3
 """Where the lab-01 reference's work goes, counted rather than timed.
 
-    python3 tools/count_work.py [--width 60 --height 60 --spp 16]
+    python3 -m tools.bench.count_work [--width 60 --height 60 --spp 16]
 
 Builds a copy of the lab-01 reference in which closest_hit and occluded are not inlined, runs
 it under valgrind's callgrind (instructions, and branches through callgrind's simple
@@ -11,7 +10,7 @@ queries, shadow queries and the rest (camera, shading, sampling, RNG, the sum).
 Why count: on a shared VM the render time of one build drifts by +-20% over minutes, so a 5%
 change to the path loop is lost in the timing noise. Instruction counts are exact and repeat
 bit for bit. They are not time (IPC varies, and a mispredicted branch costs ~15-20 cycles),
-so confirm a change that counts well with interleaved timings (tools/bench_cpu.py).
+so confirm a change that counts well with interleaved timings (tools/bench/cpu.py).
 
 The copy is built for x86-64-v3 (AVX2) because valgrind 3.19 cannot decode AVX-512; the
 reference itself is built with -march=native. Prints a table; asserts nothing. Needs
@@ -25,9 +24,9 @@ import subprocess
 import sys
 import tempfile
 
-ROOT = pathlib.Path(__file__).resolve().parent.parent
-sys.path.insert(0, str(ROOT))
-from grading.variants import build_sources  # noqa: E402
+from labkit.variants import build_sources
+
+ROOT = pathlib.Path(__file__).resolve().parents[2]
 
 # The two queries, kept out of line so that callgrind can count them.
 QUERIES = {

@@ -1,8 +1,7 @@
-#!/usr/bin/env python3
 """The CPU labs side by side, in the shape of the report's Table 4, on this machine.
 
     make bench-cpu                       Cornell at 300x300, 128 spp (quick)
-    tools/bench_cpu.py --full            the baseline: 600x600, 512 spp, 4 bounces
+    python3 -m tools.bench.cpu --full    the baseline: 600x600, 512 spp, 4 bounces
 
 Every row is a reference solution; time is render time as the binary reports it (best of
 --repeat, rows interleaved round by round so a busy spell hits all of them); speedup is
@@ -22,9 +21,9 @@ import re
 import subprocess
 import sys
 
-ROOT = pathlib.Path(__file__).resolve().parent.parent
-sys.path.insert(0, str(ROOT))
-from grading.harness import available_cores, measure_parallel, run_lab  # noqa: E402
+from labkit.harness import available_cores, measure_parallel, run_lab
+
+ROOT = pathlib.Path(__file__).resolve().parents[2]
 
 # OpenMPI refuses to run as root unless told; benchmarks run as whoever runs them.
 os.environ.setdefault("OMPI_ALLOW_RUN_AS_ROOT", "1")

@@ -1,10 +1,11 @@
-#!/usr/bin/env python3
 """Benchmarks of lab 04 (MPI): distributions x ranks, and hybrid MPI + OpenMP, against lab 01.
 
-    tools/bench_mpi.py table   seconds, speedup over lab01-ref and efficiency for each
+    make bench-mpi (python3 -m tools.bench.mpi table)
+                               seconds, speedup over lab01-ref and efficiency for each
                                distribution at 1, 2 and 4 ranks, and hybrid ranks x threads;
                                measured interleaved with lab01-ref, best of --repeat
-    tools/bench_mpi.py rows    what each band of rows costs: block and interleaved with
+    python3 -m tools.bench.mpi rows
+                               what each band of rows costs: block and interleaved with
                                --bands ranks, CPU time per rank (RT_MPI_REPORT), and the
                                speedup each would reach on that many equal, dedicated cores.
                                All ranks share one CPU (unless --cpus says otherwise), so the
@@ -24,9 +25,9 @@ import re
 import sys
 import time
 
-ROOT = pathlib.Path(__file__).resolve().parent.parent
-sys.path.insert(0, str(ROOT))
-from grading.harness import available_cores, build, run_lab  # noqa: E402
+from labkit.harness import available_cores, build, run_lab
+
+ROOT = pathlib.Path(__file__).resolve().parents[2]
 
 DISTRIBUTIONS = ["block", "interleaved", "dynamic"]
 # mpirun as the tests run it; OpenMPI refuses root unless told (benchmarks run as root in CI

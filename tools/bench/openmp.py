@@ -1,10 +1,10 @@
-#!/usr/bin/env python3
 """Benchmarks of lab 03 (OpenMP): loop schedules, thread counts and the shared-RNG mistake.
 
-    tools/bench_openmp.py                       the handout's tables on this machine
-    tools/bench_openmp.py --min-capacity 1.8    a shared machine: only rounds run while idle
-    tools/bench_openmp.py --mine --no-rng       your ./lab03 among the reference's rows
-    tools/bench_openmp.py --threads 1,2,4,8,16,32 --spp 64      a bigger machine
+    make bench-openmp (python3 -m tools.bench.openmp)   the handout's tables on this machine
+    python3 -m tools.bench.openmp --min-capacity 1.8    a shared machine: only rounds run
+                                                        while idle
+    python3 -m tools.bench.openmp --mine --no-rng       your ./lab03 among the reference's rows
+    python3 -m tools.bench.openmp --threads 1,2,4,8,16,32 --spp 64      a bigger machine
 
 Prints three tables and asserts nothing:
 
@@ -40,9 +40,9 @@ import subprocess
 import sys
 import tempfile
 
-ROOT = pathlib.Path(__file__).resolve().parent.parent
-sys.path.insert(0, str(ROOT))
-from grading.harness import available_cores, build, cpu_has_avx2, run_lab  # noqa: E402
+from labkit.harness import available_cores, build, cpu_has_avx2, run_lab
+
+ROOT = pathlib.Path(__file__).resolve().parents[2]
 
 SCHEDULES = ["static", "static,1", "dynamic,1", "dynamic,4", "guided"]
 # Private copies of the binaries (run() makes the folder, main() fills it): other people's

@@ -14,10 +14,10 @@ import sys
 
 import numpy as np
 
-ROOT = pathlib.Path(__file__).resolve().parent.parent
-sys.path.insert(0, str(ROOT))
-from grading.compare import compare  # noqa: E402
-from grading.harness import golden, run_lab  # noqa: E402
+from labkit.compare import compare
+from labkit.harness import golden, run_lab
+
+ROOT = pathlib.Path(__file__).resolve().parents[2]
 
 BUILDS = {"float": ROOT / "lab01-ref", "double": ROOT / "lab01-ref-double"}
 TIMED = dict(width=200, height=200, spp=64, seed=1)

@@ -1,4 +1,3 @@
-#!/usr/bin/env python3
 """The course report's Tables 4-7 for this machine (`make bench`).
 
     make bench                 every implementation this host runs, on the baseline (600x600,
@@ -7,10 +6,10 @@
                                round for the CPU labs on a busy two-core VM. SCALE=K divides
                                every image side by K (K*K less work) and the report says so.
     make bench QUICK=1         the CI size: sides / 5, spp / 4, one round (under a minute)
-    tools/bench_report.py --gpu-only --json-out gpu.json [--scale K | --quick]
+    python3 -m tools.bench.report --gpu-only --json-out gpu.json [--scale K | --quick]
                                on a GPU machine: only the CUDA labs, rows as JSON; needs
                                python3 with numpy and `make` (or built binaries, --bin-dir)
-    tools/bench_report.py --merge gpu.json --out DIR
+    python3 -m tools.bench.report --merge gpu.json --out DIR
                                adds those rows to the report already in DIR and redraws it
 
 Time is the render time each binary reports (CUDA-event kernel time on the GPU labs). Runs
@@ -31,14 +30,8 @@ import shutil
 import subprocess
 import sys
 
-ROOT = pathlib.Path(__file__).resolve().parent.parent
-sys.path.insert(0, str(ROOT))
-import bench_report_data as report  # noqa: E402
-import tradeoff_report  # noqa: E402  (Machine: CPU model, cores, date, load)
-import tradeoff_series  # noqa: E402  (make, gpu_missing, gpu_info; also sets Open MPI's root switches)
-
-from grading.checks import mpirun  # noqa: E402
-from grading.harness import (  # noqa: E402
+from grading.checks import mpirun
+from labkit.harness import (
     ImageError,
     RunError,
     available_cores,
@@ -46,6 +39,13 @@ from grading.harness import (  # noqa: E402
     measure_parallel,
     run_lab,
 )
+from tools.bench import report_data as report
+from tools.tradeoff import report as tradeoff_report  # (Machine: CPU model, cores, date, load)
+from tools.tradeoff import (
+    series as tradeoff_series,  # (make, gpu_missing, gpu_info; also sets Open MPI's root switches)
+)
+
+ROOT = pathlib.Path(__file__).resolve().parents[2]
 
 FORMAT = "bench-report rows v1"  # the JSON's "format": --merge refuses anything else
 
@@ -198,7 +198,7 @@ def render(impl: Impl, path: pathlib.Path, setting) -> dict:
 
 def capacity(serial: Impl, bin_dir: pathlib.Path, setting) -> float:
     """Cores' worth of throughput this run gets now: one lab01-ref render against one per
-    core at once (grading.harness.measure_parallel, as the grader measures it). On a shared
+    core at once (labkit.harness.measure_parallel, as the grader measures it). On a shared
     machine it is what bounds every parallel lab's speedup in the same round."""
     one = lambda: render(serial, bin_dir / serial.binary, setting)["seconds"]  # noqa: E731
     return measure_parallel(one, {}, rounds=1).capacity
@@ -255,7 +255,7 @@ def load_rows_json(path: pathlib.Path, what: str) -> dict:
     except ValueError as e:
         raise BadInput(f"{what} {path}: not JSON ({e})") from None
     if not isinstance(data, dict) or data.get("format") != FORMAT:
-        raise BadInput(f"{what} {path}: not rows written by tools/bench_report.py "
+        raise BadInput(f"{what} {path}: not rows written by tools/bench/report.py "
                        f"(no \"format\": \"{FORMAT}\")")
     for r in data.get("rows", []):
         ok = (isinstance(r, dict) and isinstance(r.get("binary"), str)
@@ -365,7 +365,7 @@ def main(argv=None) -> int:
             path.parent.mkdir(parents=True, exist_ok=True)
             path.write_text(json.dumps(data, indent=1) + "\n")
             log(f"bench: {len(rows)} GPU rows in {path}; merge them with "
-                f"tools/bench_report.py --merge {path.name} --out REPORT_DIR")
+                f"python3 -m tools.bench.report --merge {path.name} --out REPORT_DIR")
             return 0
         import bench_report_output
         bench_report_output.write_all(out, data)

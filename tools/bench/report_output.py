@@ -13,8 +13,9 @@ import statistics
 import matplotlib
 
 matplotlib.use("Agg")  # files only, no display
-import bench_report_data as report  # noqa: E402
 import matplotlib.pyplot as plt  # noqa: E402
+
+from tools.bench import report_data as report  # noqa: E402
 
 TITLES = {"baseline": "the baseline", "size": "image size (pixels a side)",
           "spp": "samples per pixel", "bounces": "bounces per ray"}

@@ -1,4 +1,3 @@
-#!/usr/bin/env python3
 """Benchmarks of the lab-01 reference (the baseline every speedup is measured against).
 
     make bench-serial the Cornell baseline (600x600, 512 spp, 4 bounces), best of --repeat
@@ -11,10 +10,10 @@ import math
 import pathlib
 import sys
 
-ROOT = pathlib.Path(__file__).resolve().parent.parent
-sys.path.insert(0, str(ROOT))
-from grading.compare import compare  # noqa: E402
-from grading.harness import golden, run_lab  # noqa: E402
+from labkit.compare import compare
+from labkit.harness import golden, run_lab
+
+ROOT = pathlib.Path(__file__).resolve().parents[2]
 
 BINARY = ROOT / "lab01-ref"
 

@@ -1,13 +1,14 @@
-#!/usr/bin/env python3
 """Lab 02 benchmark: the SIMD variants against the lab-01 reference, on one core.
 
-    python3 tools/bench_simd.py                   reduced Cornell baseline: 200x200, 512 spp
-    python3 tools/bench_simd.py --full            the Cornell baseline: 600x600, 512 spp (minutes)
-    python3 tools/bench_simd.py --packets         the handout's table of packet widths and methods:
-                                                  Cornell 400x400x64 and showcase 300x300x64 at 8
-                                                  bounces, best of 5, with the handout's targets
-    python3 tools/bench_simd.py --only lab02      one variant (yours: lab02, lab02a) against
-                                                  lab01-ref
+    make bench-simd (python3 -m tools.bench.simd)
+                                       reduced Cornell baseline: 200x200, 512 spp
+    python3 -m tools.bench.simd --full the Cornell baseline: 600x600, 512 spp (minutes)
+    python3 -m tools.bench.simd --packets
+                                       the handout's table of packet widths and methods:
+                                       Cornell 400x400x64 and showcase 300x300x64 at 8
+                                       bounces, best of 5, with the handout's targets
+    python3 -m tools.bench.simd --only lab02
+                                       one variant (yours: lab02, lab02a) against lab01-ref
 
 Every binary runs pinned to one CPU (taskset; --cpu picks which), interleaved (one of each,
 round after round), and each row reports its best round: a machine that slows down or speeds
@@ -25,9 +26,9 @@ import resource
 import shutil
 import sys
 
-ROOT = pathlib.Path(__file__).resolve().parent.parent
-sys.path.insert(0, str(ROOT))
-from grading.harness import build, run_lab  # noqa: E402
+from labkit.harness import build, run_lab
+
+ROOT = pathlib.Path(__file__).resolve().parents[2]
 
 # (row name, binary, environment, what). The references are timed by default; --only may
 # also name a student's build.

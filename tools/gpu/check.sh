@@ -20,12 +20,12 @@
 # GPU_CHECK_TESTS="FILE ..." runs only those test files: one call can be split into several
 # that each fit a time limit (build outputs are reused; each call writes its own DIR).
 #
-#   tools/gpu_check.sh DIR          run it (on the GPU machine)
-#   tools/gpu_check.sh --prepare    here, before sending the tree to a machine without the
+#   tools/gpu/check.sh DIR          run it (on the GPU machine)
+#   tools/gpu/check.sh --prepare    here, before sending the tree to a machine without the
 #                                   JSON library: copies its headers into .gpu-deps/ (git-ignored
 #                                   through .git/info/exclude; carry it with the tree)
 set -uo pipefail
-cd "$(dirname "$0")/.."
+cd "$(dirname "$0")/../.."
 root=$PWD
 
 if [ "${1:-}" = "--prepare" ]; then
@@ -44,7 +44,7 @@ if [ "${1:-}" = "--prepare" ]; then
     exit 0
 fi
 
-out=${1:?usage: tools/gpu_check.sh OUTDIR | --prepare}
+out=${1:?usage: tools/gpu/check.sh OUTDIR | --prepare}
 mkdir -p "$out"
 out=$(cd "$out" && pwd)
 log=$out/log.txt
@@ -81,7 +81,7 @@ if ! echo '#include <nlohmann/json.hpp>' | ${CXX:-g++} -std=c++17 -x c++ -fsynta
         export CPATH=$root/.gpu-deps/include${CPATH:+:$CPATH}
         say "JSON library: the carried copy in .gpu-deps/include (the grader's sandboxed builds will not see it)"
     else
-        say "JSON library missing: run tools/gpu_check.sh --prepare here and carry .gpu-deps"
+        say "JSON library missing: run tools/gpu/check.sh --prepare here and carry .gpu-deps"
     fi
 fi
 
@@ -170,9 +170,9 @@ if ! skipped ncu && [ -n "$ncu_bin" ] && [ -x lab05-bench ]; then
         step[ncu]=ok || step[ncu]=failed
 fi
 
-# Accuracy, process time, and the JSON and Markdown reports (tools/gpu_report.py).
+# Accuracy, process time, and the JSON and Markdown reports (tools/gpu/report.py).
 if ! skipped report; then
-    GPU_CHECK_METRICS=${metrics:-} python3 tools/gpu_report.py "$out" 2>&1 | tee -a "$log"
+    GPU_CHECK_METRICS=${metrics:-} python3 -m tools.gpu.report "$out" 2>&1 | tee -a "$log"
     step[report]=$([ "${PIPESTATUS[0]}" -eq 0 ] && echo ok || echo failed)
 fi
 

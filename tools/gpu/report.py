@@ -1,8 +1,8 @@
-"""The GPU check's measurements and report (tools/gpu_check.sh runs it on the GPU machine).
+"""The GPU check's measurements and report (tools/gpu/check.sh runs it on the GPU machine).
 
-    python3 tools/gpu_report.py OUT              measure (needs the GPU and the built labs),
+    python3 -m tools.gpu.report OUT              measure (needs the GPU and the built labs),
                                                  then write OUT/gpu-check.json, OUT/summary.md
-    python3 tools/gpu_report.py --summary JSON   only the summary, from a recorded gpu-check.json
+    python3 -m tools.gpu.report --summary JSON   only the summary, from a recorded gpu-check.json
 
 collect() runs what needs the GPU: every correctness check on the default, fast-math and
 no-FMA builds of lab 05, process time against kernel time, the flag variants' accuracy; it
@@ -19,8 +19,7 @@ import sys
 import time
 import xml.etree.ElementTree as ET
 
-ROOT = pathlib.Path(__file__).resolve().parent.parent
-sys.path.insert(0, str(ROOT))
+ROOT = pathlib.Path(__file__).resolve().parents[2]
 
 
 def collect(out: pathlib.Path) -> dict:
@@ -28,8 +27,8 @@ def collect(out: pathlib.Path) -> dict:
     import numpy as np
 
     from grading import checks
-    from grading.compare import compare
-    from grading.harness import golden, run_lab
+    from labkit.compare import compare
+    from labkit.harness import golden, run_lab
 
     result = {"machine": pathlib.Path("/tmp/gpu-check-machine.txt").read_text()}
 

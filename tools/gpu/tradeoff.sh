@@ -3,33 +3,33 @@
 # but no matplotlib and no package registry (the course's H200 machine):
 #   1. the machine: GPU, driver, nvcc, compilers, cores, load;
 #   2. the JSON library from the carried .gpu-deps/ where the compiler has none (as
-#      tools/gpu_check.sh does; `make deps` cannot run there);
+#      tools/gpu/check.sh does; `make deps` cannot run there);
 #   3. build what the gpu plan runs, -j(cores), CUDA code for the GPU present only (cuda.mk
 #      asks nvidia-smi for its compute capability: one architecture, not the six of its
 #      fallback);
-#   4. tools/tradeoff.py --plan gpu --no-plots: lab01-ref (the efficiency baseline), lab03-ref
+#   4. python3 -m tools.tradeoff --plan gpu --no-plots: lab01-ref (the efficiency baseline), lab03-ref
 #      and lab03-simd-ref (OpenMP on every core), lab05-ref, its double and --use_fast_math
 #      builds, lab06-ref and lab07-ref, and lab 01's double build, spp 1..4096 on the Cornell box and the extreme scene, the bias sweep;
 #      CSV, Markdown and tradeoff.json, no PNGs; stopped at the time budget;
 #   5. a short summary: the tables of the report.
 #
-#   bash tools/tradeoff_gpu.sh [DIR]     on the GPU machine; DIR defaults to $OUT (the device
+#   bash tools/gpu/tradeoff.sh [DIR]     on the GPU machine; DIR defaults to $OUT (the device
 #                                        call's folder), else build/reports/tradeoff-gpu
-#   TRADEOFF_GPU_DRY_RUN=1 bash tools/tradeoff_gpu.sh DIR   steps 1-2 and what 3-4 would run
+#   TRADEOFF_GPU_DRY_RUN=1 bash tools/gpu/tradeoff.sh DIR   steps 1-2 and what 3-4 would run
 #   TRADEOFF_GPU_BUDGET=S   seconds for the whole script (default 270: a 5-minute call's
 #                           limit less start-up and copying); the tool gets what the build
 #                           leaves, less 15 s for the summary
-#   TRADEOFF_PLAN=full      another plan of tools/tradeoff.py (full: not run there; the gpu
+#   TRADEOFF_PLAN=full      another plan of tools/tradeoff/run.py (full: not run there; the gpu
 #                           plan took 124 s in all on the H200 machine, build included)
 #
 # DIR then holds tradeoff/ (tradeoff.md, tradeoff.csv, tradeoff-fits.csv, tradeoff-bias.csv,
 # tradeoff.json), log.txt and machine.txt: 7 files. Back here, with matplotlib:
-#   python3 tools/tradeoff.py --replot COPY_OF_DIR/tradeoff
+#   python3 -m tools.tradeoff --replot COPY_OF_DIR/tradeoff
 # draws the plots and rewrites tradeoff.md with them.
 # Exit status: the tool's (0 PASS, 1 a check failed, 2 bad input / no GPU / a render failed,
 # 124 out of time: log.txt keeps every point measured until then).
 set -uo pipefail
-cd "$(dirname "$0")/.." || exit 2
+cd "$(dirname "$0")/../.." || exit 2
 start=$(date +%s)
 budget=${TRADEOFF_GPU_BUDGET:-270}
 plan=${TRADEOFF_PLAN:-gpu}
@@ -71,7 +71,7 @@ if ! echo '#include <nlohmann/json.hpp>' | ${CXX:-g++} -std=c++17 -x c++ -fsynta
         export CPATH=$PWD/.gpu-deps/include${CPATH:+:$CPATH}
         say "JSON library: the carried copy in .gpu-deps/include"
     else
-        say "JSON library missing: run tools/gpu_check.sh --prepare where make deps works, and carry .gpu-deps"
+        say "JSON library missing: run tools/gpu/check.sh --prepare where make deps works, and carry .gpu-deps"
         exit 2
     fi
 fi
@@ -94,11 +94,11 @@ say "build done at $(elapsed) s"
 # ---- 4. measure -------------------------------------------------------------------------
 left=$(( budget - $(elapsed) - 15 ))
 [ "$left" -gt 30 ] || { say "only $left s left of TRADEOFF_GPU_BUDGET=$budget after the build"; exit 124; }
-note="Measured by tools/tradeoff_gpu.sh on the GPU machine (no matplotlib there: plots drawn \
-afterwards from tradeoff.json by tools/tradeoff.py --replot); load average ${load_start} at the \
+note="Measured by tools/gpu/tradeoff.sh on the GPU machine (no matplotlib there: plots drawn \
+afterwards from tradeoff.json by python3 -m tools.tradeoff --replot); load average ${load_start} at the \
 start; GPU: ${gpus//$'\n'/, }."
-say "tools/tradeoff.py --plan $plan --no-plots, at most $left s"
-run timeout "$left" python3 tools/tradeoff.py --plan "$plan" --no-plots --out "$out/tradeoff" \
+say "python3 -m tools.tradeoff --plan $plan --no-plots, at most $left s"
+run timeout "$left" python3 -m tools.tradeoff --plan "$plan" --no-plots --out "$out/tradeoff" \
     --note "$note" 2>&1 | tee -a "$log"
 status=${PIPESTATUS[0]}
 [ -n "$dry" ] && status=0

@@ -1,7 +1,7 @@
 """Bias against bounces, measured and checked against a closed form.
 
 The scene: camera at the centre of a diffuse sphere (albedo rho, radius R), a point light of
-intensity I inside it, off the centre (tools/tradeoff_scenes.py). Two facts about a sphere's
+intensity I inside it, off the centre (tools/tradeoff/scenes.py). Two facts about a sphere's
 inside make the answer exact wherever the light is:
 - Every bit of the light's flux lands on the wall, so the wall's mean irradiance is
   4 pi I / (4 pi R^2) and its mean directly lit radiance is <L1> = rho I / (pi R^2).
@@ -28,17 +28,15 @@ from __future__ import annotations
 import dataclasses
 import math
 import pathlib
-import sys
 
 import numpy as np
 
-ROOT = pathlib.Path(__file__).resolve().parent.parent
-sys.path.insert(0, str(ROOT))
-import tradeoff_reference  # noqa: E402
-from tradeoff_series import first_words  # noqa: E402
+from labkit.compare import critical_z
+from labkit.harness import run_lab
+from tools.tradeoff import reference as tradeoff_reference
+from tools.tradeoff.series import first_words
 
-from grading.compare import critical_z  # noqa: E402
-from grading.harness import run_lab  # noqa: E402
+ROOT = pathlib.Path(__file__).resolve().parents[2]
 
 ALPHA = 1e-4
 # Float rounding of a path's value: the zero-variance interior of grading/checks.py differs

@@ -1,7 +1,7 @@
 """tradeoff.json: everything a `make tradeoff` report is made from, written by every run.
 
 Why: the GPU machine has numpy but no matplotlib and no package registry. A run there with
---no-plots writes the CSV, Markdown and this file; `tools/tradeoff.py --replot DIR` on a
+--no-plots writes the CSV, Markdown and this file; `python3 -m tools.tradeoff --replot DIR` on a
 machine with matplotlib reads it back and writes the plots and the same Markdown a run with
 plots would have written. The JSON is strict (no NaN literals): a float that is not finite
 (an efficiency with no usable error, an infinite standard error) is written as the string
@@ -14,10 +14,10 @@ import json
 import math
 import pathlib
 
-from tradeoff_bias import BiasPoint
-from tradeoff_fit import Fit
-from tradeoff_report import Machine
-from tradeoff_sweep import Point, Sweep
+from tools.tradeoff.bias import BiasPoint
+from tools.tradeoff.fit import Fit
+from tools.tradeoff.report import Machine
+from tools.tradeoff.sweep import Point, Sweep
 
 FORMAT = "tradeoff record v1"  # load() refuses anything else
 FILE = "tradeoff.json"
@@ -67,11 +67,11 @@ def load(path: pathlib.Path) -> Record:
         data = json.loads(path.read_text())
     except OSError as e:
         raise ValueError(f"{path}: cannot read it ({e.strerror or e}); every run of "
-                         "tools/tradeoff.py writes one") from None
+                         "python3 -m tools.tradeoff writes one") from None
     except json.JSONDecodeError as e:
         raise ValueError(f"{path}: not JSON ({e})") from None
     if not isinstance(data, dict) or data.get("format") != FORMAT:
-        raise ValueError(f"{path}: not a record written by tools/tradeoff.py "
+        raise ValueError(f"{path}: not a record written by python3 -m tools.tradeoff "
                          f"(no \"format\": \"{FORMAT}\")")
     try:
         sweeps = [_make(Sweep, {**s, "points": [_make(Point, p) for p in s["points"]],
@@ -85,4 +85,5 @@ def load(path: pathlib.Path) -> Record:
             bias_setup=data["bias_setup"], bias_ref_bounces=data["bias_ref_bounces"],
             interior=data["interior"], failures=data["failures"])
     except (KeyError, TypeError) as e:
-        raise ValueError(f"{path}: a record of tools/tradeoff.py lacks or mistypes {e}") from None
+        raise ValueError(f"{path}: a record of python3 -m tools.tradeoff lacks or mistypes "
+                         f"{e}") from None

@@ -3,7 +3,7 @@ pixel's per-path variance, from seeds no sweep uses.
 
 Rendered as `chunks` independent renders (seeds REFERENCE_SEED, +1, ...): their mean is the
 reference and the spread of the chunk means gives the per-path variance (variance of a chunk
-mean x paths per chunk), which grading/compare.py needs for its z tests and bias standard
+mean x paths per chunk), which labkit/compare.py needs for its z tests and bias standard
 error, and which the sweep uses to take the reference's own noise out of the MSE.
 Renders are cached under build/tradeoff/cache, keyed by the binary's and the scene's bytes
 and the settings, so a second run of the tool does not render them again.
@@ -14,13 +14,12 @@ import dataclasses
 import hashlib
 import json
 import pathlib
-import sys
 
 import numpy as np
 
-ROOT = pathlib.Path(__file__).resolve().parent.parent
-sys.path.insert(0, str(ROOT))
-from grading.harness import golden, run_lab  # noqa: E402
+from labkit.harness import golden, run_lab
+
+ROOT = pathlib.Path(__file__).resolve().parents[2]
 
 CACHE = ROOT / "build" / "tradeoff" / "cache"
 # Sweeps use seeds below 1e5; tools/make_golden.py uses 1 000 000 and up.

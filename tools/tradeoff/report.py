@@ -4,7 +4,7 @@ Files: tradeoff.csv (every render of the spp sweeps), tradeoff-fits.csv (one slo
 sweep), tradeoff-bias.csv (the bounce sweep), tradeoff.md (the page: machine, verdicts,
 tables, plots), tradeoff-error-time-<scene>.png (log-log error against render time, one line
 per renderer) and tradeoff-bias.png (missing energy against bounces, closed form drawn in).
-tradeoff.json, what all of them are made from, is tools/tradeoff_record.py's.
+tradeoff.json, what all of them are made from, is tools/tradeoff/record.py's.
 """
 from __future__ import annotations
 
@@ -17,7 +17,7 @@ import pathlib
 import platform
 import subprocess
 
-import tradeoff_fit
+from tools.tradeoff import fit as tradeoff_fit
 
 
 def cannot_write(out: pathlib.Path) -> str | None:
@@ -169,7 +169,7 @@ def markdown(*, machine: Machine, mode: str, note: str, sweeps, references: dict
           "reference's own noise (mean sigma^2 / N); efficiency = 1 / (MSE x seconds).", ""]
     if not plots:
         L += ["Plots: not drawn by this run (--no-plots, or no matplotlib where it ran); "
-              "`tools/tradeoff.py --replot DIR` draws them from DIR/tradeoff.json.", ""]
+              "`python3 -m tools.tradeoff --replot DIR` draws them from DIR/tradeoff.json.", ""]
     L.append("**Verdict: " + ("PASS**" if not failures else "FAIL**"))
     L += [f"- {f}" for f in failures] or ["- every checked slope within -0.5 +- 0.05, no "
                                           "plateau; the bias matches its closed form at every "

@@ -1,4 +1,3 @@
-#!/usr/bin/env python3
 """Speed against accuracy, measured, plotted and checked (`make tradeoff`).
 
     make tradeoff            every renderer this host runs, on the Cornell baseline and an
@@ -6,23 +5,24 @@
                              busy 2-core VM)
     make tradeoff QUICK=1    the CI size: lab01-ref only, small images, fewer points (10-15 s
                              measured on the same VM)
-    tools/tradeoff.py --quick --binary PATH   the quick checks on any lab-01-compatible build
-    tools/tradeoff.py --plan gpu --no-plots   on a GPU machine without matplotlib
-                             (tools/tradeoff_gpu.sh): lab01-ref as the baseline, OpenMP on
+    python3 -m tools.tradeoff --quick --binary PATH   the quick checks on any lab-01-
+                             compatible build
+    python3 -m tools.tradeoff --plan gpu --no-plots   on a GPU machine without matplotlib
+                             (tools/gpu/tradeoff.sh): lab01-ref as the baseline, OpenMP on
                              every core, the GPU labs' references, lab 05's double and fast-
                              math builds; no PNGs
-    tools/tradeoff.py --replot DIR            here, afterwards: the plots and Markdown of the
-                             report in DIR, drawn from its tradeoff.json
+    python3 -m tools.tradeoff --replot DIR            here, afterwards: the plots and
+                             Markdown of the report in DIR, drawn from its tradeoff.json
 
 Two checks, each failing the run (exit 1, one line `tradeoff: FAIL: ...`):
 - unbiased convergence: for every reference renderer the noise-corrected RMSE against spp
-  has a log-log slope within -0.5 +- 0.05 and no plateau (tools/tradeoff_fit.py);
+  has a log-log slope within -0.5 +- 0.05 and no plateau (tools/tradeoff/fit.py);
 - bias against bounces: the energy missing after B bounces in a closed diffuse sphere
   matches its closed form within a Bonferroni limit of standard errors
-  (tools/tradeoff_bias.py).
+  (tools/tradeoff/bias.py).
 Variants (fast math, fixed ray epsilon) are measured and shown, not checked: showing what
 they cost or save is their point. Writes CSV, Markdown, tradeoff.json (everything the
-report is made from, tools/tradeoff_record.py) and PNG plots (not with --no-plots) to --out
+report is made from, tools/tradeoff/record.py) and PNG plots (not with --no-plots) to --out
 (build/reports/). Exit 2: bad input or a render that failed.
 """
 from __future__ import annotations
@@ -34,18 +34,17 @@ import shutil
 import sys
 import tempfile
 
-ROOT = pathlib.Path(__file__).resolve().parent.parent
-sys.path.insert(0, str(ROOT))
-import tradeoff_bias  # noqa: E402
-import tradeoff_record  # noqa: E402
-import tradeoff_reference  # noqa: E402
-import tradeoff_report  # noqa: E402
-import tradeoff_scenes  # noqa: E402
-import tradeoff_series  # noqa: E402
-import tradeoff_sweep  # noqa: E402
-from tradeoff_series import Series  # noqa: E402
+from labkit.harness import golden
+from tools.tradeoff import bias as tradeoff_bias
+from tools.tradeoff import record as tradeoff_record
+from tools.tradeoff import reference as tradeoff_reference
+from tools.tradeoff import report as tradeoff_report
+from tools.tradeoff import scenes as tradeoff_scenes
+from tools.tradeoff import series as tradeoff_series
+from tools.tradeoff import sweep as tradeoff_sweep
+from tools.tradeoff.series import Series
 
-from grading.harness import golden  # noqa: E402
+ROOT = pathlib.Path(__file__).resolve().parents[2]
 
 
 @dataclasses.dataclass(frozen=True)
@@ -68,7 +67,7 @@ class Plan:
 QUICK = Plan("quick (CI size)", ("lab01-ref",), 1024, False, (), False,
              16, 256, tuple(range(1, 9)), 32)
 FULL = Plan("full", None, 4096, True, None, True, 32, 1024, tuple(range(1, 17)), 64)
-# The GPU machine's plan (tools/tradeoff_gpu.sh): FULL's sweeps for the GPU references, with
+# The GPU machine's plan (tools/gpu/tradeoff.sh): FULL's sweeps for the GPU references, with
 # lab01-ref as the efficiency baseline, OpenMP on every core as the CPU's best, and lab 01's
 # double build beside lab 05's. 124 s on the H200 machine's 16 cores
 # (reference/reports/tradeoff-h200/).
@@ -253,7 +252,7 @@ def measure(plan, out, note, machine, ref_bin, runnable, unavailable, scene_dir,
         f"count, against a reference of {16 * plan.bias_spp} spp and {plan.bias_ref_bounces} "
         f"bounces ({ref_bin.name}, other seeds). Closed form of render - reference: <L1> "
         f"(rho^{plan.bias_ref_bounces} - rho^B) / (1 - rho), <L1> = rho I / (pi R^2) = "
-        f"{tradeoff_bias.mean_direct(**params):.5f} (tools/tradeoff_bias.py derives it). "
+        f"{tradeoff_bias.mean_direct(**params):.5f} (tools/tradeoff/bias.py derives it). "
         f"Allowed: {tradeoff_bias.critical_z(tradeoff_bias.ALPHA, len(plan.bias_bounces)):.2f}"
         f" SE (Bonferroni, alpha {tradeoff_bias.ALPHA:g} over {len(plan.bias_bounces)} bounce "
         f"counts) + {tradeoff_bias.ROUNDING:g} of the converged radiance for float rounding.")

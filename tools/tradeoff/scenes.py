@@ -1,23 +1,22 @@
 """The scenes `make tradeoff` renders besides the Cornell baseline.
 
-- extreme: tiny next to huge. A diffuse floor of half-size 1e5 (grading/scenes.py floor_view,
+- extreme: tiny next to huge. A diffuse floor of half-size 1e5 (labkit/scenes.py floor_view,
   the one check_large_primitives uses) with a ball of radius 0.25 on it, seen from 1 unit
   above. Hit points on the floor carry the rounding of coordinates 1e5 away (~6e-3), so a
   fixed world-space epsilon far below that lets shadow rays hit the floor they leave, while
   the ball needs offsets far smaller than the floor's: the case where the ray-offset strategy
   matters. Moving a scene far from the origin tests nothing here: the shared driver renders
   every scene centred on its geometry (DESIGN.md section 6).
-- bias: the inside of a diffuse sphere lit from off-centre (tools/tradeoff_bias.py has its
+- bias: the inside of a diffuse sphere lit from off-centre (tools/tradeoff/bias.py has its
   closed form).
 """
 from __future__ import annotations
 
 import pathlib
-import sys
 
-ROOT = pathlib.Path(__file__).resolve().parent.parent
-sys.path.insert(0, str(ROOT))
-from grading import scenes  # noqa: E402
+from labkit import scenes
+
+ROOT = pathlib.Path(__file__).resolve().parents[2]
 
 EXTREME_FLOOR_HALF_SIZE = 1e5
 EXTREME_BALL = dict(center=[-0.4, 0.25, -2.5], radius=0.25)

@@ -4,7 +4,7 @@ unavailable with the reason (which the report prints).
 - the CPU references this host can build and run (lab01-ref ... lab04-simd-ref);
 - the GPU reference (lab05-ref) and its double build (lab05-ref-double, shown like a
   variant) where nvidia-smi lists a GPU, they build and they render a pixel there;
-- variants of the lab-01 reference built by `make variant` (grading/variants.py): fast math,
+- variants of the lab-01 reference built by `make variant` (labkit/variants.py): fast math,
   and a fixed world-space epsilon instead of the scale-aware ray offset of common/core/ray.h.
   A variant is one entry of VARIANTS: a name, what it changes, and either the files it
   stands in for and the make arguments, or a make target of its own (the double build,
@@ -19,16 +19,15 @@ import pathlib
 import re
 import shutil
 import subprocess
-import sys
 from typing import Callable
 
-ROOT = pathlib.Path(__file__).resolve().parent.parent
-sys.path.insert(0, str(ROOT))
-from grading.checks import mpirun  # noqa: E402
-from grading.variants import build_sources, lab_sources  # noqa: E402
+from grading.checks import mpirun
+from labkit.variants import build_sources, lab_sources
+
+ROOT = pathlib.Path(__file__).resolve().parents[2]
 
 VARIANT_DIR = ROOT / "build" / "tradeoff" / "variants"
-# Open MPI refuses to start as root unless told (containers, CI); as tools/bench_cpu.py does.
+# Open MPI refuses to start as root unless told (containers, CI); as tools/bench/cpu.py does.
 os.environ.setdefault("OMPI_ALLOW_RUN_AS_ROOT", "1")
 os.environ.setdefault("OMPI_ALLOW_RUN_AS_ROOT_CONFIRM", "1")
 
@@ -169,7 +168,7 @@ def fixed_epsilon_ray_h() -> str:
         text)
     if count != 1:
         raise RuntimeError("common/core/ray.h: offset_ray_origin's return line changed; "
-                           "update tools/tradeoff_series.py's fixed-epsilon variant")
+                           "update tools/tradeoff/series.py's fixed-epsilon variant")
     return new
 
 

@@ -1,11 +1,11 @@
 """Error against samples per pixel (and time) for one renderer on one scene.
 
-Each point is one render at n spp from its own seed, compared by grading/compare.py with a
+Each point is one render at n spp from its own seed, compared by labkit/compare.py with a
 converged reference of N >= 16 n paths from other seeds: RMSE, relMSE, bias +- its standard
 error, NaN/Inf counts, whether the noise-aware z tests pass. The reference's own noise adds
 mean(sigma^2)/N to the measured MSE; `mse` subtracts it, so that for an unbiased renderer
 mse = mean(sigma^2)/n exactly in expectation and the log-log slope is -1/2 at every n
-(tools/tradeoff_fit.py). Efficiency is 1 / (mse x seconds): the higher, the less time a
+(tools/tradeoff/fit.py). Efficiency is 1 / (mse x seconds): the higher, the less time a
 given error costs.
 
 Time is the `seconds` of the binary's --json summary: render only, no scene loading or file
@@ -16,16 +16,14 @@ from __future__ import annotations
 import dataclasses
 import math
 import pathlib
-import sys
 
-ROOT = pathlib.Path(__file__).resolve().parent.parent
-sys.path.insert(0, str(ROOT))
-import tradeoff_fit  # noqa: E402
-from tradeoff_reference import Reference  # noqa: E402
-from tradeoff_series import first_words  # noqa: E402
+from labkit.compare import compare
+from labkit.harness import run_lab
+from tools.tradeoff import fit as tradeoff_fit
+from tools.tradeoff.reference import Reference
+from tools.tradeoff.series import first_words
 
-from grading.compare import compare  # noqa: E402
-from grading.harness import run_lab  # noqa: E402
+ROOT = pathlib.Path(__file__).resolve().parents[2]
 
 SWEEP_SEED = 100  # + log2(spp): each point its own seed, none of the reference's
 
@@ -43,7 +41,7 @@ class Point:
     bias_se: float
     nan: int
     inf: int
-    z_pass: bool       # grading/compare.py's verdict against the reference
+    z_pass: bool       # labkit/compare.py's verdict against the reference
     mse: float         # RMSE^2 minus the reference's own noise (may be <= 0 when tiny)
     efficiency: float  # 1 / (mse * seconds)
 
