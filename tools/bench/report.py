@@ -324,23 +324,23 @@ def main(argv=None) -> int:
             raise BadInput("--merge only redraws a report: give it --out, not --gpu-only/--labs")
         out = pathlib.Path(a.out)
         if a.redraw:
-            import bench_report_output  # matplotlib: only where the report is drawn
+            from tools.bench import report_output  # matplotlib: only where the report is drawn
             data = load_rows_json(out / "bench.json", "--out")
             if a.note:
                 data["note"] = a.note
-            bench_report_output.write_all(out, data)
+            report_output.write_all(out, data)
             log(f"bench: redrew {out / 'bench.md'}")
             return 0
         if a.merge:
             data = merge(out, pathlib.Path(a.merge))
-            import bench_report_output  # matplotlib: only where the report is drawn
-            bench_report_output.write_all(out, data)
+            from tools.bench import report_output  # matplotlib: only where the report is drawn
+            report_output.write_all(out, data)
             log(f"bench: merged {a.merge} into {out / 'bench.md'}")
             return 0
         plan = plan_from(a.quick, a.scale, a.repeat)
         if not a.gpu_only:
             try:
-                import bench_report_output  # noqa: F401  (checked before minutes of rendering)
+                from tools.bench import report_output  # noqa: F401  (checked before minutes of rendering)
             except ImportError:
                 raise BadInput(
                     "matplotlib is not installed for this python: run `make deps`") from None
@@ -367,8 +367,8 @@ def main(argv=None) -> int:
             log(f"bench: {len(rows)} GPU rows in {path}; merge them with "
                 f"python3 -m tools.bench.report --merge {path.name} --out REPORT_DIR")
             return 0
-        import bench_report_output
-        bench_report_output.write_all(out, data)
+        from tools.bench import report_output
+        report_output.write_all(out, data)
         log(f"bench: report in {out / 'bench.md'}")
         return 0
     except BadInput as e:
