@@ -13,7 +13,7 @@
 // `float at(uint32_t dimension) const` will do; the labs use SampleStream.
 //!
 //! Lab 01 students write the regions between BEGIN/END SOLUTION; the skeleton generator
-//! (tools/skeletons.py) turns this file into labs/01-serial/skeleton/path_tracer.h.
+//! (labkit/skeletons.py) turns this file into labs/01-serial/skeleton/path_tracer.h.
 #pragma once
 
 #include <cfloat>

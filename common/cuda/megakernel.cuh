@@ -5,7 +5,7 @@
 //!
 //! Lab 05's reference kernel; the wavefront benchmark (common/wavefront/wavefront_bench.cuh)
 //! measures the wavefront labs against it.
-//! Lab 05 students write the regions between BEGIN/END SOLUTION; tools/skeletons.py turns
+//! Lab 05 students write the regions between BEGIN/END SOLUTION; labkit/skeletons.py turns
 //! this file into labs/05-cuda-mega/skeleton/megakernel.cuh, which stands in for it in the
 //! lab's own build (it comes first on the include path).
 #pragma once

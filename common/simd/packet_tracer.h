@@ -18,7 +18,7 @@
 // use the same polynomial, material.h and lane_math.h), so every hit and every shading result has
 // lab 01's bits and lab 02's image is lab 01's, bit for bit (tests/labs/test_lab02.py).
 //!
-//! Lab 02 students write the regions between BEGIN/END SOLUTION; tools/skeletons.py turns
+//! Lab 02 students write the regions between BEGIN/END SOLUTION; labkit/skeletons.py turns
 //! this file into labs/02-simd/skeleton/packet_tracer.h.
 #pragma once
 

@@ -7,7 +7,7 @@
 // unchanged on this pool.
 //!
 //! Lab 07 students write the three arrays (the region between BEGIN/END SOLUTION);
-//! tools/skeletons.py turns this file into labs/07-soa/skeleton/path_pool_soa.cuh.
+//! labkit/skeletons.py turns this file into labs/07-soa/skeleton/path_pool_soa.cuh.
 //! It stands in for this file in the lab's own build (first on the include path).
 #pragma once
 

@@ -9,7 +9,7 @@
 // threads of a warp that pop places k, k+1, ..., k+31 read neighbouring memory however many
 // paths have ended before (handouts/06-cuda-split.md, section 2).
 //!
-//! Lab 06 students write reserve (the region between BEGIN/END SOLUTION); tools/skeletons.py
+//! Lab 06 students write reserve (the region between BEGIN/END SOLUTION); labkit/skeletons.py
 //! turns this file into labs/06-cuda-split/skeleton/path_queue.cuh.
 //! It stands in for this file in the lab's own build (first on the include path).
 #pragma once

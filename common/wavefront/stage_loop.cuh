@@ -5,7 +5,7 @@
 // the GPU runs them in order, each reading its queue's size itself, so a queue that the
 // previous stage left empty costs its kernel next to nothing.
 //!
-//! Lab 06 students write run_wave (the region between BEGIN/END SOLUTION); tools/skeletons.py
+//! Lab 06 students write run_wave (the region between BEGIN/END SOLUTION); labkit/skeletons.py
 //! turns this file into labs/06-cuda-split/skeleton/stage_loop.cuh.
 //! It stands in for this file in the lab's own build (first on the include path).
 #pragma once

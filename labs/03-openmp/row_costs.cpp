@@ -1,6 +1,6 @@
 // A probe for the handout (built as lab03-row-costs): lab 01's serial render, timing every
 // row. It prints one extra line to stderr, "row-seconds: t0 t1 ...", the render time of each
-// row, top first; tools/bench_openmp.py turns it into the cost profile and predicts how
+// row, top first; tools/bench/openmp.py turns it into the cost profile and predicts how
 // well each loop schedule balances those rows. The image is lab 01's, bit for bit.
 #include <cstdio>
 #include <string>

@@ -6,7 +6,7 @@
 
 collect() runs what needs the GPU: every correctness check on the default, fast-math and
 no-FMA builds of lab 05, process time against kernel time, the flag variants' accuracy; it
-reads what gpu_check.sh left in OUT and /tmp (the pytest JUnit file, the benchmarks' JSON,
+reads what tools/gpu/check.sh left in OUT and /tmp (the pytest JUnit file, the benchmarks' JSON,
 Nsight Compute's CSVs, the compiler's report). summary() only formats: it is tested on the
 CPU against a recorded gpu-check.json (tests/tools/test_gpu_report.py).
 """

@@ -8,7 +8,7 @@
 // multiply-add), so the image comes out the same; only the instructions differ. Whether they
 // are faster is the question Part A asks: see handouts/02-simd.md.
 //!
-//! Lab 02 students write the regions between BEGIN/END SOLUTION; tools/skeletons.py turns
+//! Lab 02 students write the regions between BEGIN/END SOLUTION; labkit/skeletons.py turns
 //! this file into labs/02-simd/skeleton/part-a/vec3.h, where each region is scalar code that
 //! is correct but not SIMD.
 #pragma once
