@@ -25,7 +25,7 @@ import tempfile
 import time
 import zipfile
 
-ROOT = pathlib.Path(__file__).resolve().parents[2]  # on the import path: make test-gradescope
+ROOT = pathlib.Path(__file__).resolve().parents[2]  # make test-gradescope: on the import path
 BASE = "prt-debian-base:bookworm"
 IMAGE = "prt-gradescope-lab01"
 LIMITS = ["--cpus=0.5", "--memory=768m"]  # Gradescope's defaults

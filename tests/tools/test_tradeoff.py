@@ -14,7 +14,6 @@ and --plan gpu take a few seconds more (16 s for the whole file on an idle two-c
 everything built and the references cached)."""
 import csv
 import dataclasses
-import importlib.util
 import math
 import os
 import random
@@ -293,11 +292,8 @@ def test_gpu_script_builds_for_the_gpu_present_and_runs_the_gpu_plan(tmp_path):
 
 def lab01_mutant(name, workdir):
     """A mutant of tests/labs/test_lab01_mutants.py (one definition of each bug)."""
-    spec = importlib.util.spec_from_file_location(
-        "lab01_mutants", ROOT / "tests" / "labs" / "test_lab01_mutants.py")
-    mutants = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(mutants)
-    return mutants.build_mutant(name, workdir)
+    from tests.labs.test_lab01_mutants import build_mutant
+    return build_mutant(name, workdir)
 
 
 def test_correlated_samples_fail_the_slope_check(tmp_path):

@@ -1,0 +1,132 @@
+"""How the kit's Python fits together (DESIGN.md section 1): labkit/, grading/, tools/ and tests/
+import each other as packages from the repository root, never by editing sys.path or loading a
+file by path; the grader imports nothing from tools/; every command under tools/ is reached
+from a make target that `make help` lists; every Python or shell path and every `python3 -m`
+module the repository names exists. Reads files only: well under a second."""
+import ast
+import importlib.util
+import re
+import subprocess
+
+from labkit.harness import ROOT
+
+MAKEFILES = ["Makefile", "cuda.mk", "grading/grading.mk",
+             *sorted(str(p.relative_to(ROOT)) for p in ROOT.glob("labs/*/lab.mk"))]
+TEXT_SUFFIXES = {".md", ".py", ".sh", ".mk", ".h", ".cpp", ".cu", ".cuh", ".json", ".txt", ""}
+MODULE = re.compile(r"-m ((?:labkit|grading|tools)(?:\.[a-z_][a-z0-9_]*)*)\b")
+PATH = re.compile(r"(?<![\w/.-])((?:labkit|grading|tools)/[\w/.-]*\w\.(?:py|sh))\b")
+
+
+def tracked(*patterns: str) -> list:
+    out = subprocess.run(["git", "-C", str(ROOT), "ls-files", "-z", *patterns],
+                         capture_output=True, check=True).stdout.decode()
+    return [ROOT / f for f in out.split("\0") if f and (ROOT / f).is_file()]
+
+
+def trees(files):
+    for f in files:
+        yield f, ast.parse(f.read_text(), str(f))
+
+
+def names(node) -> str:
+    """a.b.c of an attribute chain, '' for anything else."""
+    if isinstance(node, ast.Attribute):
+        return f"{names(node.value)}.{node.attr}" if names(node.value) else ""
+    return node.id if isinstance(node, ast.Name) else ""
+
+
+def test_no_sys_path_edits_and_no_loading_by_file_path():
+    found = []
+    for f, tree in trees(tracked("*.py")):
+        for node in ast.walk(tree):
+            called = names(node.func) if isinstance(node, ast.Call) else ""
+            if called.startswith("sys.path.") or called.endswith(
+                    ("spec_from_file_location", "SourceFileLoader", "run_path")):
+                found.append(f"{f.relative_to(ROOT)}:{node.lineno}: {called}")
+            if isinstance(node, ast.Assign) and any(names(t) == "sys.path" for t in node.targets):
+                found.append(f"{f.relative_to(ROOT)}:{node.lineno}: sys.path = ...")
+    assert not found, found
+
+
+def test_the_grader_imports_nothing_from_tools():
+    found = []
+    for f, tree in trees(tracked("grading/*.py", "grading/**/*.py")):
+        for node in ast.walk(tree):
+            modules = ([a.name for a in node.names] if isinstance(node, ast.Import) else
+                       [node.module or ""] if isinstance(node, ast.ImportFrom) else [])
+            found += [f"{f.relative_to(ROOT)}:{node.lineno}: {m}" for m in modules
+                      if m == "tools" or m.startswith("tools.")]
+    assert not found, found
+
+
+def tool_commands() -> dict:
+    """Each command under tools/: its `python3 -m` module (a module with a __main__ guard, a
+    package with __main__.py) or its shell script's path."""
+    commands = {}
+    for f in tracked("tools/*.py", "tools/**/*.py"):
+        rel = f.relative_to(ROOT).with_suffix("")
+        if f.name == "__main__.py":
+            commands[".".join(rel.parent.parts)] = f
+        elif 'if __name__ == "__main__"' in f.read_text():
+            commands[".".join(rel.parts)] = f
+    for f in tracked("tools/*.sh", "tools/**/*.sh"):
+        commands[str(f.relative_to(ROOT))] = f
+    return commands
+
+
+def recipes() -> dict:
+    """Each make target's recipe, as written in the Makefiles."""
+    rules, target = {}, None
+    for name in MAKEFILES:
+        for line in (ROOT / name).read_text().splitlines():
+            rule = re.match(r"^([\w.-]+(?: [\w.-]+)*):(?!=)", line)
+            if rule:
+                target = rule.group(1).split()[0]
+            elif line.startswith("\t") and target:
+                rules[target] = rules.get(target, "") + line + "\n"
+            elif line and not line.startswith(("#", " ")):
+                target = None
+    return rules
+
+
+def test_every_tool_is_reached_from_a_make_target_make_help_lists():
+    rules = recipes()
+    help_text = subprocess.run(["make", "-s", "-C", str(ROOT), "help"], capture_output=True,
+                               text=True, check=True).stdout
+
+    def invoked(command: str, text: str) -> bool:
+        module = command.replace(".", r"\.")
+        return bool(re.search(rf"-m {module}(?![\w.])" if "/" not in command else
+                              rf"(?<![\w/]){re.escape(command)}\b", text))
+
+    commands = tool_commands()
+    reached = {c: t for c in commands for t, recipe in rules.items() if invoked(c, recipe)}
+    # A command run by a script a make target runs (tools/gpu/check.sh runs tools.gpu.report).
+    for command in set(commands) - set(reached):
+        for script, target in list(reached.items()):
+            if script.endswith(".sh") and invoked(command, (ROOT / script).read_text()):
+                reached[command] = target
+    # A module that its package's __main__ runs (tools.tradeoff.run).
+    for command in set(commands) - set(reached):
+        package = command.rpartition(".")[0]
+        main = ROOT / package.replace(".", "/") / "__main__.py"
+        if package in reached and main.is_file() and f"from {command} import" in main.read_text():
+            reached[command] = reached[package]
+    assert set(reached) == set(commands), sorted(set(commands) - set(reached))
+    unlisted = {c: t for c, t in reached.items() if f"make {t}" not in help_text}
+    assert not unlisted, unlisted
+
+
+def test_paths_and_modules_the_repository_names_exist():
+    missing = []
+    for f in tracked():
+        if f.suffix not in TEXT_SUFFIXES or f.stat().st_size > 1 << 20:
+            continue
+        text = f.read_text(errors="replace")
+        for m in PATH.finditer(text):
+            if not (ROOT / m.group(1)).is_file():
+                missing.append(f"{f.relative_to(ROOT)}: {m.group(1)}")
+        for m in MODULE.finditer(text):
+            if importlib.util.find_spec(m.group(1)) is None:
+                missing.append(f"{f.relative_to(ROOT)}: -m {m.group(1)}")
+    assert not missing, missing
