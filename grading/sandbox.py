@@ -66,8 +66,8 @@ class Outcome:
                                 # the last interval of each process (TreeClock)
     killed: str | None = None   # why the grader killed it, e.g. "timed out after 60 s"
     cut: tuple[str, ...] = ()   # streams cut at the output cap
-    busiest_thread_seconds: float = 0.0  # the CPU time of the tree's busiest thread, sampled
-                                         # by the grader (TreeClock)
+    busiest_thread_share: float = float("nan")  # of the tree's CPU time, its busiest thread's
+                                                # (sampled by the grader: TreeClock)
 
     @property
     def failure(self) -> str | None:
@@ -518,9 +518,10 @@ class TreeClock:
     counted in its parent's cutime once reaped; `seconds` keeps the largest total seen.
 
     It also keeps each thread's own CPU time (/proc/PID/task/TID/stat; the last value seen of
-    a thread that has ended, which misses at most its last SAMPLE_SECONDS), so that
-    `busiest_thread_seconds` says how much of the work one thread did, whatever the load: a
-    serial program does all of it on one thread, a parallel one shares it.
+    a thread that has ended), so that `busiest_thread_share` says how much of the work one
+    thread did, whatever the load: a serial program does all of it on one thread, a parallel
+    one shares it. Both sides of that fraction are of the same sample (the latest), so the
+    last interval before the exit, which no sample sees, is missing from both.
 
     With `nice` (the grader is root) each sample also raises the tree's new sessions and
     threads to that priority (RUN_NICE says why)."""
@@ -531,10 +532,7 @@ class TreeClock:
         self.nice = nice
         self._threads: dict[tuple[int, int, int], int] = {}  # (pid, tid, start) -> ticks
         self._sessions: set[int] = set()  # sessions whose autogroup was raised
-
-    @property
-    def busiest_thread_seconds(self) -> float:
-        return max(self._threads.values(), default=0) / _CLOCK_TICKS
+        self.busiest_thread_share = float("nan")
 
     def sample(self) -> None:
         parents: dict[int, int] = {}
@@ -562,11 +560,13 @@ class TreeClock:
                 if child not in tree:
                     tree.add(child)
                     frontier.append(child)
-        total = sum(times.get(pid, 0) for pid in tree) / _CLOCK_TICKS
-        self.seconds = max(self.seconds, total)
+        ticks = sum(times.get(pid, 0) for pid in tree)
+        self.seconds = max(self.seconds, ticks / _CLOCK_TICKS)
         for pid in tree:
             if pid in times:
                 self._sample_threads(pid, sessions[pid])
+        if ticks > 0:
+            self.busiest_thread_share = min(1.0, max(self._threads.values(), default=0) / ticks)
 
     def _sample_threads(self, pid: int, session: int) -> None:
         if self.nice is not None and session not in self._sessions:
@@ -687,4 +687,4 @@ def _supervise(p: subprocess.Popen, start: float, limits: Limits) -> Outcome:
     cpu = max(usage.ru_utime + usage.ru_stime if usage else 0.0, clock.seconds)
     (_, out), (_, err) = streams.values()
     return Outcome(p.returncode, decode(bytes(out)), decode(bytes(err)), end - start, cpu,
-                   killed, tuple(cut), clock.busiest_thread_seconds)
+                   killed, tuple(cut), clock.busiest_thread_share)
