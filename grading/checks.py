@@ -570,17 +570,18 @@ def _parallel_speedup(binary, baseline, settings: dict, *, threads, launcher, fr
                       attempts: int, overhead_reference) -> CheckResult:
     import threading
 
-    from grading.harness import RunError, cpu_capacity, measure_parallel
+    from grading.harness import cpu_capacity, measure_parallel
     capacity_here = cpu_capacity()
     if capacity_here < QUOTA_TOO_SMALL:
         # Nothing to time: no program can show a speedup here. One run shows whether the work
         # is one thread's (serial: final here too); else correctness is graded (the checks
         # gated on this one open) and the speed left to a regrade on a course machine.
         try:
-            shares = [busiest_thread_share(run_lab(binary, threads=threads, launcher=launcher,
-                                                   **settings))]
-        except (RunError, OSError):
-            shares = []
+            run = run_lab(binary, threads=threads, launcher=launcher, check=False, **settings)
+        except OSError:  # the binary cannot even be staged: nothing to tell
+            run = None
+        # Only a run that rendered tells whose work a render is (a crash is one thread's too).
+        shares = [busiest_thread_share(run)] if run and run.image is not None else []
         if one_thread_did_it(shares):
             return serial_by_thread(shares, f"on a machine giving {capacity_here:g} cores' worth")
         return CheckResult("parallel speedup", True,
