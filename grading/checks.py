@@ -20,6 +20,7 @@ tests/labs/test_lab01_mutants.py.
 """
 from __future__ import annotations
 
+import contextlib
 import dataclasses
 import functools
 import os
@@ -30,10 +31,13 @@ import time
 
 import numpy as np
 
-from grading import draws, report_html, symptoms
+from grading import draws, hidden, report_html, symptoms
 from labkit import scenes
 from labkit.compare import compare
-from labkit.harness import GOLDEN, ImageError, golden, run_lab
+from labkit.harness import GOLDEN, ROOT, ImageError, golden, run_lab
+
+# The trusted renderer that makes golden data on the spot (the timed scene drawn for a grade).
+LAB01_REFERENCE = ROOT / "lab01-ref"
 
 
 @dataclasses.dataclass
@@ -289,12 +293,13 @@ def check_scale_invariance(binary, scene: str = "cornell", factors=SCALE_FACTORS
 
 @image_checked("reproducible")
 def check_reproducible(binary, **kwargs) -> CheckResult:
-    """Same seed, same bits; another seed, another image."""
-    args = dict(width=32, height=32, spp=8, **kwargs)
+    """Same seed, same bits; another seed, another image (of the drawn timed scene)."""
     seed = draws.seed("reproducible")
-    a = run_lab(binary, seed=seed, **args).image
-    b = run_lab(binary, seed=seed, **args).image
-    c = run_lab(binary, seed=seed + 1, **args).image
+    with timed_scene() as scene:
+        args = dict(scene=scene, width=32, height=32, spp=8, **kwargs)
+        a = run_lab(binary, seed=seed, **args).image
+        b = run_lab(binary, seed=seed, **args).image
+        c = run_lab(binary, seed=seed + 1, **args).image
     same = a.tobytes() == b.tobytes()
     differs = a.tobytes() != c.tobytes()
     return CheckResult("reproducible", same and differs,
@@ -323,16 +328,40 @@ def check_structure_of_arrays(binary) -> CheckResult:
                        f"({verdict})")
 
 
-# The timed renders: the golden 'cornell' view with enough paths that process start-up is a
-# few percent of the time. Rendering the golden scene means every timed image can be checked.
+# The timed renders: a variation of the golden 'cornell' scene drawn from the grading secret
+# (draws.box_variation: the same cost, nobody's stored image), at the golden size, with enough
+# paths that process start-up is a few percent of the time. Its golden data are rendered on the
+# spot by the trusted reference where a timed image is compared with them (check_speedup);
+# labs 03 and 04 compare their timed images with lab 01's bits instead.
 TIMED_SCENE = "cornell"
 
 
-def timed_settings(spp: int, scale: int = 1) -> dict:
-    """The golden Cornell view at `scale` times the golden image's width and height."""
+def drawn_timed_scene() -> dict:
+    """The timed scene of this grade: the golden Cornell box varied by the secret."""
+    return draws.box_variation(scenes.load(TIMED_SCENE), "timed")
+
+
+@contextlib.contextmanager
+def timed_scene():
+    """The drawn timed scene in a temporary file (neutral name, removed after): its path."""
+    with tempfile.TemporaryDirectory() as tmp:
+        yield scenes.write_scene(pathlib.Path(tmp) / "scene.json", drawn_timed_scene())
+
+
+def timed_settings(spp: int, scene: pathlib.Path, scale: int = 1) -> dict:
+    """The timed render of `scene` (timed_scene()) at `scale` times the golden image's width
+    and height, at a seed drawn from the secret."""
     g = golden(TIMED_SCENE)
-    return dict(scene=g.scene, width=g.meta["width"] * scale, height=g.meta["height"] * scale,
+    return dict(scene=scene, width=g.meta["width"] * scale, height=g.meta["height"] * scale,
                 bounces=g.meta["bounces"], seed=draws.seed("timed"), spp=spp)
+
+
+def timed_golden(scene: pathlib.Path, reference=LAB01_REFERENCE) -> tuple:
+    """(mean, variance, golden_spp) of the drawn timed scene, rendered now by the trusted
+    reference at the golden size (grading/hidden.py's make_golden)."""
+    g = golden(TIMED_SCENE)
+    made = hidden.make_golden(reference, scene, size=g.meta["width"], bounces=g.meta["bounces"])
+    return made.mean, made.variance, made.golden_spp
 
 
 def box_filtered(image: np.ndarray, scale: int) -> np.ndarray:
@@ -346,12 +375,16 @@ def box_filtered(image: np.ndarray, scale: int) -> np.ndarray:
     return blocks.mean(axis=(1, 3)).astype(np.float32)
 
 
-def wrong_timed_image(image, spp: int, scale: int = 1) -> str | None:
-    """Why a timed render is not a correct image of the golden scene, or None: speed is
-    graded only for correct work, on the very runs that were timed."""
-    g = golden(TIMED_SCENE)
+def wrong_timed_image(image, spp: int, scale: int = 1, reference: tuple | None = None
+                      ) -> str | None:
+    """Why a timed render is not a correct image of its scene, or None: speed is graded only
+    for correct work, on the very runs that were timed. `reference` is the scene's (mean,
+    variance, golden_spp) (timed_golden); by default the stored golden Cornell box's."""
+    if reference is None:
+        g = golden(TIMED_SCENE)
+        reference = (g.mean, g.variance, g.meta["golden_spp"])
     report = compare(box_filtered(image, scale) if scale > 1 else image, spp * scale * scale,
-                     g.mean, g.variance, g.meta["golden_spp"], per_pixel=scale == 1)
+                     *reference, per_pixel=scale == 1)
     return None if report.passed else f"the timed render is wrong ({report.summary()})"
 
 
@@ -391,6 +424,12 @@ def one_cpu() -> list[str]:
     return [shutil.which("taskset") or "taskset", "-c", str(cpu)]
 
 
+# Thread by thread (sandbox.TreeClock): in a run of at least THREADS_TELLABLE_SECONDS of CPU
+# time (enough clock ticks that the sandbox's own start-up is a few percent of them), a program
+# whose busiest thread did less than SHARED_WORK of it ran threads (one thread does ~100%, two
+# ~50% each, however many cores they got). Lab 02's faster SIMD runs are shorter than that.
+THREADS_TELLABLE_SECONDS = 0.2
+SHARED_WORK = 0.75
 # A program whose tree never used more CPU time than this many times its wall time did not
 # run in parallel (a serial renderer measures 0.95-1.0 cores on a quiet machine; a correct
 # parallel one on two cores ~1.9, ~1.3 beside a process burning one of them). On a machine
@@ -416,32 +455,41 @@ def check_speedup(binary, baseline, min_speedup: float, *, threads=None, launche
     start-up cost, rendering one pixel, that is subtracted from both sides (launch_overhead).
     `one_core` (lab 02): both sides run confined to one CPU, and a program whose timed runs
     used more than SERIAL_CORES cores' worth of CPU time earns nothing (threads are not the
-    lesson). Points: speed_credit of the speedup."""
+    lesson). Both sides render the timed scene drawn for this grade (timed_scene), whose
+    golden data the trusted lab-01 reference renders first. Points: speed_credit of the
+    speedup."""
     name = f"speedup >= {min_speedup:g}x"
-    settings = timed_settings(spp, scale)
     pinned = one_cpu() if one_core else []
     overhead = launch_overhead(overhead_reference, launcher) if overhead_reference else 0.0
-    base, fast, used, base_used = [], [], [], []
-    for _ in range(repeat):
-        base_run = run_lab(baseline, launcher=pinned, **settings)
-        base.append(max(base_run.wall_seconds - overhead, 1e-3))
-        base_used.append(cores_used(base_run))
-        run = run_lab(binary, threads=threads, launcher=[*pinned, *launcher], **settings)
-        wrong = wrong_timed_image(run.image, spp, scale)
-        if wrong:
-            return CheckResult(name, False, f"{wrong}: speed is graded only for a correct image",
-                               credit=0.0)
-        fast.append(max(run.wall_seconds - overhead, 1e-3))
-        used.append(cores_used(run))
+    base, fast, used, base_used, shares = [], [], [], [], []
+    with timed_scene() as scene:
+        settings = timed_settings(spp, scene, scale)
+        reference = timed_golden(scene)
+        for _ in range(repeat):
+            base_run = run_lab(baseline, launcher=pinned, **settings)
+            base.append(max(base_run.wall_seconds - overhead, 1e-3))
+            base_used.append(cores_used(base_run))
+            run = run_lab(binary, threads=threads, launcher=[*pinned, *launcher], **settings)
+            wrong = wrong_timed_image(run.image, spp, scale, reference)
+            if wrong:
+                return CheckResult(name, False,
+                                   f"{wrong}: speed is graded only for a correct image",
+                                   credit=0.0)
+            fast.append(max(run.wall_seconds - overhead, 1e-3))
+            used.append(cores_used(run))
+            if (run.cpu_seconds or 0) >= THREADS_TELLABLE_SECONDS:
+                shares.append(busiest_thread_share(run))
     ratios = sorted(y / b for y, b in zip(used, base_used) if b > 0)
     share = ratios[len(ratios) // 2] if ratios else float("nan")
-    if one_core and not (max(used) <= SERIAL_CORES and share <= ONE_CORE_SHARE):
+    if one_core and not (max(used) <= SERIAL_CORES and share <= ONE_CORE_SHARE
+                         and all(s >= SHARED_WORK for s in shares)):
         return CheckResult(name, False,
                            f"the timed runs used up to {max(used):.2f} cores' worth of CPU time, "
-                           f"{share:.2f}x the share of the reference on one CPU (measured by the "
-                           f"grader; allowed {SERIAL_CORES:g} and {ONE_CORE_SHARE:g}x): lab 02 is "
-                           f"timed on one core, its speed must come from SIMD, not threads",
-                           credit=0.0)
+                           f"{share:.2f}x the share of the reference on one CPU, their busiest "
+                           f"thread as little as {min(shares, default=1.0):.0%} of it (measured "
+                           f"by the grader; allowed {SERIAL_CORES:g}, {ONE_CORE_SHARE:g}x and "
+                           f"{SHARED_WORK:.0%}): lab 02 is timed on one core, its speed must come "
+                           f"from SIMD, not threads", credit=0.0)
     speedup = min(base) / min(fast)
     credit = speed_credit(speedup, min_speedup)
     note = (f", less {overhead:.3f} s of start-up measured on the reference rendering one pixel"
@@ -466,12 +514,35 @@ def launch_overhead(reference, launcher, rounds: int = 3) -> float:
 # reference measured 0.95x with 1.79x capacity measured in the same rounds, and ~1x under a
 # steady load of 9 on two cores. Such a result is measured again and, failing that, marked
 # for regrade, with only the points measured in the score. Whether the program runs in
-# parallel at all is told apart from the load by its CPU time over its wall time: where the
-# machine gave at least SERIAL_TELLABLE cores' worth, a parallel program uses more than
-# SERIAL_CORES of them (CFS shares the CPUs by thread), a serial one cannot.
+# parallel at all is told apart from the load two ways. Thread by thread, at any load: a
+# program one of whose threads did ONE_THREAD of its timed runs' CPU time is serial (a
+# serial renderer's one thread does all of it; a parallel one's busiest thread about 1/T of
+# it, however few cores it got). By CPU time over wall time: where the machine gave at least
+# SERIAL_TELLABLE cores' worth, a parallel program uses more than SERIAL_CORES of them (CFS
+# shares the CPUs by thread), a serial one cannot.
 BUSY = 1.9
 SERIAL_TELLABLE = 1.25
 QUOTA_TOO_SMALL = 1.5  # cores' worth of CPU (count or cgroup quota) below which nothing is timed
+ONE_THREAD = 0.9
+
+
+def busiest_thread_share(run) -> float:
+    """The fraction of a run's CPU time that its busiest thread did (both measured by the
+    grader from /proc, sandbox.TreeClock); NaN where nothing was measured."""
+    return run.thread_share
+
+
+def one_thread_did_it(shares: list[float]) -> bool:
+    """Every timed run did at least ONE_THREAD of its work on one thread (none unmeasured)."""
+    return bool(shares) and all(share >= ONE_THREAD for share in shares)
+
+
+def serial_by_thread(shares: list[float], where: str) -> CheckResult:
+    return CheckResult("parallel speedup", False,
+                       f"serial: in every timed run one thread did at least {ONE_THREAD:.0%} "
+                       f"of the CPU time ({min(shares):.0%} at the least; measured by the "
+                       f"grader, thread by thread, {where}); a parallel program shares its work "
+                       f"among its threads", credit=0.0)
 
 
 @image_checked("parallel speedup")
@@ -480,31 +551,50 @@ def check_parallel_speedup(binary, baseline, *, threads=None, launcher=(),
                            overhead_reference=None) -> CheckResult:
     """Speedup of a parallel lab over the serial baseline, in wall-clock time measured by the
     grader, against the machine's capacity measured alongside (labkit.harness.
-    measure_parallel). Every timed image must be the baseline's, bit for bit (what labs 03 and
-    04 promise). It fails closed:
-    - a program whose timed runs never used more than SERIAL_CORES cores' worth of CPU time
-      (the grader's own measurement of the sandboxed tree) nor more than SERIAL_CORES times
-      the serial reference's share in the same rounds, on a machine giving at least
-      SERIAL_TELLABLE, is serial: no points, not a regrade, whatever its speedup looked like;
+    measure_parallel), on the timed scene drawn for this grade (timed_scene). Every timed
+    image must be the baseline's, bit for bit (what labs 03 and 04 promise). It fails closed:
+    - a program one of whose threads did ONE_THREAD of every timed run's CPU time is serial,
+      at any load and capacity (even where nothing is timed): no points, not a regrade;
+    - so is a program whose timed runs never used more than SERIAL_CORES cores' worth of CPU
+      time (the grader's own measurement of the sandboxed tree) nor more than SERIAL_CORES
+      times the serial reference's share in the same rounds, on a machine giving at least
+      SERIAL_TELLABLE;
     - points follow speed_credit of the speedup against the bar; where the machine stays too
       busy to reach a verdict, the test is marked for regrade and only the points measured
       count: the rest is shown apart, never in the score."""
+    with timed_scene() as scene:
+        return _parallel_speedup(binary, baseline, timed_settings(spp, scene), threads=threads,
+                                 launcher=launcher, fraction=fraction, attempts=attempts,
+                                 overhead_reference=overhead_reference)
+
+
+def _parallel_speedup(binary, baseline, settings: dict, *, threads, launcher, fraction: float,
+                      attempts: int, overhead_reference) -> CheckResult:
     import threading
 
     from labkit.harness import cpu_capacity, measure_parallel
     capacity_here = cpu_capacity()
     if capacity_here < QUOTA_TOO_SMALL:
-        # Nothing to time: no program can show a speedup here. Correctness is graded (the
-        # checks gated on this one open), the speed is left to a regrade on a course machine.
+        # Nothing to time: no program can show a speedup here. One run shows whether the work
+        # is one thread's (serial: final here too); else correctness is graded (the checks
+        # gated on this one open) and the speed left to a regrade on a course machine.
+        try:
+            run = run_lab(binary, threads=threads, launcher=launcher, check=False, **settings)
+        except OSError:  # the binary cannot even be staged: nothing to tell
+            run = None
+        # Only a run that rendered tells whose work a render is (a crash is one thread's too).
+        shares = [busiest_thread_share(run)] if run and run.image is not None else []
+        if one_thread_did_it(shares):
+            return serial_by_thread(shares, f"on a machine giving {capacity_here:g} cores' worth")
         return CheckResult("parallel speedup", True,
                            f"not timed: this machine gives {capacity_here:g} cores' worth of CPU "
                            f"time (CPU count, cgroup cpu.max), too few to show a parallel "
                            f"speedup; correctness graded, speed marked for regrade on a machine "
                            f"with 2 or more", regrade=True, credit=0.0, provisional=1.0)
-    settings = timed_settings(spp)
     want: list[bytes] = []
     wrong: list[str] = []
     used: list[float] = []       # cores' worth of CPU time of each of your timed runs
+    shares: list[float] = []     # the share of each of your timed runs' busiest thread
     base_used: list[float] = []  # the same of the serial reference run alone, same rounds
     overhead = launch_overhead(overhead_reference, launcher) if overhead_reference else 0.0
 
@@ -522,6 +612,7 @@ def check_parallel_speedup(binary, baseline, *, threads=None, launcher=(),
             wrong.append("the timed render differs from the serial reference's image (the bit "
                          "check says why)")
         used.append(cores_used(run))
+        shares.append(busiest_thread_share(run))
         return max(run.wall_seconds - overhead, 1e-3)
 
     def copies(n: int) -> float:
@@ -542,6 +633,12 @@ def check_parallel_speedup(binary, baseline, *, threads=None, launcher=(),
         got more than SERIAL_CORES times the serial reference's share of a busy machine."""
         return max(used, default=0.0) > SERIAL_CORES or share() > SERIAL_CORES
 
+    def threaded() -> bool:
+        """Evidence enough to grade correctness while the speed waits for a regrade: shown
+        parallel, or the work shared among threads (which a busy machine may have run on one
+        core's worth; a regrade on a quiet machine tells)."""
+        return parallel() or (bool(shares) and max(shares) < ONE_THREAD)
+
     note = f" (launch overhead {overhead:.3f} s subtracted)" if overhead else ""
     best = None  # (credit, timing) of the attempt closest to the bar
     capacity = 0.0
@@ -551,6 +648,9 @@ def check_parallel_speedup(binary, baseline, *, threads=None, launcher=(),
         if wrong:
             return CheckResult("parallel speedup", False,
                                f"{wrong[0]}: speed is graded only for a correct image", credit=0.0)
+        if one_thread_did_it(shares):
+            return serial_by_thread(shares, f"{max(used):.2f} cores' worth at most, on a "
+                                            f"machine giving {capacity:.2f}")
         if not parallel() and capacity >= SERIAL_TELLABLE:
             return CheckResult("parallel speedup", False,
                                f"serial: the timed runs used at most {max(used):.2f} cores' "
@@ -567,17 +667,18 @@ def check_parallel_speedup(binary, baseline, *, threads=None, launcher=(),
         if attempt < attempts:
             time.sleep(2.0 * attempt)  # let the other load pass
     if best is None:
-        return CheckResult("parallel speedup", parallel(),
+        return CheckResult("parallel speedup", threaded(),
                            f"not measurable: the machine gave only {capacity:.2f} cores' worth "
                            f"of throughput in {attempts} attempts (the timed runs used "
-                           f"{share():.2f}x the serial reference's CPU share); no points now, "
-                           f"marked for regrade",
+                           f"{share():.2f}x the serial reference's CPU share, their busiest "
+                           f"thread {max(shares, default=float('nan')):.0%} of their CPU time); "
+                           f"no points now, marked for regrade",
                            regrade=True, credit=0.0, provisional=1.0)
     credit, timing = best
     bar = timing.required(fraction)
     detail = timing.describe("yours") + note + credit_note(credit, bar)
     if credit < 1 and timing.capacity < BUSY:
-        return CheckResult("parallel speedup", credit > 0 or parallel(),
+        return CheckResult("parallel speedup", credit > 0 or threaded(),
                            f"short of the bar on a machine too busy to judge ({detail}); "
                            f"marked for regrade", regrade=True, credit=credit,
                            provisional=1.0 - credit)
@@ -593,20 +694,23 @@ def together_launcher(n: int) -> list[str]:
 @image_checked("bit-identical to lab 01")
 def check_bitwise_equal(binary, baseline, *, runs=None) -> CheckResult:
     """The image is the baseline's, bit for bit, for every way of running it (thread counts,
-    rank counts): what a counter-based RNG and a race-free parallel loop guarantee. `runs`
+    rank counts), on the timed scene drawn for this grade: what a counter-based RNG and a
+    race-free parallel loop guarantee. `runs`
     maps a label to run_lab keyword arguments; default: 1, 2, 3 and 7 threads. On a mismatch
     it says which of the two causes it is (why_different)."""
     runs = runs or {f"{t} threads": {"threads": t} for t in (1, 2, 3, 7)}
-    settings = dict(width=48, height=40, spp=8, seed=draws.seed("bitwise"))
-    want = run_lab(baseline, **settings).image
-    images = {label: run_lab(binary, **settings, **how).image for label, how in runs.items()}
-    differing = [label for label, image in images.items()
-                 if image.tobytes() != want.tobytes()]
-    if not differing:
-        return CheckResult("bit-identical to lab 01", True, "identical for " + ", ".join(runs))
-    return CheckResult("bit-identical to lab 01", False,
-                       f"differs for {', '.join(differing)}; "
-                       + why_different(binary, settings, runs, images, differing))
+    with timed_scene() as scene:  # the scene drawn for this grade: nobody's stored image
+        settings = dict(scene=scene, width=48, height=40, spp=8, seed=draws.seed("bitwise"))
+        want = run_lab(baseline, **settings).image
+        images = {label: run_lab(binary, **settings, **how).image for label, how in runs.items()}
+        differing = [label for label, image in images.items()
+                     if image.tobytes() != want.tobytes()]
+        if not differing:
+            return CheckResult("bit-identical to lab 01", True,
+                               "identical for " + ", ".join(runs))
+        return CheckResult("bit-identical to lab 01", False,
+                           f"differs for {', '.join(differing)}; "
+                           + why_different(binary, settings, runs, images, differing))
 
 
 def row_ranges(rows: list[int]) -> str:

@@ -79,13 +79,15 @@ class HiddenGolden:
     golden_spp: int
 
 
-def make_golden(reference, scene_path: pathlib.Path) -> HiddenGolden:
-    """Golden data of the hidden scene from the trusted reference (outside the sandbox)."""
+def make_golden(reference, scene_path: pathlib.Path, size: int = SIZE,
+                bounces: int = BOUNCES) -> HiddenGolden:
+    """Golden data of a scene made at grading time (the hidden scene; the timed renders' drawn
+    scene, at its size) from the trusted reference (outside the sandbox)."""
     seeds = range(2_000_000, 2_000_000 + RENDERS)
     with policy(RunPolicy(trusted=True)), \
             concurrent.futures.ThreadPoolExecutor(max(1, available_cores())) as pool:
         images = list(pool.map(
-            lambda seed: run_lab(reference, scene_path, width=SIZE, height=SIZE, bounces=BOUNCES,
+            lambda seed: run_lab(reference, scene_path, width=size, height=size, bounces=bounces,
                                  spp=SPP_PER_RENDER, seed=seed, threads=1).image, seeds))
     stack = np.stack([i.astype(np.float64) for i in images])
     return HiddenGolden(scene_path, stack.mean(axis=0).astype(np.float32),

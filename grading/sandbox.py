@@ -66,6 +66,8 @@ class Outcome:
                                 # the last interval of each process (TreeClock)
     killed: str | None = None   # why the grader killed it, e.g. "timed out after 60 s"
     cut: tuple[str, ...] = ()   # streams cut at the output cap
+    busiest_thread_share: float = float("nan")  # of the tree's CPU time, its busiest thread's
+                                                # (sampled by the grader: TreeClock)
 
     @property
     def failure(self) -> str | None:
@@ -499,21 +501,43 @@ class Runner:
 
 SAMPLE_SECONDS = 0.05
 _CLOCK_TICKS = os.sysconf("SC_CLK_TCK")
+# Every run the grader starts runs at this nice value, its sessions' autogroups and each of its
+# threads alike, where the grader may raise priority (as root): beside another user's process
+# burning a core, a parallel program at the default weight gets about one core's worth in all
+# (its session shares the CPUs with the other session as one), so neither the reference nor a
+# hand-in could show a speedup. Both sides of every timing run at the same value; a process may
+# lower its own priority again (setsid, nice), never raise it. Not a real-time class: the
+# grader and the system still run.
+RUN_NICE = -10
 
 
 class TreeClock:
     """CPU time of every process descended from one pid, read from /proc by the grader (the
     processes cannot change what the kernel reports there): utime + stime of each process
     (all its threads) plus cutime + cstime (its reaped children). A process that ends is
-    counted in its parent's cutime once reaped; `seconds` keeps the largest total seen."""
+    counted in its parent's cutime once reaped; `seconds` keeps the largest total seen.
 
-    def __init__(self, pid: int):
+    It also keeps each thread's own CPU time (/proc/PID/task/TID/stat; the last value seen of
+    a thread that has ended), so that `busiest_thread_share` says how much of the work one
+    thread did, whatever the load: a serial program does all of it on one thread, a parallel
+    one shares it. Both sides of that fraction are of the same sample (the latest), so the
+    last interval before the exit, which no sample sees, is missing from both.
+
+    With `nice` (the grader is root) each sample also raises the tree's new sessions and
+    threads to that priority (RUN_NICE says why)."""
+
+    def __init__(self, pid: int, nice: int | None = None):
         self.pid = pid
         self.seconds = 0.0
+        self.nice = nice
+        self._threads: dict[tuple[int, int, int], int] = {}  # (pid, tid, start) -> ticks
+        self._sessions: set[int] = set()  # sessions whose autogroup was raised
+        self.busiest_thread_share = float("nan")
 
     def sample(self) -> None:
         parents: dict[int, int] = {}
         times: dict[int, int] = {}
+        sessions: dict[int, int] = {}
         for entry in os.scandir("/proc"):
             if not entry.name.isdigit():
                 continue
@@ -525,6 +549,7 @@ class TreeClock:
             fields = stat_line[stat_line.rfind(b")") + 2:].split()
             pid = int(entry.name)
             parents[pid] = int(fields[1])
+            sessions[pid] = int(fields[3])
             times[pid] = sum(int(v) for v in fields[11:15])  # utime stime cutime cstime
         tree, frontier = {self.pid}, [self.pid]
         children: dict[int, list[int]] = {}
@@ -535,8 +560,41 @@ class TreeClock:
                 if child not in tree:
                     tree.add(child)
                     frontier.append(child)
-        total = sum(times.get(pid, 0) for pid in tree) / _CLOCK_TICKS
-        self.seconds = max(self.seconds, total)
+        ticks = sum(times.get(pid, 0) for pid in tree)
+        self.seconds = max(self.seconds, ticks / _CLOCK_TICKS)
+        for pid in tree:
+            if pid in times:
+                self._sample_threads(pid, sessions[pid])
+        if ticks > 0:
+            self.busiest_thread_share = min(1.0, max(self._threads.values(), default=0) / ticks)
+
+    def _sample_threads(self, pid: int, session: int) -> None:
+        if self.nice is not None and session not in self._sessions:
+            self._sessions.add(session)
+            try:
+                with open(f"/proc/{pid}/autogroup", "w") as f:
+                    f.write(str(self.nice))
+            except OSError:
+                pass  # a kernel without autogroups, or the process has gone
+        try:
+            tasks = os.listdir(f"/proc/{pid}/task")
+        except OSError:
+            return
+        for tid in tasks:
+            try:
+                with open(f"/proc/{pid}/task/{tid}/stat", "rb") as f:
+                    stat_line = f.read()
+            except OSError:
+                continue
+            fields = stat_line[stat_line.rfind(b")") + 2:].split()
+            key = (pid, int(tid), int(fields[19]))  # a reused thread id starts at another time
+            ticks = int(fields[11]) + int(fields[12])  # this thread's utime + stime
+            self._threads[key] = max(self._threads.get(key, 0), ticks)
+            if self.nice is not None and int(fields[16]) > self.nice:
+                try:
+                    os.setpriority(os.PRIO_PROCESS, int(tid), self.nice)
+                except OSError:
+                    pass
 
 
 def _tree_size(folder: pathlib.Path) -> int:
@@ -570,7 +628,7 @@ def _supervise(p: subprocess.Popen, start: float, limits: Limits) -> Outcome:
     for fd in streams:
         os.set_blocking(fd, False)
     pidfd = os.pidfd_open(p.pid)
-    clock = TreeClock(p.pid)
+    clock = TreeClock(p.pid, RUN_NICE if os.geteuid() == 0 else None)
     killed, cut, exited_at, status, usage = None, [], None, None, None
     try:
         open_fds = set(streams)
@@ -629,4 +687,4 @@ def _supervise(p: subprocess.Popen, start: float, limits: Limits) -> Outcome:
     cpu = max(usage.ru_utime + usage.ru_stime if usage else 0.0, clock.seconds)
     (_, out), (_, err) = streams.values()
     return Outcome(p.returncode, decode(bytes(out)), decode(bytes(err)), end - start, cpu,
-                   killed, tuple(cut))
+                   killed, tuple(cut), clock.busiest_thread_share)

@@ -147,6 +147,7 @@ class Run:
     image: np.ndarray | None  # (H, W, 3) float32 linear radiance, top row first
     wall_seconds: float = 0.0         # measured by the grader around the whole process tree
     cpu_seconds: float | None = None  # likewise, where it can be measured (trusted runs)
+    thread_share: float = float("nan")  # of that CPU time, its busiest thread's (likewise)
 
 
 def image_problem(image: np.ndarray, width: int | None, height: int | None) -> str | None:
@@ -223,7 +224,7 @@ def run_lab(binary: pathlib.Path | str, scene: pathlib.Path | str | None = None,
             if problem:
                 raise ImageError(problem)
         return Run(out.returncode, out.stdout, out.stderr, summary, image, out.wall_seconds,
-                   out.cpu_seconds)
+                   out.cpu_seconds, out.busiest_thread_share)
 
 
 def _summary(stdout: str) -> dict | None:

@@ -1,6 +1,7 @@
 """The grader against a catalogue of broken and hostile submissions (tests/grading/
 submissions.py): each loses the points it should, with a message naming the symptom, and
 leaves the grader, the repository and the machine as they were."""
+import contextlib
 import hashlib
 import json
 import os
@@ -443,40 +444,115 @@ def test_values_at_the_float_limit_fail_every_image_check(tmp_path):
 
 # ---- speed that fails closed (grading/checks.py) -------------------------------------------
 
-def test_threads_in_the_simd_lab_earn_no_speed(tmp_path):
+@contextlib.contextmanager
+def burning_one_core():
+    """A process burning one core, in a session of its own (as another user's job would),
+    killed however the block ends."""
+    burner = subprocess.Popen(["/bin/sh", "-c", "while :; do :; done"], start_new_session=True)
+    try:
+        yield burner
+    finally:
+        burner.kill()
+        burner.wait()
+
+
+def speed_test(results, check: str = "parallel-speedup") -> dict:
+    return next(t for t in results["tests"] if t["extra_data"]["check"] == check)
+
+
+@pytest.mark.parametrize("burner", [False, True], ids=["quiet", "beside-a-burner"])
+def test_threads_in_the_simd_lab_earn_no_speed(tmp_path, burner):
     """Scalar code on every core, handed in for lab 02: the timed runs are confined to one
-    CPU and their CPU time is measured, so widening the affinity again earns nothing."""
+    CPU and their CPU time is measured, so widening the affinity again earns nothing, on a
+    quiet machine or beside a process burning a core."""
     from labkit.harness import build
     lab03_ref, = build("lab03-ref")
-    results = grade("02", sub.threads_on_every_cpu(tmp_path, lab03_ref), tmp_path)
-    speed = next(t for t in results["tests"] if t["extra_data"]["check"] == "speedup")
-    assert speed["score"] == 0, describe(results)
+    binary = sub.threads_on_every_cpu(tmp_path, lab03_ref)
+    with burning_one_core() if burner else contextlib.nullcontext():
+        results = grade("02", binary, tmp_path)
+    assert speed_test(results, "speedup")["score"] == 0, describe(results)
     assert results["score"] <= 70, describe(results)
 
 
-@pytest.fixture
-def cpu_burner():
-    """A process burning one core, in a session of its own (as another user's job would)."""
-    p = subprocess.Popen(["/bin/sh", "-c", "while :; do :; done"], start_new_session=True)
-    yield p
-    p.kill()
-    p.wait()
-
-
-def test_serial_lab03_beside_a_cpu_burner_earns_nothing(tmp_path, cpu_burner):
-    """The unmodified lab 03 skeleton renders lab 01's bits on one core (lab01-ref stands in
-    for it): beside a process burning one core noise once made it look 1.1-1.4x faster than
-    the serial reference. Its CPU time over its wall time shows it serial; where the machine
-    is so busy that even that cannot be told, the test is marked for regrade with no points
-    in the score, the possible ones shown apart."""
-    results = grade("03", sub.REFERENCE, tmp_path)
-    speed = next(t for t in results["tests"] if t["extra_data"]["check"] == "parallel-speedup")
+def test_serial_lab03_beside_a_cpu_burner_earns_nothing_and_is_final(tmp_path):
+    """The unmodified lab 03 skeleton (serial: lab 01's bits on one thread) graded beside a
+    process burning one core, where the machine gives about one core's worth and no speedup
+    can be judged: one thread did all of its timed runs' work, which the grader sees thread
+    by thread whatever the load. Serial is final: speed 0, no regrade, no points shown apart,
+    the checks gated on a speedup closed."""
+    from labkit.harness import build
+    skeleton, = build("lab03")
+    with burning_one_core():
+        results = grade("03", skeleton, tmp_path)
+    speed = speed_test(results)
     assert speed["score"] == 0 and results["score"] <= 10, describe(results)
-    if speed["extra_data"]["regrade"]:
-        assert "if the regrade confirms" in results["output"], results["output"]
-        assert results["score"] == sum(t["score"] for t in results["tests"])
-    else:
-        assert speed["output"].startswith("serial:"), describe(results)
+    assert not speed["extra_data"]["regrade"], describe(results)
+    assert not speed["extra_data"].get("provisional"), describe(results)
+    assert "if the regrade confirms" not in results["output"], results["output"]
+    assert speed["output"].startswith("serial: in every timed run one thread did"), \
+        describe(results)
+
+
+def test_the_lab03_reference_beside_a_cpu_burner_is_not_called_serial(tmp_path):
+    """The lab 03 reference beside the same burner: its work is shared among its threads, so
+    it is never called serial; its correctness counts (bits and golden images, 60 points)
+    and its speed either earns points or waits for a regrade, never a final 0."""
+    from labkit.harness import build
+    reference, = build("lab03-ref")
+    with burning_one_core():
+        results = grade("03", reference, tmp_path)
+    speed = speed_test(results)
+    assert not speed["output"].startswith("serial"), describe(results)
+    assert speed["score"] > 0 or speed["extra_data"]["regrade"], describe(results)
+    assert results["score"] >= 60, describe(results)
+
+
+def noisy_golden(spp: int):
+    """The stored golden Cornell image plus noise calibrated to `spp` paths per pixel."""
+    import numpy as np
+
+    from labkit.harness import golden
+    g = golden("cornell")
+    noise = np.random.default_rng(5).standard_normal(g.mean.shape) * np.sqrt(g.variance / spp)
+    return np.maximum(g.mean + noise, 0).astype(np.float32)
+
+
+def golden_plus_noise(folder: pathlib.Path, image, spp: int = 256) -> pathlib.Path:
+    """A correct renderer (the lab-01 reference) that, for lab 02's timed runs (the golden
+    size at `spp`), prints `image` (noisy_golden) at once: what would pass as a render of
+    the public timed scene."""
+    from labkit.pfm import pfm_bytes
+    fake = pfm_bytes(image)
+    reference = sub.REFERENCE.read_bytes()
+    size = image.shape[1]
+    head = (f"{sub.FIND_ARGS}spp=''; width=''; prev=''\n"
+            f'for a in "$@"; do [ "$prev" = --spp ] && spp="$a"; '
+            f'[ "$prev" = --width ] && width="$a"; prev="$a"; done\n'
+            f'if [ "$spp" = {spp} ] && [ "$width" = {size} ]; then\n'
+            f'  tail -c {len(fake)} "$0" > "$pfm"; echo \'{{"seconds": 0.001}}\'; exit 0\n'
+            f"fi\n"
+            f'tail -c {len(reference) + len(fake)} "$0" | head -c {len(reference)} > ./ref '
+            f"&& chmod +x ./ref || exit 99\n"
+            f'./ref "$@"\nexit $?\n')
+    path = folder / "lab"
+    path.write_bytes(b"#!/bin/sh\n" + head.encode() + reference + fake)
+    path.chmod(0o755)
+    return path
+
+
+def test_the_public_golden_image_plus_noise_for_the_timed_runs_earns_no_speed(tmp_path):
+    """Lab 02's timed runs render a variation of the Cornell box drawn from the grading
+    secret, so the public golden image with calibrated noise (which the stored golden data
+    would pass) is a wrong image there: no speed, no more than the honest serial work it
+    replaces (the reference handed in for lab 02: 70)."""
+    from grading import checks
+    image = noisy_golden(256)
+    assert checks.wrong_timed_image(image, 256) is None  # the public scene's data pass it
+    results = grade("02", golden_plus_noise(tmp_path, image), tmp_path)
+    speed = speed_test(results, "speedup")
+    assert speed["score"] == 0 and "the timed render is wrong" in speed["output"], \
+        describe(results)
+    assert results["score"] <= 70, describe(results)
 
 
 # ---- nothing precomputable (grading/draws.py) -----------------------------------------------
@@ -489,14 +565,26 @@ def test_printing_the_published_analytic_answers_earns_nothing(tmp_path):
 
 
 def test_the_secret_draws_the_timed_and_tested_renders():
+    """The timed scene, its seed and the analytic scenes come from the secret: another secret,
+    another camera, light, colours and sphere; the same secret (a regrade), the same."""
     from grading import checks, draws
+    from labkit import scenes
+
+    def drawn():
+        scene = checks.drawn_timed_scene()
+        return (checks.timed_settings(64, pathlib.Path("x"))["seed"], checks.drawn_interior(),
+                scene["camera"], scene["light"], scene["materials"], scene["spheres"])
     with draws.secret("one"):
-        one = (checks.timed_settings(64)["seed"], checks.drawn_interior())
+        one = drawn()
     with draws.secret("two"):
-        two = (checks.timed_settings(64)["seed"], checks.drawn_interior())
-    assert one[0] != two[0] and one[1] != two[1]
+        two = drawn()
+    assert all(a != b for a, b in zip(one, two)), (one, two)
     with draws.secret("one"):
-        assert checks.timed_settings(64)["seed"] == one[0]  # a regrade draws the same
+        assert drawn() == one  # a regrade draws the same
+    public = scenes.load(checks.TIMED_SCENE)
+    assert one[2:] != (public["camera"], public["light"], public["materials"], public["spheres"])
+    assert [q["vertices"] for q in scenes.load(checks.TIMED_SCENE)["quads"]] == \
+        [q["vertices"] for q in checks.drawn_timed_scene()["quads"]]  # the same box: its cost
 
 
 def test_the_reference_objects_are_out_of_the_compilers_reach(tmp_path):

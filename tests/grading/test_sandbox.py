@@ -62,3 +62,38 @@ def test_wall_limit_counts_from_outside():
                                         (134, "aborted (signal 6)"), (3, "exited with status 3")])
 def test_exit_statuses_are_named(code, name):
     assert describe_exit(code) == name
+
+
+# ---- the grader's clocks, thread by thread (sandbox.TreeClock) -----------------------------
+
+SPIN = "i=0; while [ $i -lt 600000 ]; do i=$((i+1)); done"  # ~0.5 s of one core's time
+
+
+def test_one_busy_thread_did_all_the_work():
+    out = sh(SPIN, Limits(wall_seconds=30))
+    assert out.returncode == 0 and out.busiest_thread_share >= 0.9, out
+
+
+def test_work_shared_by_two_at_once_is_shared():
+    out = sh(f"({SPIN}) & ({SPIN}); wait", Limits(wall_seconds=30))
+    assert out.returncode == 0 and 0.3 <= out.busiest_thread_share <= 0.7, out
+
+
+def test_the_work_of_ended_processes_still_counts():
+    """Two workers one after the other, each ended and reaped before the next: what they did
+    stays in the tree's total, so neither is taken for all of the work."""
+    out = sh(f"({SPIN}); ({SPIN})", Limits(wall_seconds=30))
+    assert out.returncode == 0 and 0.3 <= out.busiest_thread_share <= 0.7, out
+
+
+def test_the_runs_get_the_graders_priority_where_it_may_give_it():
+    """As root, every run of the grader's runs at sandbox.RUN_NICE, its session's autogroup
+    and its threads alike (a burner in another session does not halve a parallel program's
+    cores); a process may lower its priority again, not raise it."""
+    import os
+    if os.geteuid() != 0:
+        pytest.skip("only root may raise a process's priority")
+    out = sh("sleep 0.3; cat /proc/self/autogroup; cut -d' ' -f19 /proc/self/stat; "
+             "renice -n -19 -p $$ >/dev/null 2>&1 && echo raised")
+    assert f"nice {sandbox.RUN_NICE}" in out.stdout, out
+    assert out.stdout.split()[-1] == str(sandbox.RUN_NICE), out

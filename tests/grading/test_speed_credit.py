@@ -63,3 +63,27 @@ def test_the_quota_is_read_from_the_cgroup():
     quota = harness.cpu_quota()
     assert quota is None or quota > 0
     assert 0 < harness.cpu_capacity() <= len(os.sched_getaffinity(0))
+
+
+def test_one_thread_doing_the_work_is_told_from_work_shared():
+    from grading.checks import ONE_THREAD, one_thread_did_it
+    assert one_thread_did_it([1.0, ONE_THREAD]) and not one_thread_did_it([1.0, 0.5])
+    assert not one_thread_did_it([]) and not one_thread_did_it([math.nan, 1.0])
+
+
+@pytest.mark.parametrize("binary, serial", [("lab01-ref", True), ("lab03-ref", False)])
+def test_serial_is_final_even_where_nothing_is_timed(monkeypatch, binary, serial):
+    """At a CPU quota too small to time a speedup (Gradescope's default 0.5) one run still
+    shows whose work it is: a serial program's one thread did all of it (final: no points,
+    no regrade, the gated checks closed), a parallel one shares it (correctness graded,
+    speed left to a regrade)."""
+    from grading import checks
+    from labkit import harness
+    monkeypatch.setattr(harness, "cpu_quota", lambda: 0.5)
+    program, = harness.build(binary)
+    result = checks.check_parallel_speedup(program, checks.LAB01_REFERENCE, threads=2)
+    if serial:
+        assert not result.regrade and not result.passed and result.credit == 0, result
+        assert result.detail.startswith("serial: in every timed run one thread did"), result.detail
+    else:
+        assert result.regrade and result.passed and result.provisional == 1, result
