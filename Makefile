@@ -180,7 +180,7 @@ render: deps
 	@MAKE="$(MAKE)" bash tools/render.sh
 
 skeletons:
-	$(PYTHON) tools/skeletons.py
+	$(PYTHON) -m tools.skeletons
 
 # Style: ruff (pyproject.toml) on the Python, clang-format (.clang-format) on every tracked
 # C++/CUDA file, both at the versions of tools/requirements.txt (make deps). The skeletons are
@@ -195,10 +195,10 @@ lint:
 format:
 	$(PYTHON) -m ruff check --quiet --fix .
 	@$(CLANG_FORMAT) -i $(CXX_SOURCES)
-	$(PYTHON) tools/skeletons.py
+	$(PYTHON) -m tools.skeletons
 
 check-skeletons:
-	$(PYTHON) tools/skeletons.py --check
+	$(PYTHON) -m tools.skeletons --check
 
 # common/core/ is exactly what runs on the GPU too: every header of it must compile under nvcc
 # on its own, with nothing but core/ on the include path, in the float and the double build

@@ -26,6 +26,7 @@ import pathlib
 
 from grading import hidden
 from grading.harness import ROOT
+from labkit import registry
 
 
 def _load_skeletons():
@@ -57,9 +58,10 @@ ELF_MAGIC = b"\x7fELF"
 
 
 def lab_folders(root: pathlib.Path) -> dict[str, str]:
-    """Lab number -> folder name: {"01": "01-serial", ...}."""
-    return {p.name[:2]: p.name for p in sorted((root / "labs").iterdir())
-            if p.is_dir() and p.name[:2].isdigit()}
+    """Lab number -> folder name: {"01": "01-serial", ...}, as labs/labs.toml under `root`
+    declares them."""
+    return {lab.number: lab.folder
+            for lab in registry.parse((root / "labs" / "labs.toml").read_text())}
 
 
 def earlier_solution_files(lab: str, folders: dict[str, str]) -> tuple[list[str], list[str]]:

@@ -169,6 +169,14 @@ def shared_sources() -> dict[str, list[str]]:
     return {entry.folder: list(entry.shared) for entry in labs() if entry.shared}
 
 
+def owner(target: str) -> Lab:
+    """The lab whose make target `target` is ("lab05-ref" -> lab 05)."""
+    for entry in labs():
+        if target in entry.targets:
+            return entry
+    raise RegistryError(f"no lab declares the make target {target!r} (labs/labs.toml)")
+
+
 def all_targets() -> tuple[str, ...]:
     """Every make target of every lab, in course order."""
     return tuple(t for entry in labs() for t in entry.targets)
@@ -187,7 +195,7 @@ def make_fragment() -> str:
                   f"LAB_STUDENT_{n} := {' '.join(entry.student)}",
                   f"LAB_REFERENCE_{n} := {' '.join(entry.reference)}",
                   f"LAB_EXTRAS_{n} := {' '.join(entry.extras)}"]
-    return "\n".join(lines) + "\n"
+    return "".join(f"{line.rstrip()}\n" for line in lines)
 
 
 def _targets_of(args: list[str], field: str) -> list[str]:

@@ -26,6 +26,7 @@ ROOT = pathlib.Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(ROOT))
 from grading.checks import mpirun  # noqa: E402
 from grading.variants import build_sources, lab_sources  # noqa: E402
+from labkit.cuda_env import missing_gpu as gpu_missing  # noqa: E402
 
 VARIANT_DIR = ROOT / "build" / "tradeoff" / "variants"
 # Open MPI refuses to start as root unless told (containers, CI); as tools/bench_cpu.py does.
@@ -87,17 +88,6 @@ def cpu_references(names=None) -> list[Series]:
             s.binary = ROOT / name
         out.append(s)
     return out
-
-
-def gpu_missing() -> str | None:
-    """Why nothing runs on a GPU here, or None (asks nvidia-smi, like tests/labs/cuda_env.py)."""
-    if shutil.which("nvidia-smi") is None:
-        return "no NVIDIA GPU here (nvidia-smi not found)"
-    p = subprocess.run(["nvidia-smi", "--query-gpu=name", "--format=csv,noheader"],
-                       capture_output=True, text=True)
-    if p.returncode != 0 or not p.stdout.strip():
-        return "no NVIDIA GPU here (nvidia-smi lists none)"
-    return None
 
 
 def gpu_info() -> str | None:
