@@ -20,11 +20,11 @@ import subprocess
 import numpy as np
 import pytest
 from cuda_env import gpu_name, missing_gpu
-from renderer_checks import CHECKS
 
 from grading import checks
 from grading.compare import compare
 from grading.harness import ROOT, build, golden, run_lab
+from grading.renderer_checks import CHECKS
 
 LAB = "06-cuda-split"
 # The H200 test's bar: the reference's best recorded time on the baseline (reference/gpu/)

@@ -8,10 +8,10 @@ import os
 import subprocess
 
 import pytest
-from renderer_checks import CHECKS
 
 from grading import checks, scenes
 from grading.harness import ROOT, build, run_lab
+from grading.renderer_checks import CHECKS
 
 
 @pytest.fixture(scope="module")
