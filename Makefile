@@ -127,7 +127,8 @@ endef
 # written by labkit/registry.py and rewritten, then read again, whenever the registry changes.
 $(BUILD)/labs.mk: labs/labs.toml labkit/registry.py
 	@mkdir -p $(dir $@)
-	@$(PYTHON) -m labkit.registry make > $@.partial && mv $@.partial $@
+	@$(PYTHON) -m labkit.registry make > $@.partial || { rm -f $@.partial; exit 2; }
+	@mv $@.partial $@
 include $(BUILD)/labs.mk
 
 # Each registered lab's own rules (its binaries, extra flags) live in labs/NN-name/lab.mk;

@@ -216,15 +216,16 @@ QUERIES = {
     "ships": lambda args: _targets_of(args, "ships"),
     "make": lambda args: [make_fragment().rstrip("\n")],
 }
-ONE_LAB = ("folder", "kind")
+# How many lab numbers each query takes: folder and kind one, the target lists none (every
+# lab) or one.
+LAB_ARGUMENTS = {"folder": (1,), "kind": (1,), "targets": (0, 1), "student": (0, 1),
+                 "references": (0, 1), "ships": (0, 1)}
 
 
 def main(argv: list[str] | None = None) -> int:
     args = sys.argv[1:] if argv is None else argv
-    if not args or args[0] not in QUERIES or len(args) > 2 \
-            or (args[0] in ONE_LAB) != (len(args) == 2) \
-            or (len(args) == 2 and args[0] not in ONE_LAB + ("targets", "student", "references",
-                                                           "ships")):
+    if not args or args[0] not in QUERIES \
+            or len(args) - 1 not in LAB_ARGUMENTS.get(args[0], (0,)):
         print(f"error: registry: usage: python3 -m labkit.registry "
               f"{{{'|'.join(QUERIES)}}} [NN]", file=sys.stderr)
         return 2
