@@ -188,10 +188,23 @@ def first_entry_with(old: str, new: str) -> str:
     ("[[lab]\n", "not TOML"),
     ("", "[[lab]] tables"),
 ])
-def test_a_broken_registry_is_one_clear_error(text, fragment):
+@pytest.mark.parametrize("reader", ["tomllib", "subset"])
+def test_a_broken_registry_is_one_clear_error(text, fragment, reader, monkeypatch):
+    if reader == "subset":  # what a Python without tomllib reads (3.10)
+        monkeypatch.setattr(registry, "tomllib", None)
     with pytest.raises(registry.RegistryError) as e:
         registry.parse(text)
     assert fragment in str(e.value) and "\n" not in str(e.value)
+
+
+def test_without_tomllib_the_registry_reads_the_same():
+    import tomllib
+    assert registry.loads_subset(TEXT) == tomllib.loads(TEXT)
+    assert registry.loads_subset('a = 3  # c\n[[lab]]\nb = "x # y"\nc = [\n  "d",\n]\n') == \
+        {"a": 3, "lab": [{"b": "x # y", "c": ["d"]}]}
+    for bad in ("[[lab]\n", 'x = ["a",\n', "a = 1\na = 2\n", "x = true\n", "x = \n"):
+        with pytest.raises(ValueError):
+            registry.loads_subset(bad)
 
 
 def test_each_check_fails_on_a_tree_that_is_wrong(tmp_path):
