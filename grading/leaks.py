@@ -45,8 +45,8 @@ skeletons = _load_skeletons()
 # Gradescope bundle), the labs' tests (they test the references, mutants of the solutions and
 # the skeletons' sync with them), CI, and this release tool itself.
 NEVER_SHIPPED = ("tools/skeletons.py", "tools/make_golden.py", "tests/grading/*",
-                 "tests/labs/test_lab0*", ".ci/*", "grading/release.py", "grading/leaks.py",
-                 "grading/reference_bins.py")
+                 "tests/labs/test_lab[0-9][0-9]*", ".ci/*", "grading/release.py",
+                 "grading/leaks.py", "grading/reference_bins.py")
 # Tests students get: the shared command-line contract (run on the reference binaries) and
 # the unit tests of common/ (which test lab 01's path tracer too: they fail until lab 01 is
 # done, as they should). Every other test needs the solutions (pristine skeletons, skeleton
