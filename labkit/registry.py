@@ -12,7 +12,7 @@ For shell and make, `python3 -m labkit.registry QUERY` prints one answer:
     make                                       the Makefile's fragment (build/labs.mk)
 
 A broken registry (a missing field, a lab declared twice, an unknown kind) is one error line
-and exit status 2, here and wherever the file is read.
+and exit status 2, here and in every program that reads it.
 """
 from __future__ import annotations
 
@@ -172,12 +172,14 @@ def parse(text: str, where: str = "labs/labs.toml") -> tuple[Lab, ...]:
 
 @functools.lru_cache(maxsize=None)
 def labs() -> tuple[Lab, ...]:
-    """Every lab, in course order."""
+    """Every lab, in course order. Every entry point needs them (the grader's rubrics are
+    made when it starts), so an unreadable or broken registry ends the program here: one
+    error line and exit status 2, not a traceback from wherever it was first asked."""
     try:
-        text = REGISTRY.read_text()
-    except OSError as e:
-        raise RegistryError(f"cannot read the lab registry: {e}") from None
-    return parse(text)
+        return parse(REGISTRY.read_text())
+    except (OSError, RegistryError) as e:
+        print(f"error: registry: {e}", file=sys.stderr)
+        raise SystemExit(2) from None
 
 
 def lab(number: str) -> Lab:

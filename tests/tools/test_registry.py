@@ -241,3 +241,8 @@ def test_make_stops_on_a_broken_registry_with_one_line(tmp_path):
     errors = [line for line in p.stderr.splitlines() if not line.startswith(("make", "Makefile"))]
     assert len(errors) == 1 and "kind must be one of" in errors[0], p.stderr
     assert not (root / "build" / "labs.mk").exists()
+    # Any program that reads the registry says the same, in one line.
+    p = subprocess.run([sys.executable, "-m", "labkit.registry", "numbers"], cwd=root,
+                       capture_output=True, text=True)
+    assert p.returncode == 2 and p.stdout == "" and p.stderr.count("\n") == 1
+    assert p.stderr.startswith("error: registry: ") and "kind must be one of" in p.stderr
