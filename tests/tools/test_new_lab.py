@@ -120,6 +120,7 @@ def test_its_skeleton_is_generated_from_its_solution(repo):
 
 
 def test_make_and_every_drift_check_know_it(repo):
+    """The drift checks pass on the copy, and so does the drift test itself, unedited."""
     root, _ = repo
     assert f"lab{LAB}-ref" in run(root, "make", "-s", "help").stdout
     assert run(root, sys.executable, "-m", "labkit.registry", "folder", LAB).stdout == f"{FOLDER}\n"
@@ -128,6 +129,8 @@ def test_make_and_every_drift_check_know_it(repo):
     assert drift.unknown_targets(root) == []
     assert drift.stale_generated(root) == []
     assert drift.not_ignored(root) == []
+    run(root, sys.executable, "-m", "pytest", "-q", "-p", "no:cacheprovider",
+        "tests/tools/test_registry.py")
 
 
 def test_it_is_graded_on_its_rubric(repo, tmp_path):
