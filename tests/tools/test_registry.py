@@ -65,11 +65,27 @@ def make_targets(root: pathlib.Path) -> set[str]:
     return {m.group(1) for m in re.finditer(r"^([A-Za-z0-9_.+/-]+):", p.stdout, re.M)}
 
 
-def make_variable(root: pathlib.Path, name: str) -> list[str]:
+def make_variable(root: pathlib.Path, name: str, *settings: str) -> list[str]:
     rule = f"print-registry-var: ; @echo $({name})"
-    p = subprocess.run(["make", "-s", "-C", str(root), f"--eval={rule}", "print-registry-var"],
-                       capture_output=True, text=True, check=True)
+    p = subprocess.run(["make", "-s", "-C", str(root), *settings, f"--eval={rule}",
+                        "print-registry-var"], capture_output=True, text=True, check=True)
     return p.stdout.split()
+
+
+def cuda_disagreements(root: pathlib.Path) -> list[str]:
+    """Where cuda.mk's view of the CUDA labs (cuda_lab's calls in their lab.mk, read as make
+    reads them where nvcc is: HAVE_NVCC set) is not the registry's: the GPU labs, and the
+    files their students write that stand in for shared ones (`shared`)."""
+    gpu_labs = [lab for lab in labs_of(root) if lab.gpu]
+    problems = []
+    if make_variable(root, "CUDA_LAB_FOLDERS", "HAVE_NVCC=yes") != [lab.folder for lab in gpu_labs]:
+        problems.append("cuda_lab's labs are not the registry's GPU labs")
+    for lab in gpu_labs:
+        written = make_variable(root, f"CUDA_STUDENT_FILES_{lab.folder}", "HAVE_NVCC=yes")
+        if sorted(written) != sorted(pathlib.PurePath(s).name for s in lab.shared):
+            problems.append(f"{lab.folder}: cuda_lab's student files {written} are not its "
+                            f"shared files {list(lab.shared)}")
+    return problems
 
 
 def unknown_targets(root: pathlib.Path) -> list[str]:
@@ -126,6 +142,10 @@ def test_every_registered_lab_is_complete():
 
 def test_every_registered_target_is_a_make_target_and_every_binary_registered():
     assert unknown_targets(ROOT) == []
+
+
+def test_the_cuda_rules_agree_with_the_registry():
+    assert cuda_disagreements(ROOT) == []
 
 
 def test_the_generated_pieces_are_current():
@@ -249,3 +269,19 @@ def test_make_stops_on_a_broken_registry_with_one_line(tmp_path):
                        capture_output=True, text=True)
     assert p.returncode == 2 and p.stdout == "" and p.stderr.count("\n") == 1
     assert p.stderr.startswith("error: registry: ") and "kind must be one of" in p.stderr
+
+
+def test_the_cuda_check_fails_where_a_lab_mk_disagrees(tmp_path):
+    root = tmp_path / "repo"
+    rels = ["Makefile", "cuda.mk", "grading/grading.mk", "labkit/__init__.py",
+            "labkit/registry.py", "labs/labs.toml",
+            *(f"labs/{lab.folder}/lab.mk" for lab in registry.labs())]
+    for rel in rels:
+        (root / rel).parent.mkdir(parents=True, exist_ok=True)
+        shutil.copy(ROOT / rel, root / rel)
+    assert cuda_disagreements(root) == []
+    toml = root / "labs" / "labs.toml"
+    toml.write_text(toml.read_text().replace(
+        'shared = ["common/wavefront/path_queue.cuh", "common/wavefront/stage_loop.cuh"]',
+        'shared = ["common/wavefront/path_queue.cuh"]'))
+    assert [p.split(":")[0] for p in cuda_disagreements(root)] == ["06-cuda-split"]
