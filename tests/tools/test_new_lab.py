@@ -18,7 +18,7 @@ import zipfile
 
 import pytest
 
-from grading.harness import ROOT
+from labkit.registry import ROOT
 from tests.tools import test_registry as drift
 
 LAB, FOLDER = "08", "08-throwaway"
