@@ -128,12 +128,21 @@ $(1)-ref: $(patsubst %.cpp,$(BUILD)/%.o,$(wildcard labs/$(2)/solution/*.cpp)) $(
 .PHONY: $(1) $(1)-ref
 endef
 
-# Each lab's own rules (its binaries, extra flags) live in labs/NN-name/lab.mk; each adds
-# its binaries to LAB_BINARIES.
+# The labs are declared once, in labs/labs.toml (DESIGN.md section 2); build/labs.mk is what
+# make knows of it (LABS, GPU_LABS, LAB_FOLDER_NN, LAB_KIND_NN, REGISTERED_TARGETS, ...),
+# written by labkit/registry.py and rewritten, then read again, whenever the registry changes.
+$(BUILD)/labs.mk: labs/labs.toml labkit/registry.py
+	@mkdir -p $(dir $@)
+	@$(PYTHON) -m labkit.registry make > $@.partial || { rm -f $@.partial; exit 2; }
+	@mv $@.partial $@
+include $(BUILD)/labs.mk
+
+# Each registered lab's own rules (its binaries, extra flags) live in labs/NN-name/lab.mk;
+# each adds its binaries to LAB_BINARIES.
 # cuda.mk (nvcc, the cuda_lab rule) comes first: the CUDA labs' lab.mk files use it.
 LAB_BINARIES :=
 include cuda.mk
-include $(sort $(wildcard labs/*/lab.mk))
+include $(foreach n,$(LABS),labs/$(LAB_FOLDER_$(n))/lab.mk)
 include grading/grading.mk
 
 # Lab 01's reference in double, with the same scene files and command line (--json says

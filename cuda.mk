@@ -1,4 +1,4 @@
-# CUDA labs (05-07): the nvcc rules. Included by the Makefile before the labs' lab.mk files,
+# CUDA labs (kind "gpu" in labs/labs.toml: 05-07): the nvcc rules. Included by the Makefile before the labs' lab.mk files,
 # which build their labs with cuda_lab (below); each lab's own targets are in its lab.mk.
 #
 #   make cuda-variant VARIANT_LAB=<lab folder> VARIANT=DIR   a CUDA lab from a folder of sources
@@ -54,7 +54,7 @@ print-cuda-build-command:
 
 # $(1): binary stem (lab05), $(2): lab folder (05-cuda-mega), $(3): the shared GPU folders
 # the lab builds on besides common/cuda (common/wavefront), $(4): the files its students
-# write that stand in for shared ones (megakernel.cuh; labkit/skeletons.py's SHARED_SOURCES).
+# write that stand in for shared ones (megakernel.cuh: the lab's `shared` in labs/labs.toml).
 # skeleton/ or solution/ comes first on the include path, then $(3), then CUDA_INCLUDES.
 define cuda_lab
 CUDA_LAB_FOLDERS += $(2)
@@ -109,20 +109,19 @@ $(BUILD)/cuda/speed_targets_check: tests/cuda/speed_targets_check.cu
 check-speed-targets: $(BUILD)/cuda/speed_targets_check
 	@$<
 
-# The compiler's resource report (ptxas -v) for every kernel of the GPU references and
-# lab 05's benchmark (the course report's Table 1 for our kernels), for one architecture: the
-# GPU present, else sm_90. Writes build/kernel-report.md. Each source gets the include path
-# its own build uses.
+# The compiler's resource report (ptxas -v) for every kernel of the GPU references (every
+# GPU lab of labs/labs.toml) and lab 05's benchmark (the course report's Table 1 for our
+# kernels), for one architecture: the GPU present, else sm_90. Writes build/kernel-report.md.
+# Each source gets the include path its own build uses.
 KERNEL_REPORT_ARCH = $(if $(CUDA_GPU_CAPS),sm_$(firstword $(CUDA_GPU_CAPS)),sm_90)
 KERNEL_REPORT_NVCC = $(NVCC) -std=c++17 -O3 -arch=$(KERNEL_REPORT_ARCH) -Xptxas -v
 kernel_report_compile = $(KERNEL_REPORT_NVCC) -Ilabs/$(1)/solution $(CUDA_SHARED_INCLUDES_$(1)) \
     $(CUDA_INCLUDES) $(INCLUDES) -c labs/$(1)/$(2) -o $(BUILD)/kernel-report/$(3).o
 kernel-report:
 	@mkdir -p $(BUILD)/kernel-report
-	@{ $(call kernel_report_compile,05-cuda-mega,solution/render.cu,lab05) && \
-	   $(call kernel_report_compile,05-cuda-mega,bench.cu,lab05-bench) && \
-	   $(call kernel_report_compile,06-cuda-split,solution/render.cu,lab06) && \
-	   $(call kernel_report_compile,07-soa,solution/render.cu,lab07); \
+	@{ $(foreach n,$(GPU_LABS),\
+	       $(call kernel_report_compile,$(LAB_FOLDER_$(n)),solution/render.cu,lab$(n)) &&) \
+	   $(call kernel_report_compile,05-cuda-mega,bench.cu,lab05-bench); \
 	 } > $(BUILD)/kernel-report/ptxas.log 2>&1 || { cat $(BUILD)/kernel-report/ptxas.log; exit 1; }
 	@$(PYTHON) labs/05-cuda-mega/kernel_report.py $(BUILD)/kernel-report/ptxas.log \
 	    --arch $(KERNEL_REPORT_ARCH) --out $(BUILD)/kernel-report.md

@@ -1,5 +1,5 @@
-"""What grading a GPU lab (05-07) needs of the machine: an NVIDIA GPU, and a sandbox that lets
-a CUDA program reach it.
+"""What grading a GPU lab (kind "gpu" in labs/labs.toml) needs of the machine: an NVIDIA
+GPU, and a sandbox that lets a CUDA program reach it.
 
 A CUDA program talks to the driver through device nodes (/dev/nvidiactl, /dev/nvidia-uvm,
 /dev/nvidia0, ...) and the driver's user-space library (libcuda.so), which the CUDA runtime
@@ -14,10 +14,13 @@ from __future__ import annotations
 import functools
 import glob
 import os
-import shutil
 import subprocess
 
-GPU_LABS = frozenset({"05", "06", "07"})
+from labkit import registry
+from labkit.cuda_env import missing_gpu
+
+# The labs that run on a GPU: those of kind "gpu" in labs/labs.toml.
+GPU_LABS = frozenset(registry.gpu_labs())
 
 DEV = "/dev"
 # Where the driver's libcuda.so may live: Debian/Ubuntu's multiarch folder, the folder the
@@ -32,22 +35,6 @@ SYSFS = ("/sys/bus/pci", "/sys/devices", "/sys/module/nvidia")
 
 def is_gpu_lab(lab: str) -> bool:
     return lab in GPU_LABS
-
-
-@functools.lru_cache(maxsize=None)
-def missing_gpu() -> str | None:
-    """Why nothing can run on an NVIDIA GPU here, or None. Asks nvidia-smi, which comes with
-    the driver (as tests/labs/cuda_env.py does for the lab tests)."""
-    if shutil.which("nvidia-smi") is None:
-        return "this machine has no NVIDIA GPU (no driver: nvidia-smi not found)"
-    try:
-        p = subprocess.run(["nvidia-smi", "--query-gpu=name", "--format=csv,noheader"],
-                           capture_output=True, text=True, timeout=60)
-    except (OSError, subprocess.TimeoutExpired) as e:
-        return f"this machine's NVIDIA driver does not answer (nvidia-smi: {e})"
-    if p.returncode != 0 or not p.stdout.strip():
-        return "this machine has no NVIDIA GPU (nvidia-smi lists none)"
-    return None
 
 
 @functools.lru_cache(maxsize=None)

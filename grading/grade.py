@@ -21,6 +21,7 @@ from typing import Callable
 
 from grading import checks, draws, golden_sums, gpu, hidden, report_html, sandbox, symptoms
 from grading.results import Results, Test
+from labkit import registry
 from labkit.harness import ROOT, RunPolicy, available_cores, build, policy
 
 LAB01_REFERENCE = ROOT / "lab01-ref"
@@ -116,9 +117,10 @@ def checked_golden(scene: str, points: int, **options) -> Item:
 # and must pass the golden comparison.
 GPU_SPEED_BAR = 0.75  # at least 3/4 of the reference's speed: at most 1.33x its time
 GPU_TIMED_SCALE = 10
-# H200 throughput of the references (reference/gpu/): lab 05 4.6, lab 06 2.5, lab 07 2.7
-# Gpaths/s, so 640x640 at these spp takes 0.36, 0.34 and 0.31 s of kernel time.
-GPU_TIMED_SPP = {"05": 4096, "06": 2048, "07": 2048}
+# Each GPU lab's spp is its timed_spp in labs/labs.toml. H200 throughput of the references
+# (reference/gpu/): lab 05 4.6, lab 06 2.5, lab 07 2.7 Gpaths/s, so 640x640 at 4096, 2048 and
+# 2048 spp takes 0.36, 0.34 and 0.31 s of kernel time.
+GPU_TIMED_SPP = {lab.number: lab.timed_spp for lab in registry.labs() if lab.gpu}
 
 
 def gpu_reference(lab: str) -> pathlib.Path:
@@ -135,14 +137,14 @@ def gpu_speed(lab: str, points: int) -> Item:
                 requires=GOLDENS)
 
 
-def gpu_rubric(lab: str) -> list[Item]:
+def gpu_rubric(lab: str, layout_lesson: bool = False) -> list[Item]:
     """Labs 05-07 alike. The sphere interior is worth little: lab 05's skeleton (spheres only,
     one path per pixel) passes it, the zero-variance scene needing no second path. A
     reproducible skeleton proves nothing either, so reproducibility, like scale, counts only
-    for a renderer that renders the golden image. Lab 07's lesson is the pool's layout, which
-    its speed cannot show (lab 06's layout is within 10% of it): 10 of its speed's points go
-    to the layout itself."""
-    layout = [needs(STRUCTURE_OF_ARRAYS, "golden-cornell")] if lab == "07" else []
+    for a renderer that renders the golden image. Lab 07's lesson is the pool's layout
+    (`layout_lesson`, rubric "gpu-soa"), which its speed cannot show (lab 06's layout is within
+    10% of it): 10 of its speed's points go to the layout itself."""
+    layout = [needs(STRUCTURE_OF_ARRAYS, "golden-cornell")] if layout_lesson else []
     return [
         worth(SPHERE_INTERIOR, 5), worth(LIT_PLANE, 10), worth(GLASS_PANE, 10), hidden_scene(),
         checked_golden("cornell", 20), checked_golden("showcase", 15), worth(SCALE, 5),
@@ -151,17 +153,18 @@ def gpu_rubric(lab: str) -> list[Item]:
     ]
 
 
-# Points per check, per lab (grading/README.md gives the formulas). The checks are described
-# in grading/checks.py. In labs 03 and 04 the point is parallelism: a correct serial renderer
-# (lab 03's skeleton is one) earns nothing there until its parallel speedup is shown, and the
-# speedup counts only when the timed images are lab 01's bits.
-RUBRICS = {
-    "01": [
+# Points per check, per kind of rubric (grading/README.md gives the formulas); each lab names
+# its rubric in labs/labs.toml. The checks are described in grading/checks.py. In labs 03 and
+# 04 the point is parallelism: a correct serial renderer (lab 03's skeleton is one) earns
+# nothing there until its parallel speedup is shown, and the speedup counts only when the
+# timed images are lab 01's bits.
+RUBRIC_KINDS: dict[str, Callable[[str], list[Item]]] = {
+    "serial": lambda lab: [
         worth(SPHERE_INTERIOR, 15), worth(LIT_PLANE, 15), worth(GLASS_PANE, 10), hidden_scene(),
         checked_golden("cornell", 20), checked_golden("showcase", 20), worth(SCALE, 10),
         worth(REPRODUCIBLE, 10),
     ],
-    "02": [
+    "simd": lambda lab: [
         worth(SPHERE_INTERIOR, 10), worth(LIT_PLANE, 10), worth(GLASS_PANE, 10), hidden_scene(),
         checked_golden("cornell", 15), checked_golden("showcase", 15), worth(SCALE, 10),
         # The handout's bar is 2.5x on the full baseline; graded here is what holds on a busy
@@ -171,7 +174,7 @@ RUBRICS = {
              lambda b: checks.check_speedup(b, LAB01_REFERENCE, 1.5, one_core=True),
              requires=GOLDENS),
     ],
-    "03": [
+    "openmp": lambda lab: [
         needs(bitwise(30), "parallel-speedup"),
         hidden_scene(),
         needs(checked_golden("cornell", 20), "parallel-speedup"),
@@ -180,7 +183,7 @@ RUBRICS = {
         # handout's bar, 0.9 x cores, is measured by tools/bench/openmp.py on a quiet machine.
         parallel_speedup(40),
     ],
-    "04": [
+    "mpi": lambda lab: [
         needs(bitwise(30, runs={f"{n} ranks": {"launcher": checks.mpirun(n), "threads": 1}
                                 for n in (1, 2, 3, 5)}), "parallel-speedup"),
         hidden_scene(launcher=checks.mpirun(2), threads=1),
@@ -189,8 +192,10 @@ RUBRICS = {
         parallel_speedup(40, threads=1, launcher=checks.mpirun(available_cores()),
                          overhead_reference=LAB04_REFERENCE),
     ],
-    **{lab: gpu_rubric(lab) for lab in sorted(gpu.GPU_LABS)},
+    "gpu": gpu_rubric,
+    "gpu-soa": lambda lab: gpu_rubric(lab, layout_lesson=True),
 }
+RUBRICS = {lab.number: RUBRIC_KINDS[lab.rubric](lab.number) for lab in registry.labs()}
 
 # One run may take this long (seconds); every test render of a reference takes under 2 s on
 # a busy two-core machine. After a run has timed out, later runs get SHORT_RUN_SECONDS: a
@@ -400,10 +405,6 @@ def print_table(lab: str, binary: pathlib.Path, results: dict) -> None:
         print(results["output"])
 
 
-LAB_FOLDERS = {"01": "01-serial", "02": "02-simd", "03": "03-openmp", "04": "04-mpi",
-               "05": "05-cuda-mega", "06": "06-cuda-split", "07": "07-soa"}
-
-
 def first_errors(text: str, lines: int = 20) -> str:
     """The compiler's first error lines (what a student needs to see first)."""
     all_lines = text.splitlines()
@@ -453,7 +454,7 @@ def build_lab(lab: str, sources: pathlib.Path | None = None, trusted: bool = Tru
     if sources is not None:
         from grading.compile import build_in_sandbox
         target = "cuda-variant" if gpu.is_gpu_lab(lab) else "variant"
-        binary, errors, note = build_in_sandbox(LAB_FOLDERS[lab], sources, target,
+        binary, errors, note = build_in_sandbox(registry.lab(lab).folder, sources, target,
                                                 trusted=trusted)
         if note and notes is not None:
             notes.append(note)
@@ -509,7 +510,7 @@ def main(argv=None) -> int:
             results.refuse(line, regrade=True)
             return 2
         build("lab01-ref")  # the baseline of every speedup, the hidden scene's golden data
-        if a.lab == "04":
+        if registry.lab(a.lab).kind == "mpi":
             build("lab04-ref")  # measures mpirun's start-up
         if gpu.is_gpu_lab(a.lab):
             build(f"lab{a.lab}-ref")  # the baseline of the lab's speed

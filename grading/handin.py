@@ -4,11 +4,12 @@
     python3 -m grading.handin NN [--out FILE.zip]
 
 The hand-in is the lab's skeleton files, as the student finished them: the files of
-labs/NN-name/skeleton/, at the top of the zip (lab 02's Part A keeps its folder,
-part-a/vec3.h). Gradescope unpacks the upload into its submission folder, and
-`make grade-batch` takes one such folder per student; the grader finds the files where a
-student may have put them (grading/students_tree.py: at the top, or in a folder at any
-depth, as in a zipped folder or a repository checkout) and builds only the top-level ones.
+labs/NN-name/skeleton/ that labs/labs.toml lists as its hand-in, at the top of the zip
+(lab 02's Part A keeps its folder, part-a/vec3.h). Gradescope unpacks the upload into its
+submission folder, and `make grade-batch` takes one such folder per student; the grader
+finds the files where a student may have put them (grading/students_tree.py: at the top, or
+in a folder at any depth, as in a zipped folder or a repository checkout) and builds only
+the top-level ones.
 """
 from __future__ import annotations
 
@@ -19,10 +20,11 @@ import subprocess
 import sys
 import zipfile
 
+from labkit import registry
 from labkit.harness import ROOT
 
-LAB_FOLDERS = {"01": "01-serial", "02": "02-simd", "03": "03-openmp", "04": "04-mpi",
-               "05": "05-cuda-mega", "06": "06-cuda-split", "07": "07-soa"}
+# Lab number -> folder: {"01": "01-serial", ...} (labs/labs.toml).
+LAB_FOLDERS = registry.folders()
 
 
 class HandinError(Exception):
@@ -34,11 +36,9 @@ def skeleton(lab: str) -> pathlib.Path:
 
 
 def handin_files(lab: str) -> list[str]:
-    """The files of lab `lab`'s hand-in, relative to its skeleton folder: the top-level ones
-    (what the grader builds) first, then those in folders."""
-    files = [p.relative_to(skeleton(lab)).as_posix() for p in skeleton(lab).rglob("*")
-             if p.is_file()]
-    return sorted(files, key=lambda f: ("/" in f, f))
+    """The files of lab `lab`'s hand-in, relative to its skeleton folder (its registry entry's
+    `handin`): the top-level ones (what the grader builds) first, then those in folders."""
+    return sorted(registry.lab(lab).handin, key=lambda f: ("/" in f, f))
 
 
 def graded_files(lab: str) -> list[str]:
@@ -77,7 +77,7 @@ def unchanged(lab: str, files: list[str]) -> list[str]:
 
 def main(argv=None) -> int:
     p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    p.add_argument("lab", help="the lab number, 01-07")
+    p.add_argument("lab", help=f"the lab number: {', '.join(LAB_FOLDERS)}")
     p.add_argument("--out", type=pathlib.Path, help="default: handin-labNN.zip")
     a = p.parse_args(argv)
     if a.lab not in LAB_FOLDERS:

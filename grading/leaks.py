@@ -24,15 +24,18 @@ import json
 import pathlib
 
 from grading import hidden
-from labkit import skeletons  # the one definition of the markers and of SHARED_SOURCES
+from labkit import (  # skeletons: the one definition of the markers and of SHARED_SOURCES
+    registry,
+    skeletons,
+)
 
 # The instructor's side of the kit: the skeleton generator (it documents the markers), the
 # golden-image generator, the grader's own tests (hostile submissions, the sandbox, the
 # Gradescope bundle), the labs' tests (they test the references, mutants of the solutions and
 # the skeletons' sync with them), CI, and this release tool itself.
 NEVER_SHIPPED = ("labkit/skeletons.py", "tools/make_golden.py", "tests/grading/*",
-                 "tests/labs/test_lab0*", ".ci/*", "grading/release.py", "grading/leaks.py",
-                 "grading/reference_bins.py")
+                 "tests/labs/test_lab[0-9][0-9]*", ".ci/*", "grading/release.py",
+                 "grading/leaks.py", "grading/reference_bins.py")
 # Tests students get: the shared command-line contract (run on the reference binaries) and
 # the unit tests of common/ (which test lab 01's path tracer too: they fail until lab 01 is
 # done, as they should). Every other test needs the solutions (pristine skeletons, skeleton
@@ -44,9 +47,10 @@ ELF_MAGIC = b"\x7fELF"
 
 
 def lab_folders(root: pathlib.Path) -> dict[str, str]:
-    """Lab number -> folder name: {"01": "01-serial", ...}."""
-    return {p.name[:2]: p.name for p in sorted((root / "labs").iterdir())
-            if p.is_dir() and p.name[:2].isdigit()}
+    """Lab number -> folder name: {"01": "01-serial", ...}, as labs/labs.toml under `root`
+    declares them."""
+    return {lab.number: lab.folder
+            for lab in registry.parse((root / "labs" / "labs.toml").read_text())}
 
 
 def earlier_solution_files(lab: str, folders: dict[str, str]) -> tuple[list[str], list[str]]:

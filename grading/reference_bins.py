@@ -31,28 +31,21 @@ import pathlib
 import shutil
 import subprocess
 
+from labkit import registry
 from labkit.harness import ROOT
 
-# The binaries a lab ships when its solution does not: what the grader runs and what students
-# time themselves against. Lab 02 has two parts, and Part B two references: lab02-ref-avx2 is
-# what students write (8 AVX2 lanes), the yardstick of their speed; lab02-ref runs at the
-# CPU's width with compacted packets (handout 02, section 8).
-# Besides the references themselves, the binaries built from a lab's solution that its
-# handout runs: lab 02's worked example (lab02-prims), lab 03's schedule benchmark
+# The binaries a lab ships when its solution does not (each lab's `ships` in labs/labs.toml):
+# what the grader runs and what students time themselves against. Lab 02 has two parts, and
+# Part B two references: lab02-ref-avx2 is what students write (8 AVX2 lanes), the yardstick
+# of their speed; lab02-ref runs at the CPU's width with compacted packets (handout 02,
+# section 8). Besides the references themselves, the binaries built from a lab's solution
+# that its handout runs: lab 02's worked example (lab02-prims), lab 03's schedule benchmark
 # (lab03-bench) and the OpenMP/MPI references over lab 02's packets (`make render`'s
 # renderer, handout 02's comparison).
-REFERENCES = {
-    "01": ["lab01-ref"],
-    "02": ["lab02-ref", "lab02-ref-avx2", "lab02a-ref", "lab02-prims"],
-    "03": ["lab03-ref", "lab03-bench", "lab03-simd-ref"],
-    "04": ["lab04-ref", "lab04-simd-ref"],
-    "05": ["lab05-ref"],
-    "06": ["lab06-ref"],
-    "07": ["lab07-ref"],
-}
+REFERENCES = {lab.number: list(lab.ships) for lab in registry.labs()}
 # Built where nvcc is; a release without them says so (GPU labs then build only the
 # student's own code).
-GPU_LABS = ("05", "06", "07")
+GPU_LABS = registry.gpu_labs()
 PORTABLE_ARCH = "-march=x86-64-v2"
 MIRROR = ROOT / "build" / "release" / "tree"
 LOCK = ROOT / "build" / "release" / "lock"
@@ -89,8 +82,8 @@ def build_key(opt: str, cuda_arch: str) -> str:
     change, so objects built under other flags or other make rules must never be reused:
     anything that changes them changes the key, and the build starts afresh."""
     h = hashlib.sha256(f"{opt}\0{cuda_arch}".encode())
-    for f in ["Makefile", "cuda.mk", *sorted(str(p.relative_to(ROOT))
-                                             for p in ROOT.glob("labs/*/lab.mk"))]:
+    for f in ["Makefile", "cuda.mk", "labs/labs.toml",
+              *sorted(str(p.relative_to(ROOT)) for p in ROOT.glob("labs/*/lab.mk"))]:
         h.update(f.encode() + b"\0" + (ROOT / f).read_bytes())
     return h.hexdigest()[:16]
 

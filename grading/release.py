@@ -29,6 +29,7 @@ import textwrap
 
 from grading import handin, leaks, reference_bins
 from grading.gradescope import repository_files
+from labkit import registry
 from labkit.harness import ROOT
 
 # Top-level entries of the repository that ship (then filtered by leaks.NEVER_SHIPPED and
@@ -110,24 +111,15 @@ def add_references(stage: pathlib.Path, lab: str, files: list[str]) -> list[str]
     return sorted(built)
 
 
-# What a student runs to try lab NN's code at a small size, after `make labNN`.
-TRY = {
-    "01": "./lab01 --width 128 --height 128 --spp 16 --out quick.ppm",
-    "02": "./lab02 --width 128 --height 128 --spp 16 --out quick.ppm",
-    "03": "./lab03 --threads 2 --width 128 --height 128 --spp 16 --out quick.ppm",
-    "04": "mpirun -np 2 ./lab04 --width 128 --height 128 --spp 16 --out quick.ppm",
-}
-GPU_TRY = "./lab{lab} --width 128 --height 128 --spp 16 --out quick.ppm   # needs an NVIDIA GPU"
-
-
 def student_readme(lab: str, folders: dict[str, str], prebuilt: list[str]) -> str:
     """The release's README.md: what students read first (the course's README is staff's)."""
     name = folders[lab]
     files = handin.handin_files(lab)
     later = [f"{n} ({folders[n]})" for n in folders if n > lab]
     earlier = [f"{n} ({folders[n]})" for n in folders if n < lab]
-    try_it = TRY.get(lab, GPU_TRY.format(lab=lab))
-    build = "make lab02a lab02" if lab == "02" else f"make lab{lab}"
+    # What a student runs to build and try lab NN's code at a small size (labs/labs.toml).
+    try_it = registry.lab(lab).try_command
+    build = f"make {' '.join(registry.lab(lab).student)}"
     title = (ROOT / "handouts" / f"{name}.md").read_text().splitlines()[0].lstrip("# ")
     return f"""\
 # {title}

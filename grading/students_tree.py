@@ -5,7 +5,8 @@ files students write, such as lab 01's common/core/path_tracer.h, are the soluti
 hand-in that leaves its copy out would be built against the solution, and the objects in
 build/ are the references'. So a submission is compiled in a students' tree made for its lab:
 
-- the Makefile, cuda.mk, grading/grading.mk, every lab's lab.mk and top-level files (the
+- the Makefile, cuda.mk, grading/grading.mk, the lab registry (labs/labs.toml and
+  labkit/registry.py, which the Makefile reads), every lab's lab.mk and top-level files (the
   drivers a lab links), and common/ with every shared file whose solution regions belong to
   this lab or a later one in its skeleton form (what a student release holds:
   grading/release.py); an earlier lab's shared files stay solutions (lab 07 builds on lab
@@ -161,7 +162,10 @@ def collect(handin: pathlib.Path, lab_folder: str) -> tuple[dict[str, bytes], li
 
 def _tree_files(lab_folder: str) -> dict[str, bytes]:
     """Path -> content of the students' tree's sources."""
-    picked = [ROOT / "Makefile", ROOT / "cuda.mk", ROOT / "grading" / "grading.mk"]
+    # The Makefile reads the lab registry through labkit/registry.py (build/labs.mk).
+    picked = [ROOT / "Makefile", ROOT / "cuda.mk", ROOT / "grading" / "grading.mk",
+              ROOT / "labs" / "labs.toml", ROOT / "labkit" / "__init__.py",
+              ROOT / "labkit" / "registry.py"]
     for lab in sorted((ROOT / "labs").iterdir()):
         if lab.is_dir():
             picked += [f for f in sorted(lab.iterdir()) if f.is_file() and not f.is_symlink()]

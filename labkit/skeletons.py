@@ -12,8 +12,9 @@ The skeleton keeps everything outside the markers, drops the reference code and 
 the "//>" lines (keeping their indentation). Comment lines that start with "//!" are for
 instructors only (how the file becomes a skeleton, where its solution lives): the skeleton
 drops them too. A lab's solution/ files become skeleton/ files of
-the same name; the shared files a lab lists in SHARED_SOURCES (code the lab's students write
-but later labs reuse, such as common/core/path_tracer.h) become skeleton/ files too; the
+the same name; the shared files a lab lists as `shared` in labs/labs.toml (code the lab's
+students write but later labs reuse, such as common/core/path_tracer.h) become skeleton/
+files too; the
 lab's build puts skeleton/ first on the include path, so there they stand in for the shared
 file.
 
@@ -30,16 +31,12 @@ import pathlib
 import re
 import sys
 
+from labkit import registry
+
 ROOT = pathlib.Path(__file__).resolve().parent.parent
 
-# Shared files whose solution regions belong to a lab's students.
-SHARED_SOURCES = {
-    "01-serial": ["common/core/path_tracer.h"],
-    "02-simd": ["common/simd/packet_tracer.h"],
-    "05-cuda-mega": ["common/cuda/megakernel.cuh"],
-    "06-cuda-split": ["common/wavefront/path_queue.cuh", "common/wavefront/stage_loop.cuh"],
-    "07-soa": ["common/wavefront/path_pool_soa.cuh"],
-}
+# Lab folder -> the shared files whose solution regions belong to its students.
+SHARED_SOURCES = registry.shared_sources()
 
 BEGIN = re.compile(r"^\s*// BEGIN SOLUTION\s*$")
 SKELETON = re.compile(r"^\s*// SKELETON\s*$")
@@ -84,9 +81,9 @@ def skeleton_text(text: str, name: str) -> str:
 
 def generated_files():
     """Yield (skeleton path, expected text) for every lab."""
-    for lab in sorted((ROOT / "labs").iterdir()):
+    for lab in (entry.path for entry in registry.labs()):
         solution = lab / "solution"
-        if not solution.is_dir():
+        if not solution.is_dir():  # a student release: the solution is not there
             continue
         # solution/'s files keep their place below it (lab 02's part-a/vec3.h); shared files
         # land at the top of skeleton/.

@@ -36,6 +36,7 @@ from grading.grade import (
     grading_order,
     passed_by_check,
 )
+from labkit import registry
 from labkit.harness import ROOT, build
 from tests.grading import submissions
 from tests.grading.gpu_mutants import (
@@ -47,13 +48,18 @@ from tests.grading.gpu_mutants import (
 )
 from tests.labs.cuda_env import missing_gpu, missing_nvcc
 
-GPU_LABS = {"05": "05-cuda-mega", "06": "06-cuda-split", "07": "07-soa"}
+# The GPU labs: number -> folder, as labs/labs.toml declares them.
+GPU_LABS = {lab: registry.lab(lab).folder for lab in registry.gpu_labs()}
 
 
 # ---- host side: the rubrics ---------------------------------------------------------------
 
 def test_the_gpu_labs_have_rubrics():
-    assert set(GPU_LABS) == gpu.GPU_LABS <= set(RUBRICS)
+    """The labs 05-07 are the registry's GPU labs, the grader runs them on the GPU, and each
+    has a GPU rubric: one timed against its own reference."""
+    assert {"05", "06", "07"} <= set(GPU_LABS) == gpu.GPU_LABS <= set(RUBRICS)
+    assert all(gpu.is_gpu_lab(lab) == (lab in GPU_LABS) for lab in RUBRICS)
+    assert all(any(i.id == "speed" for i in RUBRICS[lab]) for lab in GPU_LABS)
 
 
 @pytest.mark.parametrize("lab", sorted(GPU_LABS))

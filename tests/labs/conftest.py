@@ -4,7 +4,7 @@ Tests that need only nvcc (building, the compiler's report, bad input, which the
 rejects before any GPU work) run wherever nvcc is, CI included. Tests that render need an
 NVIDIA GPU; elsewhere they skip and say why. tools/gpu/check.sh runs them on a GPU machine."""
 import pytest
-from cuda_env import missing_gpu, missing_nvcc
+from cuda_env import NO_GPU_HINT, missing_gpu, missing_nvcc
 
 from labkit.harness import build
 
@@ -20,7 +20,7 @@ def nvcc():
 def gpu(nvcc):
     """Skips the test where there is no GPU to run on."""
     if reason := missing_gpu():
-        pytest.skip(reason)
+        pytest.skip(f"{reason}; {NO_GPU_HINT}")
 
 
 @pytest.fixture(scope="session")

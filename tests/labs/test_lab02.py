@@ -25,6 +25,7 @@ import subprocess
 import pytest
 
 from grading import checks
+from grading.renderer_checks import CHECKS as RENDERER_CHECKS
 from labkit.harness import (
     ROOT,
     available_cores,
@@ -118,20 +119,8 @@ def lab02a_pristine_skeleton(tmp_path_factory):
     return build_sources("02-simd-a", tmp_path_factory.mktemp("lab02a-skeleton"), sources)
 
 
-CHECKS = [
-    checks.check_sphere_interior,
-    checks.check_million_samples,
-    checks.check_lit_plane,
-    checks.check_glass_slab,
-    lambda b: checks.check_golden(b, "cornell"),
-    lambda b: checks.check_golden(b, "showcase"),
-    checks.check_scale_invariance,
-    checks.check_translation_invariance,
-    checks.check_large_primitives,
-    checks.check_reproducible,
-]
-CHECK_IDS = ["sphere-interior", "million-samples", "lit-plane", "glass-pane", "golden-cornell",
-             "golden-showcase", "scale", "translation", "large-primitives", "reproducible"]
+CHECKS = list(RENDERER_CHECKS.values())
+CHECK_IDS = list(RENDERER_CHECKS)
 
 
 def render_shipped(binary, scene: str, **size):

@@ -16,6 +16,7 @@ import pytest
 from cuda_env import gpu_name, missing_gpu
 
 from grading import checks
+from grading.renderer_checks import CHECKS
 from labkit.compare import compare
 from labkit.harness import ROOT, build, golden, run_lab
 
@@ -155,19 +156,7 @@ def test_bad_flags(lab05_ref, flags, fragment):
 
 # ---- on the GPU ------------------------------------------------------------------------
 
-@pytest.mark.parametrize("check", [
-    checks.check_sphere_interior,
-    checks.check_million_samples,
-    checks.check_lit_plane,
-    checks.check_glass_slab,
-    lambda b: checks.check_golden(b, "cornell"),
-    lambda b: checks.check_golden(b, "showcase"),
-    checks.check_scale_invariance,
-    checks.check_translation_invariance,
-    checks.check_large_primitives,
-    checks.check_reproducible,
-], ids=["sphere-interior", "million-samples", "lit-plane", "glass-pane", "golden-cornell",
-        "golden-showcase", "scale", "translation", "large-primitives", "reproducible"])
+@pytest.mark.parametrize("check", list(CHECKS.values()), ids=list(CHECKS))
 def test_reference_passes(gpu, lab05_ref, check):
     result = check(lab05_ref)
     assert result.passed, str(result)

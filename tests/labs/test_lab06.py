@@ -20,9 +20,9 @@ import subprocess
 import numpy as np
 import pytest
 from cuda_env import gpu_name, missing_gpu
-from renderer_checks import CHECKS
 
 from grading import checks
+from grading.renderer_checks import CHECKS
 from labkit.compare import compare
 from labkit.harness import ROOT, build, golden, run_lab
 

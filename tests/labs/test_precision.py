@@ -8,9 +8,9 @@ import os
 import subprocess
 
 import pytest
-from renderer_checks import CHECKS
 
 from grading import checks
+from grading.renderer_checks import CHECKS
 from labkit import scenes
 from labkit.harness import ROOT, build, run_lab
 

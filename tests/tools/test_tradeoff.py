@@ -237,7 +237,7 @@ def fake_nvidia_smi(folder, gpu_listed):
 
 @pytest.mark.skipif(tradeoff_series.gpu_missing() is None, reason="a real GPU is present")
 @pytest.mark.parametrize("gpu_listed, says", [
-    (False, "no NVIDIA GPU here (nvidia-smi lists none)"),
+    (False, "no NVIDIA GPU (nvidia-smi lists none)"),
     (True, "lab05-ref: does not build here: lab05-ref: needs the CUDA toolkit"),
 ])
 def test_gpu_plan_without_a_usable_gpu_is_one_line(tmp_path, gpu_listed, says):

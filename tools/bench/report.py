@@ -31,6 +31,7 @@ import subprocess
 import sys
 
 from grading.checks import mpirun
+from labkit import registry
 from labkit.harness import (
     ImageError,
     RunError,
@@ -63,10 +64,18 @@ class Parser(argparse.ArgumentParser):
 class Impl:
     binary: str
     label: str
-    gpu: bool = False
     avx2: bool = False        # needs AVX2 + FMA at run time (lab 02 Part B's packets)
-    mpi: bool = False         # runs under mpirun, one rank per core
     threads: bool = False     # takes --threads (one per core)
+
+    @property
+    def gpu(self) -> bool:
+        """Renders on a GPU: its lab's kind in labs/labs.toml."""
+        return registry.owner(self.binary).kind == "gpu"
+
+    @property
+    def mpi(self) -> bool:
+        """Runs under mpirun, one rank per core: its lab's kind in labs/labs.toml."""
+        return registry.owner(self.binary).kind == "mpi"
 
 
 IMPLS = [
@@ -75,11 +84,11 @@ IMPLS = [
     Impl("lab02-ref", "SIMD B: AVX2 8 paths per packet, 1 thread", avx2=True),
     Impl("lab03-ref", "OpenMP, every core", threads=True),
     Impl("lab03-simd-ref", "OpenMP + AVX2 packets, every core", avx2=True, threads=True),
-    Impl("lab04-ref", "MPI, one rank per core", mpi=True),
-    Impl("lab04-simd-ref", "MPI + AVX2 packets, one rank per core", avx2=True, mpi=True),
-    Impl("lab05-ref", "CUDA megakernel", gpu=True),
-    Impl("lab06-ref", "CUDA split kernels (wavefront)", gpu=True),
-    Impl("lab07-ref", "CUDA split kernels, SoA", gpu=True),
+    Impl("lab04-ref", "MPI, one rank per core"),
+    Impl("lab04-simd-ref", "MPI + AVX2 packets, one rank per core", avx2=True),
+    Impl("lab05-ref", "CUDA megakernel"),
+    Impl("lab06-ref", "CUDA split kernels (wavefront)"),
+    Impl("lab07-ref", "CUDA split kernels, SoA"),
 ]
 BY_NAME = {i.binary: i for i in IMPLS}
 SERIAL = "lab01-ref"

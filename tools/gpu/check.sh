@@ -1,8 +1,9 @@
 #!/usr/bin/env bash
 # Everything the CUDA labs need a GPU for, in one call (`make gpu-check OUT=DIR`):
 #   1. the machine: GPU, driver, nvcc, host compiler;
-#   2. build every CUDA target for the GPU present (plus lab 01's reference): labs 05-07, their
-#      benchmarks and lab 05's flag and precision variants;
+#   2. build every CUDA target for the GPU present (plus lab 01's reference): every target of
+#      every GPU lab in labs/labs.toml (labs 05-07, their benchmarks and lab 05's flag and
+#      precision variants);
 #   3. the compiler's resource report (make kernel-report) and the scene loads in the SASS;
 #   4. the GPU tests (pytest), for real;
 #   5. the benchmarks on the baseline, CUDA events, best and median of 5 after a warm-up, each
@@ -94,9 +95,10 @@ fi
 # ---- 2. build ---------------------------------------------------------------------------
 jobs=$(nproc)
 start=$(date +%s)
-run_step build make -j"$jobs" lab01-ref lab05 lab05-ref lab05-bench lab05-bench-fast-math \
-    lab05-ref-fast-math lab05-ref-no-fma lab05-ref-double lab06 lab06-ref lab06-bench \
-    lab07 lab07-ref lab07-bench
+# Every target of every GPU lab (labs/labs.toml), and lab 01's reference.
+gpu_labs=$(python3 -m labkit.registry gpu-labs) || exit 2
+gpu_targets=$(for lab in $gpu_labs; do python3 -m labkit.registry targets "$lab"; done)
+run_step build make -j"$jobs" lab01-ref $gpu_targets
 say "build took $(( $(date +%s) - start )) s"
 
 # ---- 3. the compiler's report -----------------------------------------------------------
@@ -114,7 +116,8 @@ fi
 skipped() { [[ " ${GPU_CHECK_SKIP:-} " == *" $1 "* ]] && { step[$1]=skipped; say "$1: skipped (GPU_CHECK_SKIP)"; }; }
 
 # ---- 4. the GPU tests -------------------------------------------------------------------
-gpu_tests=${GPU_CHECK_TESTS:-"tests/labs/test_lab05.py tests/labs/test_lab06.py tests/labs/test_lab07.py tests/labs/test_device_code.py tests/labs/test_properties.py tests/grading/test_gpu_rubrics.py"}
+lab_tests=$(for lab in $gpu_labs; do printf 'tests/labs/test_lab%s.py ' "$lab"; done)
+gpu_tests=${GPU_CHECK_TESTS:-"${lab_tests}tests/labs/test_device_code.py tests/labs/test_properties.py tests/grading/test_gpu_rubrics.py"}
 rm -f /tmp/gpu-check-junit.xml
 if ! skipped tests; then
     say "tests: pytest $gpu_tests"

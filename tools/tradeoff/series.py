@@ -22,6 +22,7 @@ import subprocess
 from typing import Callable
 
 from grading.checks import mpirun
+from labkit.cuda_env import missing_gpu as gpu_missing
 from labkit.variants import build_sources, lab_sources
 
 ROOT = pathlib.Path(__file__).resolve().parents[2]
@@ -86,17 +87,6 @@ def cpu_references(names=None) -> list[Series]:
             s.binary = ROOT / name
         out.append(s)
     return out
-
-
-def gpu_missing() -> str | None:
-    """Why nothing runs on a GPU here, or None (asks nvidia-smi, like tests/labs/cuda_env.py)."""
-    if shutil.which("nvidia-smi") is None:
-        return "no NVIDIA GPU here (nvidia-smi not found)"
-    p = subprocess.run(["nvidia-smi", "--query-gpu=name", "--format=csv,noheader"],
-                       capture_output=True, text=True)
-    if p.returncode != 0 or not p.stdout.strip():
-        return "no NVIDIA GPU here (nvidia-smi lists none)"
-    return None
 
 
 def gpu_info() -> str | None:
