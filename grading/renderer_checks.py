@@ -1,5 +1,5 @@
 """The grader's checks that every renderer of the course passes, by name: the lab tests run
-them on each reference (parametrized by these ids), tools/gpu_report.py on each GPU build.
+them on each reference (parametrized by these ids), tools/gpu/report.py on each GPU build.
 A rubric (grading/grade.py) weighs a subset of them; this is the whole list, kept once."""
 from grading import checks
 
