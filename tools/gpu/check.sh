@@ -132,7 +132,7 @@ if ! skipped bench && [ -x lab05-bench ]; then
     say "benchmark: lab05-bench --repeat 5 (the baseline)"
     ./lab05-bench --repeat 5 > "$out/bench.json" 2>> "$log" && step[bench]=ok || step[bench]=failed
     say "benchmark: lab05-bench-fast-math (--use_fast_math), the main shapes"
-    ./lab05-bench-fast-math --repeat 5 --only "${GPU_CHECK_FAST_MATH_VARIANTS:-all-materials,diffuse-split-16,diffuse-regs-64,diffuse-scene-global,reference-16,plain,whole-paths,scene-constant,split-1}" \
+    ./lab05-bench-fast-math --repeat 5 --only "${GPU_CHECK_FAST_MATH_VARIANTS:-reference,general,all-materials,scene-shared,regs-64,plain}" \
         > "$out/bench-fast-math.json" 2>> "$log" && step[bench_fast_math]=ok || step[bench_fast_math]=failed
 fi
 # The wavefront labs' references and their targets on the baseline (measure.sh, step 8, has
@@ -153,7 +153,7 @@ if ! skipped sanitizer && command -v compute-sanitizer >/dev/null && [ -x lab05-
       compute-sanitizer --tool initcheck --error-exitcode 3 ./lab05-ref --quiet --width 48 --height 40 --spp 4 &&
       compute-sanitizer --tool memcheck --error-exitcode 3 ./lab06-ref --quiet --width 48 --height 40 --spp 4 &&
       compute-sanitizer --tool memcheck --error-exitcode 3 ./lab07-ref --quiet --width 48 --height 40 --spp 4 &&
-      compute-sanitizer --tool racecheck --error-exitcode 3 ./lab05-bench --width 48 --height 40 --spp 4 --repeat 1 --only reference >/dev/null
+      compute-sanitizer --tool racecheck --error-exitcode 3 ./lab05-bench --width 48 --height 40 --spp 4 --repeat 1 --only scene-shared >/dev/null
     } >> "$log" 2>&1 && step[sanitizer]=ok || step[sanitizer]=failed
     say "compute-sanitizer: ${step[sanitizer]}"
 fi
@@ -167,9 +167,9 @@ if ! skipped ncu && [ -n "$ncu_bin" ] && [ -x lab05-bench ]; then
         timeout 180 "$ncu_bin" --clock-control none --metrics "$metrics" --csv --page raw \
             ./lab05-bench --repeat 1 "$@" > "/tmp/gpu-check-ncu-$label.csv" 2>> "$log"
     }
-    ncu_run cornell --spp 64 --only "${GPU_CHECK_NCU_VARIANTS:-plain,whole-paths-split-1,whole-paths,reference-16,diffuse-split-16}" &&
-    ncu_run cornell-1-bounce --spp 64 --bounces 1 --only whole-paths &&
-    ncu_run showcase --spp 64 --width 600 --height 600 --scene common/scenes/showcase.json --only whole-paths &&
+    ncu_run cornell --spp 64 --only "${GPU_CHECK_NCU_VARIANTS:-plain,reference,triangles,quads,general,regenerate,scene-shared}" &&
+    ncu_run cornell-1-bounce --spp 64 --bounces 1 --only reference &&
+    ncu_run showcase --spp 64 --width 600 --height 600 --scene common/scenes/showcase.json --only reference &&
         step[ncu]=ok || step[ncu]=failed
 fi
 
