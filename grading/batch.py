@@ -37,9 +37,10 @@ import threading
 import time
 import zipfile
 
-from grading import gpu, hidden
+from grading import hidden
 from grading.grade import RUBRICS
 from grading.speed_numbers import speed_numbers
+from labkit import gpu
 from labkit.harness import ROOT
 
 

@@ -17,8 +17,9 @@ import pathlib
 import shutil
 import tempfile
 
-from grading import gpu, students_tree
-from grading.sandbox import Limits, Runner
+from grading import students_tree
+from labkit import gpu
+from labkit.sandbox import Limits, Runner
 
 COMPILE_LIMITS = Limits(wall_seconds=300, cpu_seconds=600, output_bytes=1 << 20)
 

@@ -4,7 +4,7 @@ and write a Gradescope-style results.json, whatever happens.
     make grade LAB=01                  grade your own lab-01 code (./lab01), trusted
     python3 -m grading.grade 01 --binary ./lab01-ref --results out.json
 
-Without --trusted every process of the submission runs in the sandbox of grading/sandbox.py;
+Without --trusted every process of the submission runs in the sandbox of labkit/sandbox.py;
 where the sandbox cannot be had the grader says why and grades nothing. The score formula of
 each lab is in grading/README.md.
 """
@@ -19,9 +19,9 @@ import sys
 import time
 from typing import Callable
 
-from grading import checks, draws, golden_sums, gpu, hidden, report_html, sandbox, symptoms
+from grading import checks, draws, golden_sums, hidden, report_html, symptoms
 from grading.results import Results, Test
-from labkit import registry
+from labkit import gpu, registry, sandbox
 from labkit.harness import ROOT, RunPolicy, available_cores, build, policy
 
 LAB01_REFERENCE = ROOT / "lab01-ref"

@@ -73,7 +73,7 @@ class Results:
         self.notes: list[str] = []
         self.refused = False
         self.start = time.perf_counter()
-        self.sandbox = "none (--trusted)"  # which sandbox ran the submission (grading/sandbox.py)
+        self.sandbox = "none (--trusted)"  # which sandbox ran the submission (labkit/sandbox.py)
 
     def add(self, test: Test) -> None:
         if not any(t.id == test.id for t in self.tests):

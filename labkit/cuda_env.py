@@ -1,4 +1,4 @@
-"""Whether CUDA code can be built and run here: asked once, by the grader (grading/gpu.py),
+"""Whether CUDA code can be built and run here: asked once, by the grader (labkit/gpu.py),
 the lab tests (tests/labs/cuda_env.py) and the tools alike. The driver comes with nvidia-smi:
 no nvidia-smi, no driver; a driver that lists no GPU, no GPU."""
 from __future__ import annotations

@@ -17,10 +17,11 @@ from typing import Callable, Sequence
 
 import numpy as np
 
-# Every run, trusted or not, goes through the grader's one runner: a tool's timings and the
-# grader's are taken the same way (the sandbox is skipped for trusted runs).
-from grading.sandbox import Limits, Runner
 from labkit.pfm import read_pfm
+
+# Every run, trusted or not, goes through the one runner (labkit/sandbox.py): a tool's timings and the
+# grader's are taken the same way (the sandbox is skipped for trusted runs).
+from labkit.sandbox import Limits, Runner
 
 ROOT = pathlib.Path(__file__).resolve().parent.parent
 SCENES = ROOT / "common" / "scenes"
@@ -102,10 +103,10 @@ def available_cores() -> int:
 @dataclasses.dataclass(frozen=True)
 class RunPolicy:
     """How run_lab runs binaries: trusted (the lab tests, a student's own `make grade`) or in
-    the sandbox (grading others' code), and under which limits (grading/sandbox.py)."""
+    the sandbox (grading others' code), and under which limits (labkit/sandbox.py)."""
     trusted: bool = True
     limits: Limits = Limits(wall_seconds=600, memory_bytes=None)
-    gpu: bool = False  # the binaries run on the GPU: the sandbox must show it (grading/gpu.py)
+    gpu: bool = False  # the binaries run on the GPU: the sandbox must show it (labkit/gpu.py)
 
 
 _policy = RunPolicy()
@@ -185,7 +186,7 @@ def run_lab(binary: pathlib.Path | str, scene: pathlib.Path | str | None = None,
     `launcher` prefixes the command (e.g. mpirun ...). With check=True a run that did not exit
     0 raises RunError naming the symptom (with the binary's stderr), and an image that is
     missing, of the wrong size or not finite raises ImageError. The run goes through
-    grading/sandbox.py under the current policy(); `timeout` (seconds) lowers its wall limit.
+    labkit/sandbox.py under the current policy(); `timeout` (seconds) lowers its wall limit.
     """
     pol = current_policy()
     limits = pol.limits

@@ -14,7 +14,7 @@ import time
 
 import pytest
 
-from grading import sandbox
+from labkit import sandbox
 from labkit.harness import ROOT
 
 DAEMONS = ("munged", "slurmctld", "slurmd", "sbatch")

@@ -13,7 +13,7 @@ import zipfile
 
 import pytest
 
-from grading import sandbox
+from labkit import sandbox
 from labkit.harness import ROOT
 from tests.grading import submissions as sub
 

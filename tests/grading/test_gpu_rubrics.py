@@ -26,7 +26,7 @@ import sys
 
 import pytest
 
-from grading import checks, gpu, sandbox
+from grading import checks
 from grading.grade import (
     GOLDENS,
     GPU_TIMED_SCALE,
@@ -36,7 +36,7 @@ from grading.grade import (
     grading_order,
     passed_by_check,
 )
-from labkit import registry
+from labkit import gpu, registry, sandbox
 from labkit.harness import ROOT, build
 from tests.grading import submissions
 from tests.grading.gpu_mutants import (

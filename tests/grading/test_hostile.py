@@ -14,8 +14,8 @@ import time
 
 import pytest
 
-from grading import sandbox
 from grading.grade import describe, grade, passed_by_check
+from labkit import sandbox
 from labkit.harness import GOLDEN, ROOT
 from tests.grading import submissions as sub
 

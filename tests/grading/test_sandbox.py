@@ -1,8 +1,8 @@
-"""grading/sandbox.py on its own: what a sandboxed process may touch, and its limits."""
+"""labkit/sandbox.py on its own: what a sandboxed process may touch, and its limits."""
 import pytest
 
-from grading import sandbox
-from grading.sandbox import Limits, Runner, describe_exit
+from labkit import sandbox
+from labkit.sandbox import Limits, Runner, describe_exit
 
 
 @pytest.fixture(autouse=True)

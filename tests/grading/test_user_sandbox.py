@@ -1,6 +1,6 @@
 """The grader where namespaces cannot be had (a Docker container with Docker's default
 seccomp profile, as on Gradescope): bubblewrap fails there, and the grader isolates by user
-instead (grading/sandbox.py, grading/confine.py). The grader runs here under a seccomp filter
+instead (labkit/sandbox.py, labkit/confine.py). The grader runs here under a seccomp filter
 refusing namespace creation (tests/grading/no_namespaces.py), as such a container would."""
 import json
 import os
@@ -9,7 +9,7 @@ import sys
 
 import pytest
 
-from grading import sandbox
+from labkit import sandbox
 from labkit.harness import GOLDEN, ROOT, build
 from tests.grading import submissions as sub
 

@@ -15,8 +15,8 @@ import sys
 
 import pytest
 
-from grading import gpu, grade, handin, leaks, reference_bins, release
-from labkit import registry
+from grading import grade, handin, leaks, reference_bins, release
+from labkit import gpu, registry
 
 ROOT = registry.ROOT
 LAB_FOLDER = re.compile(r"^\d\d-")

@@ -1,4 +1,4 @@
-"""The innermost wrapper of the user sandbox (grading/sandbox.py, where namespaces cannot be
+"""The innermost wrapper of the user sandbox (labkit/sandbox.py, where namespaces cannot be
 had): run by the system's Python as the sandbox user, after setpriv and prlimit, it loads a
 libseccomp filter (python3-seccomp) and execs the submitted command, which inherits the
 filter and cannot remove it.

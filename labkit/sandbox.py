@@ -7,7 +7,7 @@ lie about its own speed. Every process the grader starts from a submission goes 
 
 - (untrusted, the default) runs it under bubblewrap: as an unprivileged user, in its own user,
   PID, network, IPC and mount namespaces, seeing read-only exactly the files it was given, the
-  system's libraries and MPI's files (and, for a GPU lab, the GPU: grading/gpu.py), and
+  system's libraries and MPI's files (and, for a GPU lab, the GPU: labkit/gpu.py), and
   writing only to a scratch folder of its own;
 - applies resource limits inside (CPU seconds, memory, file size, processes, open files);
 - kills the whole process tree when the wall-clock limit passes, when an output stream exceeds
@@ -109,7 +109,7 @@ def bwrap_path() -> str | None:
 
 
 # The two isolations (grading/README.md): bubblewrap's namespaces where they can be had, else
-# a dedicated unprivileged user (setpriv, prlimit, a seccomp filter: grading/confine.py), which
+# a dedicated unprivileged user (setpriv, prlimit, a seccomp filter: labkit/confine.py), which
 # works where a container's seccomp profile refuses namespaces (Docker's default, Gradescope).
 BUBBLEWRAP, USER = "bubblewrap", "user"
 DESCRIPTIONS = {
@@ -117,7 +117,7 @@ DESCRIPTIONS = {
     USER: "a dedicated user (setpriv, prlimit, seccomp filter{landlock}; no namespaces here)",
 }
 SANDBOX_USER = "prt-sandbox"   # made by setup.sh (or the grader, as root) for the user sandbox
-SYSTEM_PYTHON = "/usr/bin/python3"  # runs grading/confine.py: python3-seccomp is its module
+SYSTEM_PYTHON = "/usr/bin/python3"  # runs labkit/confine.py: python3-seccomp is its module
 
 _probe_result: list[str | None] = []
 _isolation: list[str] = []
@@ -261,7 +261,7 @@ def hide_from_sandbox(folder: pathlib.Path) -> None:
 
 
 def _confine_script() -> str:
-    """grading/confine.py copied where the sandbox user can read it (the repository is closed
+    """labkit/confine.py copied where the sandbox user can read it (the repository is closed
     to it), once per grader process."""
     if not _confine_copy:
         folder = pathlib.Path(tempfile.mkdtemp(prefix="grading-confine-"))
@@ -352,7 +352,7 @@ class Runner:
 
     def __init__(self, trusted: bool, gpu: bool = False):
         self.trusted = trusted
-        self.gpu = gpu  # a GPU lab's runs: the sandbox shows the GPU (grading/gpu.py)
+        self.gpu = gpu  # a GPU lab's runs: the sandbox shows the GPU (labkit/gpu.py)
         self.user_mode = not trusted and isolation() == USER
         self.root = pathlib.Path(tempfile.mkdtemp(prefix="grading-"))
         os.chmod(self.root, 0o755)  # the unprivileged sandbox user must reach staged inputs
@@ -460,7 +460,7 @@ class Runner:
         for path, writable in self.binds:
             cmd += ["--bind" if writable else "--ro-bind", path, path]
         if self.gpu:  # after --dev /dev and --clearenv, which it adds to
-            from grading.gpu import sandbox_args
+            from labkit.gpu import sandbox_args
             cmd += sandbox_args()
         cmd += ["--remount-ro", "/"]  # bubblewrap's root is a tmpfs: no files may go there
         for key, value in {"PATH": "/usr/local/bin:/usr/bin:/bin", "HOME": SCRATCH,
