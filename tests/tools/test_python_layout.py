@@ -1,8 +1,8 @@
 """How the kit's Python fits together (DESIGN.md section 1): labkit/, grading/, tools/ and tests/
 import each other as packages from the repository root, never by editing sys.path or loading a
-file by path; the grader imports nothing from tools/; every command under tools/ is reached
-from a make target that `make help` lists; every Python or shell path and every `python3 -m`
-module the repository names exists. Reads files only: well under a second."""
+file by path; the grader imports nothing from tools/, labkit/ nothing from either; every
+command under tools/ is reached from a make target that `make help` lists; every Python or
+shell path and every `python3 -m` module the repository names exists. Reads files only: well under a second."""
 import ast
 import importlib.util
 import re
@@ -48,14 +48,26 @@ def test_no_sys_path_edits_and_no_loading_by_file_path():
     assert not found, found
 
 
-def test_the_grader_imports_nothing_from_tools():
+def imports_of(patterns, packages) -> list:
+    """Every import, in the files `patterns` match, of a module of one of `packages`."""
     found = []
-    for f, tree in trees(tracked("grading/*.py", "grading/**/*.py")):
+    for f, tree in trees(tracked(*patterns)):
         for node in ast.walk(tree):
             modules = ([a.name for a in node.names] if isinstance(node, ast.Import) else
                        [node.module or ""] if isinstance(node, ast.ImportFrom) else [])
             found += [f"{f.relative_to(ROOT)}:{node.lineno}: {m}" for m in modules
-                      if m == "tools" or m.startswith("tools.")]
+                      if any(m == p or m.startswith(p + ".") for p in packages)]
+    return found
+
+
+def test_the_grader_imports_nothing_from_tools():
+    found = imports_of(("grading/*.py", "grading/**/*.py"), ("tools",))
+    assert not found, found
+
+
+def test_the_library_imports_neither_the_grader_nor_the_tools():
+    """labkit/ is below both: the grader and the tools import it, never the other way."""
+    found = imports_of(("labkit/*.py", "labkit/**/*.py"), ("grading", "tools"))
     assert not found, found
 
 
