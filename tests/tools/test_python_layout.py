@@ -2,7 +2,8 @@
 import each other as packages from the repository root, never by editing sys.path or loading a
 file by path; the grader imports nothing from tools/, labkit/ nothing from either; every
 command under tools/ is reached from a make target that `make help` lists; every Python or
-shell path and every `python3 -m` module the repository names exists. Reads files only: well under a second."""
+shell path and every `python3 -m` module the repository names exists. Reads files only: well
+under a second."""
 import ast
 import importlib.util
 import re
