@@ -306,7 +306,8 @@ void read_spheres(const SceneReader& r, const PrimitiveReader& prims, Scene& sce
     }
 }
 
-// Triangles, then quads (each as the two triangles v0 v1 v2 and v0 v2 v3).
+// Triangles, then quads, each checked as the two triangles v0 v1 v2 and v0 v2 v3
+// (classify_quads then makes most of them one primitive).
 void read_triangles(const SceneReader& r, const PrimitiveReader& prims, Scene& scene) {
     const json& triangles = prims.list("triangles");
     for (size_t i = 0; i < triangles.size(); ++i) {
@@ -383,6 +384,47 @@ void check_scene_scale(const SceneReader& r, const json& root, const Scene& scen
     }
 }
 
+// What each quad of the file becomes (DESIGN.md, section 5), once every check has passed on it
+// as two triangles (read_triangles): an axis-aligned rectangle, else one planar convex quad,
+// else the two triangles it was read as. The kind is chosen on the points the renderer will
+// use, the written ones moved to the scene's centre and rounded once (centre_scene), so the
+// same file gives the same kinds wherever it is placed, and centring keeps them.
+void classify_quads(Scene& scene, size_t file_triangles) {
+    const WrittenPoint centre = centring_centre(scene);
+    const size_t count = (scene.triangles.size() - file_triangles) / 2;
+    const std::vector<Triangle> halves(scene.triangles.begin() + file_triangles,
+                                       scene.triangles.end());
+    const std::vector<WrittenPoint> written(
+        scene.written.triangle_vertices.begin() + 3 * file_triangles,
+        scene.written.triangle_vertices.end());
+    scene.triangles.resize(file_triangles);
+    scene.written.triangle_vertices.resize(3 * file_triangles);
+    for (size_t i = 0; i < count; ++i) {
+        const Triangle& first = halves[2 * i];  // v0 v1 v2; the second is v0 v2 v3
+        const Triangle& second = halves[2 * i + 1];
+        const Vec3 loaded[4] = {first.v0, first.v1, first.v2, second.v2};
+        const WrittenPoint w[4] = {written[6 * i], written[6 * i + 1], written[6 * i + 2],
+                                   written[6 * i + 5]};
+        const Vec3 rendered[4] = {moved_to_centre(w[0], centre), moved_to_centre(w[1], centre),
+                                  moved_to_centre(w[2], centre), moved_to_centre(w[3], centre)};
+        const int axis = axis_rect_axis(rendered);
+        if (axis >= 0) {
+            scene.rects.push_back(make_axis_rect(loaded, axis, first.material));
+            scene.written.rect_vertices.insert(scene.written.rect_vertices.end(), w, w + 4);
+        } else if (is_planar_convex_quad(rendered)) {
+            scene.quads.push_back(
+                make_convex_quad(loaded[0], loaded[1], loaded[2], loaded[3], first.material));
+            scene.written.quad_vertices.insert(scene.written.quad_vertices.end(), w, w + 4);
+        } else {
+            scene.triangles.push_back(first);
+            scene.triangles.push_back(second);
+            scene.written.triangle_vertices.insert(scene.written.triangle_vertices.end(),
+                                                   written.begin() + 6 * i,
+                                                   written.begin() + 6 * i + 6);
+        }
+    }
+}
+
 }  // namespace
 
 Scene parse_scene(const std::string& text, const std::string& name) {
@@ -407,6 +449,7 @@ Scene parse_scene(const std::string& text, const std::string& name) {
     read_triangles(r, prims, scene);
     read_render_settings(r, root, scene.render);
     check_scene_scale(r, root, scene);
+    classify_quads(scene, root.contains("triangles") ? root["triangles"].size() : 0);
     return scene;
 }
 

@@ -103,7 +103,8 @@ TEST(StepOffEdges, AMirrorHitOnARoomsEdgeStartsInFrontOfBothFaces) {
     const Ray ray{{0.4f, 0.8f, 0.25f}, {0.6f, -0.8f, 0.0f}};
     Hit hit;
     hit.t = 1.0f;
-    hit.triangle = 1;  // the floor's second triangle holds the edge x = 1
+    hit.kind = PrimitiveKind::Triangle;
+    hit.index = 1;  // the floor's second triangle holds the edge x = 1
     ASSERT_EQ(ray.at(hit.t).x, 1.0f);
     ASSERT_EQ(ray.at(hit.t).y, 0.0f);
     PathState path = start_path(ray, 4);
