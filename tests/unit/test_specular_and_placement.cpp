@@ -164,7 +164,11 @@ TEST(WrittenCoordinates, AGenericOffsetCentresToTheUnmovedScene) {
         centre_scene(parse_scene(scene_text(12345.678, -8765.4321, 3456.789), "moved.json"));
     EXPECT_NEAR(moved.light.position.y, base.light.position.y, 1e-9f);
     EXPECT_NEAR(moved.light.position.x, base.light.position.x, 1e-9f);
-    EXPECT_NEAR(moved.triangles[0].v0.z, base.triangles[0].v0.z, 1e-9f);
+    ASSERT_EQ(moved.rects.size(), 1u);  // the floor, in both
+    ASSERT_EQ(base.rects.size(), 1u);
+    EXPECT_EQ(moved.rects[0].plane, base.rects[0].plane);
+    EXPECT_EQ(moved.rects[0].lo_v, base.rects[0].lo_v);
+    EXPECT_EQ(moved.rects[0].hi_u, base.rects[0].hi_u);
     const Camera a = base.camera.for_image(16, 16), b = moved.camera.for_image(16, 16);
     const Vec3 da = a.ray_through(8, 8).direction, db = b.ray_through(8, 8).direction;
     EXPECT_GT(dot(da, db), 1.0f - 1e-6f) << "the moved camera aims elsewhere";
