@@ -4,6 +4,8 @@
 
 #include <cstdint>
 
+#include <axis_rect.h>
+#include <convex_quad.h>
 #include <material.h>
 #include <sphere.h>
 #include <triangle.h>
@@ -28,6 +30,10 @@ struct SceneView {
     int num_spheres;
     const Triangle* triangles;
     int num_triangles;
+    const ConvexQuad* quads;  // planar convex quads of the scene file
+    int num_quads;
+    const AxisRect* rects;  // its axis-aligned rectangles
+    int num_rects;
     const Material* materials;
     int num_materials;
     PointLight light;

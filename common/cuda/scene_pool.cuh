@@ -1,4 +1,5 @@
-// The scene as one block of 16-byte words (materials, then spheres, then triangles), so that
+// The scene as one block of 16-byte words (materials, then spheres, triangles, convex quads and
+// axis-aligned rectangles), so that
 // a single copy puts it in any of the GPU's memories, and the SceneView the shared core reads
 // from it wherever it lies: global memory, the constant bank or a block's shared memory.
 #pragma once
@@ -21,8 +22,9 @@ enum class SceneMemory {
 
 // Where each array starts in the pool, in 16-byte words, and the scene's small fields.
 struct SceneLayout {
-    int num_spheres = 0, num_triangles = 0, num_materials = 0;
-    int material_word = 0, sphere_word = 0, triangle_word = 0;  // in this order
+    int num_spheres = 0, num_triangles = 0, num_quads = 0, num_rects = 0, num_materials = 0;
+    int material_word = 0, sphere_word = 0, triangle_word = 0, quad_word = 0,
+        rect_word = 0;  // in this order
     int words = 0;  // the whole pool
     PointLight light{};
     bool has_light = false;
@@ -38,6 +40,10 @@ struct SceneLayout {
                 num_spheres,
                 reinterpret_cast<const Triangle*>(pool + triangle_word),
                 num_triangles,
+                reinterpret_cast<const ConvexQuad*>(pool + quad_word),
+                num_quads,
+                reinterpret_cast<const AxisRect*>(pool + rect_word),
+                num_rects,
                 reinterpret_cast<const Material*>(pool + material_word),
                 num_materials,
                 light,
@@ -53,11 +59,15 @@ inline SceneLayout layout_of(const SceneView& scene) {
     SceneLayout l;
     l.num_spheres = scene.num_spheres;
     l.num_triangles = scene.num_triangles;
+    l.num_quads = scene.num_quads;
+    l.num_rects = scene.num_rects;
     l.num_materials = scene.num_materials;
     l.material_word = 0;
     l.sphere_word = l.material_word + words_for(scene.num_materials * sizeof(Material));
     l.triangle_word = l.sphere_word + words_for(scene.num_spheres * sizeof(Sphere));
-    l.words = l.triangle_word + words_for(scene.num_triangles * sizeof(Triangle));
+    l.quad_word = l.triangle_word + words_for(scene.num_triangles * sizeof(Triangle));
+    l.rect_word = l.quad_word + words_for(scene.num_quads * sizeof(ConvexQuad));
+    l.words = l.rect_word + words_for(scene.num_rects * sizeof(AxisRect));
     l.light = scene.light;
     l.has_light = scene.has_light;
     l.background = scene.background;
@@ -73,11 +83,13 @@ inline std::vector<float4> pack(const SceneView& scene, const SceneLayout& l) {
     put(l.material_word, scene.materials, scene.num_materials * sizeof(Material));
     put(l.sphere_word, scene.spheres, scene.num_spheres * sizeof(Sphere));
     put(l.triangle_word, scene.triangles, scene.num_triangles * sizeof(Triangle));
+    put(l.quad_word, scene.quads, scene.num_quads * sizeof(ConvexQuad));
+    put(l.rect_word, scene.rects, scene.num_rects * sizeof(AxisRect));
     return pool;
 }
 
 // Where a renderer puts the scene: each block's shared memory when it is small (the Cornell
-// box's 10 triangles, sphere and 4 materials take 720 bytes; shared memory measured faster
+// box's 5 rectangles, sphere and 4 materials take under 300 bytes; shared memory measured faster
 // than the constant bank and global memory there, handouts/05-cuda-mega.md), else global
 // memory, through the L1 cache: every block copies the whole scene first, which for a large
 // scene would cost more than it saves.

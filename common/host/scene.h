@@ -61,6 +61,8 @@ struct WrittenCoordinates {
     WrittenPoint light_position;
     std::vector<WrittenPoint> sphere_centres;     // parallel to Scene::spheres
     std::vector<WrittenPoint> triangle_vertices;  // 3 per entry of Scene::triangles
+    std::vector<WrittenPoint> quad_vertices;      // 4 per entry of Scene::quads
+    std::vector<WrittenPoint> rect_vertices;      // 4 per entry of Scene::rects, as written
 };
 
 struct Scene {
@@ -72,7 +74,11 @@ struct Scene {
     std::vector<Material> materials;
     std::vector<std::string> material_names;  // parallel to materials
     std::vector<Sphere> spheres;
-    std::vector<Triangle> triangles;  // quads arrive here as two triangles
+    // The file's triangles, then the two triangles (v0 v1 v2), (v0 v2 v3) of each quad that is
+    // not planar and convex; the other quads are one primitive each (scene_loader.h).
+    std::vector<Triangle> triangles;
+    std::vector<ConvexQuad> quads;  // planar convex quads that are not axis-aligned rectangles
+    std::vector<AxisRect> rects;    // axis-aligned rectangles
     RenderSettings render;            // the file's settings, or the defaults
     WrittenCoordinates written;       // the file's points in double, for centre_scene
 
@@ -81,6 +87,10 @@ struct Scene {
                 static_cast<int>(spheres.size()),
                 triangles.data(),
                 static_cast<int>(triangles.size()),
+                quads.data(),
+                static_cast<int>(quads.size()),
+                rects.data(),
+                static_cast<int>(rects.size()),
                 materials.data(),
                 static_cast<int>(materials.size()),
                 light,

@@ -40,7 +40,9 @@ struct ExactPoints {
     bool sized() const {
         return scene.written.present &&
                scene.written.sphere_centres.size() == scene.spheres.size() &&
-               scene.written.triangle_vertices.size() == 3 * scene.triangles.size();
+               scene.written.triangle_vertices.size() == 3 * scene.triangles.size() &&
+               scene.written.quad_vertices.size() == 4 * scene.quads.size() &&
+               scene.written.rect_vertices.size() == 4 * scene.rects.size();
     }
     WrittenPoint sphere(size_t i) const {
         return pick(sized(), sized() ? scene.written.sphere_centres[i] : WrittenPoint{},
@@ -50,6 +52,26 @@ struct ExactPoints {
         const Triangle& t = scene.triangles[i];
         return pick(sized(), sized() ? scene.written.triangle_vertices[3 * i + k] : WrittenPoint{},
                     k == 0 ? t.v0 : (k == 1 ? t.v1 : t.v2));
+    }
+    WrittenPoint quad_vertex(size_t i, int k) const {
+        const ConvexQuad& q = scene.quads[i];
+        const Vec3 own[4] = {q.v0, q.v1, q.v2, q.v3};
+        return pick(sized(), sized() ? scene.written.quad_vertices[4 * i + k] : WrittenPoint{},
+                    own[k]);
+    }
+    // A rectangle keeps its bounds, not its corners: its written corners stand while each
+    // rounds to one of the rectangle's own corners, else its own (rect_corners) are used.
+    WrittenPoint rect_vertex(size_t i, int k) const {
+        Vec3 own[4];
+        rect_corners(scene.rects[i], own);
+        bool written_stand = sized();
+        for (int j = 0; written_stand && j < 4; ++j) {
+            const WrittenPoint& w = scene.written.rect_vertices[4 * i + j];
+            bool on_corner = false;
+            for (const Vec3& c : own) on_corner = on_corner || w.rounds_to(c);
+            written_stand = on_corner;
+        }
+        return written_stand ? scene.written.rect_vertices[4 * i + k] : exact(own[k]);
     }
     WrittenPoint camera_position() const {
         return pick(scene.camera.written, scene.camera.written_position, scene.camera.position);
@@ -70,6 +92,12 @@ void centre_of_bounds(const Scene& scene, double centre[3]) {
     for (size_t i = 0; i < scene.triangles.size(); ++i) {
         for (int k = 0; k < 3; ++k) box.add(points.vertex(i, k));
     }
+    for (size_t i = 0; i < scene.quads.size(); ++i) {
+        for (int k = 0; k < 4; ++k) box.add(points.quad_vertex(i, k));
+    }
+    for (size_t i = 0; i < scene.rects.size(); ++i) {
+        for (int k = 0; k < 4; ++k) box.add(points.rect_vertex(i, k));
+    }
     for (int axis = 0; axis < 3; ++axis)
         centre[axis] = box.empty ? 0.0 : 0.5 * (box.lo[axis] + box.hi[axis]);
 }
@@ -79,6 +107,17 @@ WrittenPoint minus(WrittenPoint p, const double centre[3]) {
     return {p.x - centre[0], p.y - centre[1], p.z - centre[2]};
 }
 }  // namespace
+
+WrittenPoint centring_centre(const Scene& scene) {
+    double centre[3];
+    centre_of_bounds(scene, centre);
+    return {centre[0], centre[1], centre[2]};
+}
+
+Vec3 moved_to_centre(const WrittenPoint& p, const WrittenPoint& centre) {
+    const double c[3] = {centre.x, centre.y, centre.z};
+    return rounded(minus(p, c));
+}
 
 Vec3 centring_offset(const Scene& scene) {
     double centre[3];
@@ -101,6 +140,14 @@ Scene centre_scene(Scene scene) {
         for (int k = 0; k < 3; ++k)
             moved.triangle_vertices.push_back(minus(points.vertex(i, k), centre));
     }
+    for (size_t i = 0; i < scene.quads.size(); ++i) {
+        for (int k = 0; k < 4; ++k)
+            moved.quad_vertices.push_back(minus(points.quad_vertex(i, k), centre));
+    }
+    for (size_t i = 0; i < scene.rects.size(); ++i) {
+        for (int k = 0; k < 4; ++k)
+            moved.rect_vertices.push_back(minus(points.rect_vertex(i, k), centre));
+    }
     const WrittenPoint camera_position = minus(points.camera_position(), centre);
     const WrittenPoint camera_look_at = minus(points.camera_look_at(), centre);
     moved.light_position = minus(points.light(), centre);
@@ -111,6 +158,19 @@ Scene centre_scene(Scene scene) {
         const WrittenPoint* v = &moved.triangle_vertices[3 * i];
         scene.triangles[i] =
             make_triangle(rounded(v[0]), rounded(v[1]), rounded(v[2]), scene.triangles[i].material);
+    }
+    // Each quad and rectangle keeps its kind: the loader chose it on these very points
+    // (scene_loader.cpp), so a rectangle's corners still share their coordinates exactly.
+    for (size_t i = 0; i < scene.quads.size(); ++i) {
+        const WrittenPoint* v = &moved.quad_vertices[4 * i];
+        scene.quads[i] = make_convex_quad(rounded(v[0]), rounded(v[1]), rounded(v[2]),
+                                          rounded(v[3]), scene.quads[i].material);
+    }
+    for (size_t i = 0; i < scene.rects.size(); ++i) {
+        const WrittenPoint* v = &moved.rect_vertices[4 * i];
+        const Vec3 corners[4] = {rounded(v[0]), rounded(v[1]), rounded(v[2]), rounded(v[3])};
+        scene.rects[i] =
+            make_axis_rect(corners, rect_axis(scene.rects[i]), scene.rects[i].material);
     }
     scene.camera.position = rounded(camera_position);
     scene.camera.look_at = rounded(camera_look_at);

@@ -20,6 +20,11 @@
 // primitives.
 Vec3 centring_offset(const Scene& scene);
 
-// The scene moved by centring_offset (triangles rebuilt, so normals and extents are the
-// moved triangles' own); its written coordinates move with it.
+// That centre in double, unrounded, and a point as centre_scene moves it there: p - centre in
+// double, rounded once (the loader classifies quads on the points they will render with).
+WrittenPoint centring_centre(const Scene& scene);
+Vec3 moved_to_centre(const WrittenPoint& p, const WrittenPoint& centre);
+
+// The scene moved by centring_offset (primitives rebuilt, so normals and extents are the
+// moved primitives' own, each of its kind); its written coordinates move with it.
 Scene centre_scene(Scene scene);

@@ -22,12 +22,24 @@ double longest_edge(const Triangle& t) {
                      static_cast<double>(length(t.v0 - t.v2))});
 }
 
+double longest_edge(const ConvexQuad& q) {
+    return std::max(
+        {static_cast<double>(length(q.v1 - q.v0)), static_cast<double>(length(q.v2 - q.v1)),
+         static_cast<double>(length(q.v3 - q.v2)), static_cast<double>(length(q.v0 - q.v3))});
+}
+
+double longest_edge(const AxisRect& r) {
+    return std::max(double(r.hi_u) - r.lo_u, double(r.hi_v) - r.lo_v);
+}
+
 }  // namespace
 
 SceneUse scene_use(const Scene& scene) {
     SceneUse use;
     use.spheres = static_cast<int>(scene.spheres.size());
     use.triangles = static_cast<int>(scene.triangles.size());
+    use.quads = static_cast<int>(scene.quads.size());
+    use.rects = static_cast<int>(scene.rects.size());
     for (const Material& m : scene.materials) {
         use.diffuse += m.type == MaterialType::Diffuse;
         use.mirrors += m.type == MaterialType::Mirror;
@@ -45,6 +57,14 @@ SceneUse scene_use(const Scene& scene) {
         if (edge > 0) smallest = std::min(smallest, edge);  // a zero-area triangle shows nothing
         use.extent = std::max(use.extent, static_cast<double>(t.extent));
     }
+    for (const ConvexQuad& q : scene.quads) {
+        smallest = std::min(smallest, longest_edge(q));
+        use.extent = std::max(use.extent, static_cast<double>(q.extent));
+    }
+    for (const AxisRect& r : scene.rects) {
+        smallest = std::min(smallest, longest_edge(r));
+        use.extent = std::max(use.extent, static_cast<double>(r.extent));
+    }
     use.smallest = std::isfinite(smallest) ? smallest : 0.0;
     return use;
 }
@@ -57,11 +77,20 @@ std::string describe(const SceneUse& use) {
     add(use.diffuse, "diffuse");
     add(use.mirrors, "mirror");
     add(use.glass, "glass");
-    std::string line = "scene: " + plural(use.spheres, "sphere", "spheres") + ", " +
-                       plural(use.triangles, "triangle", "triangles") +
-                       "; materials: " + (materials.empty() ? "none" : materials) + "; " +
-                       (use.light ? "a point light" : "no light") + "; " +
-                       (use.background ? "a background" : "a black background");
+    // The kinds the scene has, by count: "1 sphere, 5 rectangles".
+    std::string primitives;
+    const auto count = [&](int n, const char* one, const char* many) {
+        if (n) primitives += (primitives.empty() ? "" : ", ") + plural(n, one, many);
+    };
+    count(use.spheres, "sphere", "spheres");
+    count(use.triangles, "triangle", "triangles");
+    count(use.quads, "convex quad", "convex quads");
+    count(use.rects, "rectangle", "rectangles");
+    std::string line =
+        "scene: " + (primitives.empty() ? std::string("no primitives") : primitives) +
+        "; materials: " + (materials.empty() ? "none" : materials) + "; " +
+        (use.light ? "a point light" : "no light") + "; " +
+        (use.background ? "a background" : "a black background");
     if (use.smallest > 0) {
         line += "; sizes from " + number(use.smallest) + " within coordinates up to " +
                 number(use.extent) + " (1 : " + number(use.extent / use.smallest) + ")";
@@ -80,6 +109,8 @@ std::string scale_warning(const SceneUse& use) {
 std::string to_json(const SceneUse& use) {
     return "{\"spheres\": " + std::to_string(use.spheres) +
            ", \"triangles\": " + std::to_string(use.triangles) +
+           ", \"quads\": " + std::to_string(use.quads) +
+           ", \"rects\": " + std::to_string(use.rects) +
            ", \"diffuse\": " + std::to_string(use.diffuse) +
            ", \"mirrors\": " + std::to_string(use.mirrors) +
            ", \"glass\": " + std::to_string(use.glass) +

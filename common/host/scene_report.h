@@ -1,4 +1,5 @@
-// What a scene uses, told to the person who renders it: the primitive kinds, the material
+// What a scene uses, told to the person who renders it: the primitives of each kind (a quad of
+// the file counts as a rectangle, a planar convex quad or two triangles: scene_loader.cpp), the material
 // kinds, the light, the background, and the range of sizes against the scene's extent; and a
 // warning, with what to do, when a detail is smaller than the renderer can resolve at the
 // scene's extent. (The loader refuses what cannot render at all: scene_limits.h. This is the
@@ -12,12 +13,12 @@
 #include <scene.h>
 
 struct SceneUse {
-    int spheres = 0, triangles = 0;
+    int spheres = 0, triangles = 0, quads = 0, rects = 0;  // geometry_kinds(scene), counted
     int diffuse = 0, mirrors = 0, glass = 0;  // the material table's entries by kind
     bool light = false;
     bool background = false;  // a background that is not black
-    double smallest = 0;      // the smallest radius or longest triangle edge (0: no primitive)
-    double extent = 0;        // the largest |coordinate| of any primitive, after centring
+    double smallest = 0;  // the smallest radius or longest edge (0: no primitive)
+    double extent = 0;  // the largest |coordinate| of any primitive, after centring
 };
 
 // A detail is resolved while it spans at least this many ray offsets of a ray that crossed
@@ -26,6 +27,6 @@ struct SceneUse {
 constexpr double kResolvedDetail = 1.0 / (1 << 14);
 
 SceneUse scene_use(const Scene& scene);
-std::string describe(const SceneUse& use);       // one line
+std::string describe(const SceneUse& use);  // one line
 std::string scale_warning(const SceneUse& use);  // one line with what to do, or ""
-std::string to_json(const SceneUse& use);        // an object for --json
+std::string to_json(const SceneUse& use);  // an object for --json

@@ -45,6 +45,12 @@ MUTANTS = {
         "path_tracer.h",
         "if (intersect_triangle(ray, shear, scene.triangles[i], t_max) < t_max) return true;",
         "continue;", ["showcase"]),
+    "every rectangle hit names rectangle 0": (
+        "path_tracer.h", "hit = {t, PrimitiveKind::Rect, i};", "hit = {t, PrimitiveKind::Rect, 0};",
+        ["cornell", "showcase"]),
+    "rectangle: inside test of one axis reversed": (
+        "axis_rect.h", "const real sign_u = a < u ? sign_a : -sign_a;",
+        "const real sign_u = a < u ? -sign_a : sign_a;", ["cornell", "showcase"]),
     "no pixel jitter": ("path_tracer.h",
                         "camera.ray_through(x + real(rng.at(kDimPixelX)), "
                         "y + real(rng.at(kDimPixelY)))",

@@ -88,6 +88,15 @@ Scene scaled(const Scene& base, float s) {
         sp.radius *= s;
     }
     for (Triangle& t : out.triangles) t = make_triangle(t.v0 * s, t.v1 * s, t.v2 * s, t.material);
+    for (ConvexQuad& q : out.quads)
+        q = make_convex_quad(q.v0 * s, q.v1 * s, q.v2 * s, q.v3 * s, q.material);
+    for (AxisRect& r : out.rects) {
+        Vec3 corners[4];
+        rect_corners(r, corners);
+        for (Vec3& c : corners) c = c * s;
+        r = make_axis_rect(corners, rect_axis(r), r.material);
+    }
+    out.written = {};  // the file's points no longer stand for these
     return out;
 }
 
@@ -101,21 +110,22 @@ TEST(PathTracer, ClosestHitPicksTheNearestPrimitive) {
     ts.sphere({0, 5, 0}, 0.5f, m);    // sphere 1 above it
     const SceneView v = ts.view();
     const Hit down = closest_hit(v, {{0, 10, 0}, {0, -1, 0}});
-    EXPECT_EQ(down.sphere, 1);
-    EXPECT_EQ(down.triangle, -1);
+    EXPECT_EQ(down.kind, PrimitiveKind::Sphere);
+    EXPECT_EQ(down.index, 1);
     EXPECT_FLOAT_EQ(down.t, 4.5f);
     const Hit floor_hit = closest_hit(v, {{3, 10, 0.5f}, {0, -1, 0}});
-    EXPECT_EQ(floor_hit.sphere, -1);
-    EXPECT_GE(floor_hit.triangle, 0);
+    EXPECT_EQ(floor_hit.kind, PrimitiveKind::Triangle);
+    EXPECT_GE(floor_hit.index, 0);
     EXPECT_FLOAT_EQ(floor_hit.t, 10.0f);
     // Between the spheres, looking down: the lower sphere, not the floor behind it.
     const Hit mid = closest_hit(v, {{0, 3.5f, 0}, {0, -1, 0}});
-    EXPECT_EQ(mid.sphere, 0);
+    EXPECT_EQ(mid.kind, PrimitiveKind::Sphere);
+    EXPECT_EQ(mid.index, 0);
     EXPECT_FLOAT_EQ(mid.t, 1.0f);
     // A triangle in front of a sphere.
     const Hit up = closest_hit(v, {{0, -3, 0}, {0, 1, 0}});
-    EXPECT_GE(up.triangle, 0);
-    EXPECT_EQ(up.sphere, -1);
+    EXPECT_EQ(up.kind, PrimitiveKind::Triangle);
+    EXPECT_GE(up.index, 0);
     EXPECT_FLOAT_EQ(up.t, 3.0f);
     const Hit none = closest_hit(v, {{0, 10, 0}, {0, 1, 0}});
     EXPECT_FALSE(none.found());
@@ -182,7 +192,7 @@ TEST(PathTracer, OccludersCastShadowsGlassIncluded) {
         ts.light(light, Vec3(4.0f));
         const SceneView v = ts.view();
         const Ray ray = ray_to({2, 1, 2}, p);  // sees p past the sphere
-        ASSERT_EQ(closest_hit(v, ray).sphere, -1);
+        ASSERT_NE(closest_hit(v, ray).kind, PrimitiveKind::Sphere);
         expect_exact(trace_path(v, ray, kRng, 1), Vec3(0.0f));
         expect_exact(direct_light_from(v, p, {0, 1, 0}, Vec3(0.5f)), Vec3(0.0f));
     }
@@ -234,7 +244,7 @@ TEST(PathTracer, MirrorShowsWhatItFaces) {
     ts.scene.background = Vec3(0.25f);
     const SceneView v = ts.view();
     const Ray straight_down{{0.1f, 0.5f, 0}, {0, -1, 0}};  // under the sphere
-    EXPECT_GE(closest_hit(v, straight_down).triangle, 0);
+    EXPECT_EQ(closest_hit(v, straight_down).kind, PrimitiveKind::Triangle);
     const Vec3 l = trace_path(v, straight_down, kRng, 3);
     EXPECT_EQ(l.x, 0.0f);  // the sphere's unlit bottom; the next bounce would need > 3
 }
@@ -478,7 +488,8 @@ TEST(PathTracer, SphereNormalIsUnitLength) {
     ts.sphere({3, -2, 1}, 2.0f, ts.material(MaterialType::Diffuse, Vec3(0.5f)));
     const SceneView v = ts.view();
     Hit hit;
-    hit.sphere = 0;
+    hit.kind = PrimitiveKind::Sphere;
+    hit.index = 0;
     // A ray whose t is a little off, as after a few bounces of rounding.
     for (float t : {2.0f, 2.0001f, 1.9999f}) {
         hit.t = t;
