@@ -19,8 +19,8 @@ import numpy as np
 
 from labkit.pfm import read_pfm
 
-# Every run, trusted or not, goes through the one runner (labkit/sandbox.py): a tool's timings and the
-# grader's are taken the same way (the sandbox is skipped for trusted runs).
+# Every run, trusted or not, goes through the one runner (labkit/sandbox.py): a tool's timings
+# and the grader's are taken the same way (the sandbox is skipped for trusted runs).
 from labkit.sandbox import Limits, Runner
 
 ROOT = pathlib.Path(__file__).resolve().parent.parent
