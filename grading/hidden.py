@@ -68,6 +68,24 @@ def hidden_scene(secret: str) -> dict:
          "radius": glass_r, "material": "clear"},
         {"center": [float(rng.uniform(0.7, 0.85)), mirror_r, float(rng.uniform(-0.75, -0.6))],
          "radius": mirror_r, "material": "polished"}]
+    # A panel turned at a drawn angle to the walls (a convex quad, not a rectangle) and a
+    # tilted triangle: every primitive kind is traced here, so a renderer that skips one of
+    # them fails (the Cornell box alone holds only a sphere and rectangles).
+    s["materials"]["panel"] = {"type": "diffuse",
+                               "albedo": [float(rng.uniform(0.3, 0.85)) for _ in range(3)]}
+    angle = float(rng.uniform(np.radians(25), np.radians(65)))
+    # Above the box's ball, left of the triangle, in front of the back wall: in view.
+    cx, cz, half, height = float(rng.uniform(0.3, 0.4)), float(rng.uniform(-0.9, -0.85)), \
+        0.1, float(rng.uniform(0.2, 0.3))
+    dx, dz = half * np.cos(angle), half * np.sin(angle)
+    s["quads"] = s.get("quads", []) + [{"vertices": [
+        [cx - dx, 0.45, cz - dz], [cx + dx, 0.45, cz + dz],
+        [cx + dx, 0.45 + height, cz + dz], [cx - dx, 0.45 + height, cz - dz]],
+        "material": "panel"}]
+    s["triangles"] = s.get("triangles", []) + [{"vertices": [
+        [0.55 + float(rng.uniform(-0.03, 0.03)), 0.45, -0.6],
+        [0.7, 0.55 + float(rng.uniform(-0.03, 0.03)), -0.65],
+        [0.6, 0.7, -0.55 + float(rng.uniform(-0.03, 0.03))]], "material": "panel"}]
     return s
 
 

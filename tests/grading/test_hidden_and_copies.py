@@ -68,3 +68,24 @@ def test_a_grade_writes_a_page_with_the_images(lab01_ref, tmp_path):
         else:
             assert "upside down" in page and "hidden-diff.png" not in page
             assert (pages / "hidden-diff.png").exists()
+
+
+def skipping(kind_loop: str) -> dict:
+    """path_tracer.h whose closest-hit loop over one primitive kind never finds anything."""
+    from labkit.harness import ROOT as root
+    text = (root / "common" / "core" / "path_tracer.h").read_text()
+    assert text.count(kind_loop) == 1, kind_loop
+    return {"path_tracer.h": text.replace(kind_loop, "(void)t;", 1)}
+
+
+def test_a_renderer_that_skips_a_primitive_kind_fails_the_hidden_scene(lab01_ref, tmp_path):
+    """The hidden scene holds every primitive kind (the Cornell box holds only rectangles and a
+    sphere): a renderer whose closest hit misses triangles, or convex quads, fails there."""
+    from grading import hidden
+    from labkit.variants import build_variant
+    assert hidden.check_hidden(lab01_ref, lab01_ref, "kinds").passed
+    for name, loop in (("triangles", "if (t < hit.t) hit = {t, PrimitiveKind::Triangle, i};"),
+                       ("quads", "if (t < hit.t) hit = {t, PrimitiveKind::Quad, i};")):
+        binary = build_variant("01-serial", tmp_path / name, skipping(loop))
+        result = hidden.check_hidden(binary, lab01_ref, "kinds")
+        assert not result.passed, f"a renderer without {name} passed: {result.detail}"
