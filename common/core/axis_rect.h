@@ -137,7 +137,8 @@ RT_HD inline real intersect_rect(const Ray& ray, const AxisRect& r, real t_max) 
     const real d_a = ray.direction[a];
     const real to_plane = r.plane - ray.origin[a];
     const real t = to_plane / d_a;
-    if (!(t > 0.0f) || !(t < t_max) || !(fabs_real(d_a) > 0.0f)) return t_max;
+    const bool in_range = (t > 0.0f) & (t < t_max) & (fabs_real(d_a) > 0.0f);  // NaN fails
+    if (!kConvergedTests && !in_range) return t_max;  // on a GPU the final select decides
     const real d_u = ray.direction[u], d_w = ray.direction[w];
     const real o_u = ray.origin[u], o_w = ray.origin[w];
     // u_hit - c = E / d_a when axis a comes before u (E's first term is a's), else -E / d_a.
@@ -153,5 +154,5 @@ RT_HD inline real intersect_rect(const Ray& ray, const AxisRect& r, real t_max) 
     const real lo_w = edge(w, r.lo_v - o_w, d_w) * sign_w;
     const real hi_w = edge(w, r.hi_v - o_w, d_w) * sign_w;
     const bool inside = (lo_u >= 0.0f) & (hi_u <= 0.0f) & (lo_w >= 0.0f) & (hi_w <= 0.0f);
-    return inside ? t : t_max;
+    return (in_range & inside) ? t : t_max;
 }

@@ -7,3 +7,15 @@
 #else
 #define RT_HD
 #endif
+
+// How a primitive test ends when a cheap test already rejects the primitive. A CPU core
+// returns at once and skips the arithmetic that the rejection made needless. A GPU warp
+// would run that arithmetic anyway for any of its lanes that still needs it, and an early
+// return only splits the warp (its lanes then run the rest of the loop apart and must be
+// joined again): there every lane runs every instruction of the test, and the rejection
+// joins the select that chooses the answer at the end.
+#if defined(__CUDA_ARCH__)
+constexpr bool kConvergedTests = true;
+#else
+constexpr bool kConvergedTests = false;
+#endif

@@ -29,14 +29,17 @@ RT_HD inline real intersect_sphere(const Ray& ray, const Sphere& s, real t_max) 
     const Vec3 perpendicular = f + ray.direction * b;  // centre-to-ray offset at that point
     const real r2 = s.radius * s.radius;
     const real disc = r2 - length_squared(perpendicular);
-    if (!(disc >= 0.0f)) return t_max;
-    const real q = b + copysign_real(sqrt_real(disc), b);
+    const bool meets = disc >= 0.0f;  // false for NaN too
+    if (!kConvergedTests && !meets) return t_max;  // on a GPU the final select decides
+    // A GPU's miss goes on with the root of 1, whatever it is worth: the root of a negative
+    // number, or of 0, would take the slow path of its square root.
+    const real q = b + copysign_real(sqrt_real(meets ? disc : real(1)), b);
     const real c = length_squared(f) - r2;
     const real t_a = c / q;
     const real t_b = q;
     const real t_near = min_float(t_a, t_b);
     const real t_far = max_float(t_a, t_b);
-    if (t_near > 0.0f && t_near < t_max) return t_near;
-    if (t_far > 0.0f && t_far < t_max) return t_far;
-    return t_max;
+    const bool near_ok = (t_near > 0.0f) & (t_near < t_max);
+    const bool far_ok = (t_far > 0.0f) & (t_far < t_max);
+    return !meets ? t_max : near_ok ? t_near : far_ok ? t_far : t_max;
 }

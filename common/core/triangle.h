@@ -153,10 +153,12 @@ RT_HD inline real intersect_triangle(const Ray& ray, const RayShear& shear, cons
     // degenerate triangles (zero normal) have denom == 0 and are culled too.
     const real denom = dot(tri.normal, ray.direction);
     const real num = tri.plane_offset - dot(tri.normal, ray.origin);  // t_plane = num / denom
-    // Bitwise | rather than ||: one well-predicted branch instead of several random ones.
+    // Bitwise | rather than ||: one well-predicted branch instead of several random ones. On
+    // a GPU no branch: the cull joins the final select (kConvergedTests, rt_hd.h).
     const bool behind = num * denom <= 0.0f;
     const bool beyond = fabs_real(num) >= t_max * real(1.00001f) * fabs_real(denom);
-    if (behind | beyond) return t_max;
+    const bool culled = behind | beyond;
+    if (!kConvergedTests && culled) return t_max;
 
     const Vec3 a = tri.v0 - ray.origin;
     const Vec3 b = tri.v1 - ray.origin;
@@ -169,22 +171,23 @@ RT_HD inline real intersect_triangle(const Ray& ray, const RayShear& shear, cons
     real u = edge_function(cx, cy, bx, by);
     real v = edge_function(ax, ay, cx, cy);
     real w = edge_function(bx, by, ax, ay);
-    if (u == 0.0f || v == 0.0f || w == 0.0f) {  // rare: on an edge, or rounded to zero
+    if (!culled && (u == 0.0f || v == 0.0f || w == 0.0f)) {  // rare: on an edge, or rounded
         u = static_cast<real>(edge_function_exact(cx, cy, bx, by));
         v = static_cast<real>(edge_function_exact(ax, ay, cx, cy));
         w = static_cast<real>(edge_function_exact(bx, by, ax, ay));
     }
     const bool any_negative = (u < 0.0f) | (v < 0.0f) | (w < 0.0f);
     const bool any_positive = (u > 0.0f) | (v > 0.0f) | (w > 0.0f);
-    if (any_negative & any_positive) return t_max;  // the ray passes outside an edge
+    const bool outside = any_negative & any_positive;  // the ray passes outside an edge
+    if (!kConvergedTests && outside) return t_max;
 
-    const real det = u + v + w;
-    if (det == 0.0f) return t_max;  // parallel ray or degenerate triangle
+    const real det = u + v + w;  // 0 for a parallel ray or a degenerate triangle: a miss
     const real t_scaled = u * (shear.sz * az) + v * (shear.sz * bz) + w * (shear.sz * cz);
     // t = t_scaled / det must lie in (0, t_max); compare without dividing first.
     const real sign = copysign_real(real(1), det);
     const real t_signed = t_scaled * sign;
     const real det_abs = det * sign;
-    if (!(t_signed > 0.0f) || !(t_signed < t_max * det_abs)) return t_max;
-    return t_scaled / det;
+    const bool hit = !(culled | outside) & (det != 0.0f) & (t_signed > 0.0f) &
+                     (t_signed < t_max * det_abs);  // false for NaN
+    return hit ? t_scaled / det : t_max;
 }
