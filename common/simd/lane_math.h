@@ -224,3 +224,22 @@ inline void redo_edges_exactly(MaskOf<F> on_edge, F ax, F ay, F bx, F by, F cx, 
     v = F::load(uvw[1]);
     w = F::load(uvw[2]);
 }
+
+// The same for intersect_quad's four edge functions (v0v1, v1v2, v2v3, v3v0), as convex_quad.h
+// computes them exactly.
+template <class F>
+inline void redo_quad_edges_exactly(MaskOf<F> on_edge, const F (&x)[4], const F (&y)[4],
+                                    F (&e)[4]) {
+    constexpr int kN = F::kLanes;
+    float out[4][kN];
+    for (int k = 0; k < 4; ++k) e[k].store(out[k]);
+    for (unsigned bits = on_edge.bits(); bits != 0; bits &= bits - 1) {
+        const int lane = __builtin_ctz(bits);
+        for (int k = 0; k < 4; ++k) {
+            const int q = (k + 1) % 4;  // edge k -> q, computed as edge_function(q, k)
+            out[k][lane] = static_cast<float>(edge_function_exact(
+                x[q].lane(lane), y[q].lane(lane), x[k].lane(lane), y[k].lane(lane)));
+        }
+    }
+    for (int k = 0; k < 4; ++k) e[k] = F::load(out[k]);
+}

@@ -109,7 +109,45 @@ inline int nearest_lane(Float8 t, int hit_bits) {
     return __builtin_ctz(static_cast<unsigned>((t == Float8(m)).bits() & hit_bits));
 }
 
-// closest_hit (path_tracer.h) over every packet: 8 primitives per test, then the nearest lane.
+// intersect_rect (axis_rect.h) for one ray against 8 rectangles. Here each lane has its own
+// axis, so each picks the ray's components with selects; the arithmetic per lane is the
+// scalar test's, both orders of the canonical edge function computed and one selected.
+inline Float8 intersect_rects8(const BroadcastRay& r, const RectPacket& p, Float8 t_max) {
+    const Int8 axis = Int8::load(p.axis);
+    const Mask8 on_x = axis == 0, on_z = axis == 2;
+    const Mask8 on_y = axis == 1;
+    const Float8 d_a = select(on_x, r.direction.x, select(on_y, r.direction.y, r.direction.z));
+    const Float8 o_a = select(on_x, r.origin.x, select(on_y, r.origin.y, r.origin.z));
+    const Float8 to_plane = Float8::load(p.plane) - o_a;
+    const Float8 t = to_plane / d_a;
+    const Mask8 crosses = (t > 0.0f) & (t < t_max) & (abs(d_a) > 0.0f);
+    if (none(crosses)) return t_max;
+    // u is y for axis x, else x; v is y for axis z, else z. a < u only for axis x, a < v
+    // except for axis z.
+    const Float8 d_u = select(on_x, r.direction.y, r.direction.x);
+    const Float8 o_u = select(on_x, r.origin.y, r.origin.x);
+    const Float8 d_v = select(on_z, r.direction.y, r.direction.z);
+    const Float8 o_v = select(on_z, r.origin.y, r.origin.z);
+    const Float8 sign_a = copysign(1.0f, d_a);
+    const Float8 sign_u = select(on_x, sign_a, -sign_a);
+    const Float8 sign_v = select(on_z, -sign_a, sign_a);
+    const auto edge = [&](Mask8 plane_first, Float8 to_other, Float8 d_other) {
+        const Float8 p1 = to_plane * d_other, p2 = to_other * d_a;  // never fused
+        return select(plane_first, p1 - p2, p2 - p1);
+    };
+    const Mask8 below_z = ~on_z;
+    const Float8 lo_u = edge(on_x, Float8::load(p.lo[0]) - o_u, d_u) * sign_u;
+    const Float8 hi_u = edge(on_x, Float8::load(p.hi[0]) - o_u, d_u) * sign_u;
+    const Float8 lo_v = edge(below_z, Float8::load(p.lo[1]) - o_v, d_v) * sign_v;
+    const Float8 hi_v = edge(below_z, Float8::load(p.hi[1]) - o_v, d_v) * sign_v;
+    const Mask8 hit = crosses & (lo_u >= 0.0f) & (hi_u <= 0.0f) & (lo_v >= 0.0f) & (hi_v <= 0.0f);
+    return select(hit, t, t_max);
+}
+
+// closest_hit (path_tracer.h) over every packet: 8 primitives per test, then the nearest lane;
+// the convex quads one by one, in the scalar loops' order. Primitives: the kinds compiled in
+// (geometry_set.h); the loops of kinds the scene lacks cost a comparison, and are kept.
+template <class Primitives = AnyGeometry>
 inline Hit closest_hit(const SimdSceneView& scene, const Ray& ray) {
     Hit hit;
     const BroadcastRay r(ray);
@@ -119,8 +157,7 @@ inline Hit closest_hit(const SimdSceneView& scene, const Ray& ray) {
         const int hits = (t < t_max).bits();
         if (hits == 0) continue;
         const int lane = nearest_lane(t, hits);
-        hit.t = t.lane(lane);
-        hit.sphere = i * kSimdWidth + lane;
+        hit = {t.lane(lane), PrimitiveKind::Sphere, i * kSimdWidth + lane};
     }
     for (int i = 0; i < scene.num_triangle_packets; ++i) {
         const Float8 t_max = hit.t;
@@ -128,14 +165,25 @@ inline Hit closest_hit(const SimdSceneView& scene, const Ray& ray) {
         const int hits = (t < t_max).bits();
         if (hits == 0) continue;
         const int lane = nearest_lane(t, hits);
-        hit.t = t.lane(lane);
-        hit.sphere = -1;
-        hit.triangle = i * kSimdWidth + lane;
+        hit = {t.lane(lane), PrimitiveKind::Triangle, i * kSimdWidth + lane};
+    }
+    for (int i = 0; i < scene.num_quads; ++i) {
+        const float t = intersect_quad(ray, r.shear, scene.quads[i], hit.t);
+        if (t < hit.t) hit = {t, PrimitiveKind::Quad, i};
+    }
+    for (int i = 0; i < scene.num_rect_packets; ++i) {
+        const Float8 t_max = hit.t;
+        const Float8 t = intersect_rects8(r, scene.rects[i], t_max);
+        const int hits = (t < t_max).bits();
+        if (hits == 0) continue;
+        const int lane = nearest_lane(t, hits);
+        hit = {t.lane(lane), PrimitiveKind::Rect, i * kSimdWidth + lane};
     }
     return hit;
 }
 
 // occluded (path_tracer.h): stops at the first packet with a hit.
+template <class Primitives = AnyGeometry>
 inline bool occluded(const SimdSceneView& scene, const Ray& ray, float t_max) {
     const BroadcastRay r(ray);
     const Float8 limit = t_max;
@@ -144,6 +192,12 @@ inline bool occluded(const SimdSceneView& scene, const Ray& ray, float t_max) {
     }
     for (int i = 0; i < scene.num_triangle_packets; ++i) {
         if (any(intersect_triangles8(r, scene.triangles[i], limit) < limit)) return true;
+    }
+    for (int i = 0; i < scene.num_quads; ++i) {
+        if (intersect_quad(ray, r.shear, scene.quads[i], t_max) < t_max) return true;
+    }
+    for (int i = 0; i < scene.num_rect_packets; ++i) {
+        if (any(intersect_rects8(r, scene.rects[i], limit) < limit)) return true;
     }
     return false;
 }

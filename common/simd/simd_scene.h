@@ -8,14 +8,21 @@
 //     ...            (3 vertices x 3 axes = 9 rows)
 //     normal[x..z], plane_offset                                       (4 more rows)
 //
+//   RectPacket (one per 8 axis-aligned rectangles, 32-byte aligned, 192 bytes)
+//     plane, lo[u], lo[v], hi[u], hi[v], axis: one row each, a lane per rectangle
+//
 // The last packet is padded with triangles that are never hit (zero normal: the plane cull
-// rejects them) and spheres that are never hit (radius squared -1), so no loop needs a tail.
+// rejects them), spheres that are never hit (radius squared -1) and rectangles that are never
+// hit (a NaN plane), so no loop needs a tail. Convex quads stay in the SceneView's array and
+// are tested one at a time: no scene of the course has many.
 // Only geometry lives here: materials and shading normals are read from the SceneView
 // through the index that a Hit records (packet * 8 + lane, the primitive's own index).
 //
 // Plain data and no intrinsics, so any translation unit may include it.
 #pragma once
 
+#include <cmath>
+#include <cstdint>
 #include <vector>
 
 #include <scene_view.h>
@@ -35,20 +42,37 @@ struct alignas(32) SpherePacket {
     float radius2[kSimdWidth];    // radius * radius; -1 in padding lanes (never hit)
 };
 
+// 8 axis-aligned rectangles (axis_rect.h), field by field: each lane has its own axis.
+struct alignas(32) RectPacket {
+    float plane[kSimdWidth];         // AxisRect::plane; NaN in padding lanes (never hit)
+    float lo[2][kSimdWidth];         // [u, v][lane]: lo_u, lo_v
+    float hi[2][kSimdWidth];         // hi_u, hi_v
+    int32_t axis[kSimdWidth];        // rect_axis
+};
+
 // Non-owning view of the packets: what the 8-wide closest_hit / occluded read.
 struct SimdSceneView {
     const TrianglePacket* triangles;  // ceil(num_triangles / 8) packets
     int num_triangle_packets;
     const SpherePacket* spheres;  // ceil(num_spheres / 8) packets
     int num_sphere_packets;
+    const RectPacket* rects;  // ceil(num_rects / 8) packets
+    int num_rect_packets;
+    const ConvexQuad* quads;  // the scene's own, tested one by one
+    int num_quads;
 };
 
-// The SoA copy of a scene's spheres and triangles. Owns its packets, so a copy of it (say,
-// one per renderer object) is self-contained; building it costs microseconds.
+// The SoA copy of a scene's spheres, triangles and rectangles. Owns its packets (a copy of
+// it, say one per renderer object, shares only the scene's convex quads); building it costs
+// microseconds.
 class SimdScene {
 public:
     explicit SimdScene(const SceneView& scene)
-        : triangles_(packets_for(scene.num_triangles)), spheres_(packets_for(scene.num_spheres)) {
+        : triangles_(packets_for(scene.num_triangles)),
+          spheres_(packets_for(scene.num_spheres)),
+          rects_(packets_for(scene.num_rects)),
+          quads_(scene.quads),
+          num_quads_(scene.num_quads) {
         for (int i = 0; i < scene.num_triangles; ++i) {
             const Triangle& tri = scene.triangles[i];
             TrianglePacket& p = triangles_[i / kSimdWidth];
@@ -70,11 +94,27 @@ public:
             for (int axis = 0; axis < 3; ++axis) p.center[axis][lane] = s.center[axis];
             p.radius2[lane] = s.radius * s.radius;  // the same rounding as intersect_sphere's
         }
+        for (RectPacket& p : rects_) {
+            for (float& plane : p.plane) plane = NAN;  // padding until a rectangle fills the lane
+        }
+        for (int i = 0; i < scene.num_rects; ++i) {
+            const AxisRect& r = scene.rects[i];
+            RectPacket& p = rects_[i / kSimdWidth];
+            const int lane = i % kSimdWidth;
+            p.plane[lane] = r.plane;
+            p.lo[0][lane] = r.lo_u;
+            p.lo[1][lane] = r.lo_v;
+            p.hi[0][lane] = r.hi_u;
+            p.hi[1][lane] = r.hi_v;
+            p.axis[lane] = rect_axis(r);
+        }
     }
 
     SimdSceneView view() const {
-        return {triangles_.data(), static_cast<int>(triangles_.size()), spheres_.data(),
-                static_cast<int>(spheres_.size())};
+        return {triangles_.data(), static_cast<int>(triangles_.size()),
+                spheres_.data(),   static_cast<int>(spheres_.size()),
+                rects_.data(),     static_cast<int>(rects_.size()),
+                quads_,            num_quads_};
     }
 
 private:
@@ -85,4 +125,7 @@ private:
 
     std::vector<TrianglePacket> triangles_;  // C++17 new honours alignas(32)
     std::vector<SpherePacket> spheres_;
+    std::vector<RectPacket> rects_;
+    const ConvexQuad* quads_;  // not owned: the scene's
+    int num_quads_;
 };
