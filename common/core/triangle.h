@@ -189,5 +189,7 @@ RT_HD inline real intersect_triangle(const Ray& ray, const RayShear& shear, cons
     const real det_abs = det * sign;
     const bool hit = !(culled | outside) & (det != 0.0f) & (t_signed > 0.0f) &
                      (t_signed < t_max * det_abs);  // false for NaN
-    return hit ? t_scaled / det : t_max;
+    // Divided before the select: written inside it, the division becomes a branch on a GPU.
+    const real t = t_scaled / det;
+    return hit ? t : t_max;
 }

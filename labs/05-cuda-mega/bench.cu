@@ -140,8 +140,8 @@ static const std::vector<Variant>& variants() {
         // What the previous reference chose and the converged kernel measured again.
         SHAPE("regenerate", "path regeneration (trace_samples_regenerating)", 32, Constant, 64,
               true, 255),
-        SHAPE("regs-72", "at most 72 registers", 32, Constant, 64, false, 72),
         SHAPE("regs-64", "at most 64 registers", 32, Constant, 64, false, 64),
+        SHAPE("regs-56", "at most 56 registers", 32, Constant, 64, false, 56),
         SHAPE("split-16", "16 threads per pixel", 16, Constant, 64, false, 255),
         SHAPE("split-1", "1 thread per pixel", 1, Constant, 64, false, 255),
         SHAPE("block-32", "blocks of 32", 32, Constant, 32, false, 255),

@@ -112,8 +112,41 @@ def test_kernel_report(nvcc):
         for materials in ("DiffuseOnly", "AnyMaterial"):
             for primitives in ("BoxGeometry", "GeneralGeometry", "AnyGeometry"):
                 row(f"render_kernel<32, {memory}, 64, false, 255, {materials}, {primitives}>")
-    registers, _, _ = row("render_kernel<32, constant, 64, false, 72, DiffuseOnly, BoxGeometry>")
-    assert registers <= 72, registers
+    registers, _, _ = row("render_kernel<32, constant, 64, false, 64, DiffuseOnly, BoxGeometry>")
+    assert registers <= 64, registers
+
+
+def test_loop_branches_reads_machine_code():
+    """labs/05-cuda-mega/loop_branches.py finds a kernel's innermost loops in cuobjdump's
+    listing and tells a branch that can split the warp from one that only guards the CALL of
+    a slow path; the trap at a kernel's end (a branch to itself) is no loop. A made-up
+    listing, so no cuobjdump is needed."""
+    code = [
+        (0x00, "MOV R1, c[0x0][0x28]"),
+        (0x10, "FADD R2, R2, R3"),
+        (0x20, "@P0 BRA 0x50"),  # skips arithmetic: lanes may part here
+        (0x30, "FMUL R4, R4, R4"),
+        (0x40, "FMUL R5, R5, R5"),
+        (0x50, "@!P1 BRA 0x80"),  # skips only the call of a slow path
+        (0x60, "MOV R0, 0x70"),
+        (0x70, "CALL.REL.NOINC 0x200"),
+        (0x80, "ISETP.GE.AND P2, PT, R6, R7, PT"),
+        (0x90, "@!P2 BRA 0x10"),  # the loop
+        (0xa0, "EXIT"),
+        (0xb0, "BRA 0xb0"),
+    ]
+    listing = "\t\tFunction : _Z13render_kernelv\n" + "".join(
+        f"        /*{a:04x}*/                   {text} ;  /* 0x0 */\n" for a, text in code)
+    script = ROOT / "labs" / LAB / "loop_branches.py"
+    p = subprocess.run(["python3", str(script)], input=listing, capture_output=True, text=True,
+                       timeout=60)
+    assert p.returncode == 0, p.stderr
+    loops = [ln.strip() for ln in p.stdout.splitlines() if ln.strip().startswith("loop")]
+    assert loops == ["loop 0x0010-0x0090: 9 instructions, 1 divergent branches, "
+                     "1 slow-path guards"], p.stdout
+    p = subprocess.run(["python3", str(script), "--kernel", "no_such_kernel"], input=listing,
+                       capture_output=True, text=True, timeout=60)
+    assert p.returncode == 1 and "no function matching" in p.stderr, p.stderr
 
 
 # ---- host side: errors before and without the GPU --------------------------------------
