@@ -59,19 +59,70 @@ void BM_occluded_cornell(benchmark::State& state) {
 }
 BENCHMARK(BM_occluded_cornell);
 
-void BM_intersect_triangle(benchmark::State& state) {
-    const Scene& scene = cornell();
+// The Cornell box's five walls as each kind of flat primitive: rectangles (as it loads),
+// convex quads, and two triangles each (as every quad loaded before they had kinds).
+struct Walls {
+    std::vector<AxisRect> rects;
+    std::vector<ConvexQuad> quads;
+    std::vector<Triangle> triangles;
+};
+const Walls& walls() {
+    static const Walls w = [] {
+        Walls out;
+        out.rects = cornell().rects;
+        for (const AxisRect& r : out.rects) {
+            Vec3 c[4];
+            rect_corners(r, c);
+            out.quads.push_back(make_convex_quad(c[0], c[1], c[2], c[3], r.material));
+            out.triangles.push_back(make_triangle(c[0], c[1], c[2], r.material));
+            out.triangles.push_back(make_triangle(c[0], c[2], c[3], r.material));
+        }
+        return out;
+    }();
+    return w;
+}
+
+// One wall per iteration: a rectangle, a quad, or a quad's worth of triangles (two tests).
+void BM_intersect_triangle_pair(benchmark::State& state) {
+    const std::vector<Triangle>& tris = walls().triangles;
     const std::vector<Ray> rays = sample_rays(4096);
     size_t i = 0;
     for (auto _ : state) {
         const Ray& r = rays[i & 4095];
         const RayShear shear(r.direction);
-        benchmark::DoNotOptimize(
-            intersect_triangle(r, shear, scene.triangles[i++ % scene.triangles.size()], 1e30f));
+        const size_t w = 2 * (i++ % (tris.size() / 2));
+        const float t = intersect_triangle(r, shear, tris[w], 1e30f);
+        benchmark::DoNotOptimize(intersect_triangle(r, shear, tris[w + 1], t));
     }
     state.SetItemsProcessed(state.iterations());
 }
-BENCHMARK(BM_intersect_triangle);
+BENCHMARK(BM_intersect_triangle_pair);
+
+void BM_intersect_quad(benchmark::State& state) {
+    const std::vector<ConvexQuad>& quads = walls().quads;
+    const std::vector<Ray> rays = sample_rays(4096);
+    size_t i = 0;
+    for (auto _ : state) {
+        const Ray& r = rays[i & 4095];
+        const RayShear shear(r.direction);
+        benchmark::DoNotOptimize(intersect_quad(r, shear, quads[i++ % quads.size()], 1e30f));
+    }
+    state.SetItemsProcessed(state.iterations());
+}
+BENCHMARK(BM_intersect_quad);
+
+void BM_intersect_rect(benchmark::State& state) {
+    const std::vector<AxisRect>& rects = walls().rects;
+    const std::vector<Ray> rays = sample_rays(4096);
+    size_t i = 0;
+    for (auto _ : state) {
+        benchmark::DoNotOptimize(
+            intersect_rect(rays[i & 4095], rects[i % rects.size()], 1e30f));
+        ++i;
+    }
+    state.SetItemsProcessed(state.iterations());
+}
+BENCHMARK(BM_intersect_rect);
 
 void BM_intersect_sphere(benchmark::State& state) {
     const Scene& scene = cornell();

@@ -1,5 +1,6 @@
 #include <scene_loader.h>
 
+#include <array>
 #include <cerrno>
 #include <cmath>
 #include <cstring>
@@ -384,12 +385,24 @@ void check_scene_scale(const SceneReader& r, const json& root, const Scene& scen
     }
 }
 
+// An edge as two points, the lesser first: the same key from either side.
+using EdgeKey = std::array<real, 6>;
+EdgeKey edge_key(Vec3 p, Vec3 q) {
+    EdgeKey a{p.x, p.y, p.z, q.x, q.y, q.z}, b{q.x, q.y, q.z, p.x, p.y, p.z};
+    return a < b ? a : b;
+}
+
 // What each quad of the file becomes (DESIGN.md, section 5), once every check has passed on it
 // as two triangles (read_triangles): an axis-aligned rectangle, else one planar convex quad,
 // else the two triangles it was read as. The kind is chosen on the points the renderer will
 // use, the written ones moved to the scene's centre and rounded once (centre_scene), so the
 // same file gives the same kinds wherever it is placed, and centring keeps them.
+// A rectangle's test is watertight against rectangles and a convex quad's against quads and
+// triangles, each with its own kind of edge function: so a rectangle that shares an edge with
+// a triangle or a convex quad (the same two points) becomes a convex quad too, and so on
+// along the rectangles that share its edges; no ray then slips between two kinds of test.
 void classify_quads(Scene& scene, size_t file_triangles) {
+    enum Kind { kRect, kQuad, kTriangles };
     const WrittenPoint centre = centring_centre(scene);
     const size_t count = (scene.triangles.size() - file_triangles) / 2;
     const std::vector<Triangle> halves(scene.triangles.begin() + file_triangles,
@@ -397,6 +410,44 @@ void classify_quads(Scene& scene, size_t file_triangles) {
     const std::vector<WrittenPoint> written(
         scene.written.triangle_vertices.begin() + 3 * file_triangles,
         scene.written.triangle_vertices.end());
+    std::vector<std::array<Vec3, 4>> rendered(count);
+    std::vector<Kind> kind(count);
+    std::vector<int> axis(count, -1);
+    std::vector<EdgeKey> shared;  // the edges of every triangle and convex quad
+    const auto add_edges = [&](const Vec3* v, int n) {
+        for (int k = 0; k < n; ++k) shared.push_back(edge_key(v[k], v[(k + 1) % n]));
+    };
+    for (size_t i = 0; i < file_triangles; ++i) {
+        Vec3 v[3];
+        for (int k = 0; k < 3; ++k)
+            v[k] = moved_to_centre(scene.written.triangle_vertices[3 * i + k], centre);
+        add_edges(v, 3);
+    }
+    for (size_t i = 0; i < count; ++i) {
+        const int corner[4] = {0, 1, 2, 5};  // the halves hold v0 v1 v2 and v0 v2 v3
+        Vec3 v[4];
+        for (int k = 0; k < 4; ++k) v[k] = moved_to_centre(written[6 * i + corner[k]], centre);
+        axis[i] = axis_rect_axis(v);
+        kind[i] = axis[i] >= 0 ? kRect : (is_planar_convex_quad(v) ? kQuad : kTriangles);
+        rendered[i] = {v[0], v[1], v[2], v[3]};
+        if (kind[i] != kRect) add_edges(v, 4);  // two triangles: their outline is the quad's
+    }
+    std::map<EdgeKey, std::vector<size_t>> rect_edges;
+    for (size_t i = 0; i < count; ++i) {
+        for (int k = 0; kind[i] == kRect && k < 4; ++k)
+            rect_edges[edge_key(rendered[i][k], rendered[i][(k + 1) % 4])].push_back(i);
+    }
+    while (!shared.empty()) {  // a worklist: each rectangle is demoted once
+        const auto found = rect_edges.find(shared.back());
+        shared.pop_back();
+        if (found == rect_edges.end()) continue;
+        for (size_t i : found->second) {
+            if (kind[i] != kRect) continue;
+            kind[i] = kQuad;
+            add_edges(rendered[i].data(), 4);
+        }
+    }
+
     scene.triangles.resize(file_triangles);
     scene.written.triangle_vertices.resize(3 * file_triangles);
     for (size_t i = 0; i < count; ++i) {
@@ -405,13 +456,10 @@ void classify_quads(Scene& scene, size_t file_triangles) {
         const Vec3 loaded[4] = {first.v0, first.v1, first.v2, second.v2};
         const WrittenPoint w[4] = {written[6 * i], written[6 * i + 1], written[6 * i + 2],
                                    written[6 * i + 5]};
-        const Vec3 rendered[4] = {moved_to_centre(w[0], centre), moved_to_centre(w[1], centre),
-                                  moved_to_centre(w[2], centre), moved_to_centre(w[3], centre)};
-        const int axis = axis_rect_axis(rendered);
-        if (axis >= 0) {
-            scene.rects.push_back(make_axis_rect(loaded, axis, first.material));
+        if (kind[i] == kRect) {
+            scene.rects.push_back(make_axis_rect(loaded, axis[i], first.material));
             scene.written.rect_vertices.insert(scene.written.rect_vertices.end(), w, w + 4);
-        } else if (is_planar_convex_quad(rendered)) {
+        } else if (kind[i] == kQuad) {
             scene.quads.push_back(
                 make_convex_quad(loaded[0], loaded[1], loaded[2], loaded[3], first.material));
             scene.written.quad_vertices.insert(scene.written.quad_vertices.end(), w, w + 4);

@@ -78,10 +78,16 @@ std::string describe(const SceneUse& use) {
     add(use.diffuse, "diffuse");
     add(use.mirrors, "mirror");
     add(use.glass, "glass");
-    std::string line = "scene: " + plural(use.spheres, "sphere", "spheres") + ", " +
-                       plural(use.triangles, "triangle", "triangles") + ", " +
-                       plural(use.quads, "quad", "quads") + ", " +
-                       plural(use.rects, "rectangle", "rectangles") +
+    // The kinds the scene has, by count: "1 sphere, 5 rectangles".
+    std::string primitives;
+    const auto count = [&](int n, const char* one, const char* many) {
+        if (n) primitives += (primitives.empty() ? "" : ", ") + plural(n, one, many);
+    };
+    count(use.spheres, "sphere", "spheres");
+    count(use.triangles, "triangle", "triangles");
+    count(use.quads, "convex quad", "convex quads");
+    count(use.rects, "rectangle", "rectangles");
+    std::string line = "scene: " + (primitives.empty() ? std::string("no primitives") : primitives) +
                        "; materials: " + (materials.empty() ? "none" : materials) + "; " +
                        (use.light ? "a point light" : "no light") + "; " +
                        (use.background ? "a background" : "a black background");

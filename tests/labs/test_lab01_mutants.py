@@ -45,6 +45,13 @@ MUTANTS = {
         "path_tracer.h",
         "if (intersect_triangle(ray, shear, scene.triangles[i], t_max) < t_max) return true;",
         "continue;", ["showcase"]),
+    "shadow rays ignore rectangles": (
+        "path_tracer.h",
+        "if (intersect_rect(ray, scene.rects[i], t_max) < t_max) return true;",
+        "continue;", ["cornell"]),
+    "rectangle: inside test of one axis reversed": (
+        "axis_rect.h", "const real sign_u = a < u ? sign_a : -sign_a;",
+        "const real sign_u = a < u ? -sign_a : sign_a;", ["cornell", "showcase"]),
     "no pixel jitter": ("path_tracer.h",
                         "camera.ray_through(x + real(rng.at(kDimPixelX)), "
                         "y + real(rng.at(kDimPixelY)))",

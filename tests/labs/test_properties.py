@@ -81,6 +81,19 @@ def box_quads(lo, hi, material):
     return [{"vertices": [corner(*c) for c in face], "material": material} for face in faces]
 
 
+def outward(faces):
+    """The same faces wound the other way: box_quads' fronts face into the box, these out of
+    it, as a closed glass solid's must (DESIGN.md, section 5)."""
+    return [{**f, "vertices": f["vertices"][::-1]} for f in faces]
+
+
+def as_triangles(faces):
+    """Each quad as its two triangles (v0 v1 v2), (v0 v2 v3): the same surface, whose edges
+    the neighbouring quads then share with triangles."""
+    return [{"vertices": [f["vertices"][a] for a in corners], "material": f["material"]}
+            for f in faces for corners in ((0, 1, 2), (0, 2, 3))]
+
+
 # ---- closed specular enclosures -------------------------------------------------------------
 
 IOR = 1.5
@@ -151,6 +164,32 @@ def mirror_room():
     return transformed(room, rotation([0.3, 1.0, 0.2], 23.7), offset=[0.37, -0.21, 0.11])
 
 
+def mirror_box():
+    """A closed axis-aligned mirror box of quads (six rectangles once loaded) holding a glass
+    box of rectangles, wound outward: their edges and corners are the rectangles' own."""
+    return {"camera": {"position": [0.1234, 0.2345, 0.3456], "look_at": [0.5, -0.3, -1],
+                       "up": [0, 1, 0], "vfov": 80},
+            "background": [1, 1, 1],
+            "materials": {"mirror": {"type": "mirror", "albedo": [1, 1, 1]},
+                          "glass": {"type": "glass", "ior": IOR}},
+            "quads": box_quads([-1, -1, -1], [1, 1, 1], "mirror")
+            + outward(box_quads([-0.7, -0.9, -0.8], [-0.1, -0.3, -0.2], "glass"))}
+
+
+def mixed_room(rotated=True):
+    """mirror_box with half of each box's faces as quads and half as two triangles, so that
+    quads (or rectangles, unrotated) share edges with triangles; rotated about a generic axis
+    (then every quad is a convex quad), or as written (then the loader makes the rectangles
+    that meet triangles quads)."""
+    room = mirror_box()
+    walls, glass = room["quads"][:6], room["quads"][6:]
+    room["quads"] = walls[0::2] + glass[1::2]
+    room["triangles"] = as_triangles(walls[1::2] + glass[0::2])
+    if not rotated:
+        return room
+    return transformed(room, rotation([0.3, 1.0, 0.2], 23.7), offset=[0.37, -0.21, 0.11])
+
+
 def enclosure_image(binary, scene, tmp_path, bounces, width=48, height=48, spp=48):
     path = scenes.write_scene(tmp_path / "enclosure.json", scene)
     return run_lab(binary, path, width=width, height=height, spp=spp, bounces=bounces,
@@ -180,8 +219,40 @@ def test_closed_mirror_room_with_glass_traps_every_path(renderer, tmp_path, boun
     assert not image.any(), f"{int((image > 0).any(axis=2).sum())} pixels see the background"
 
 
+ROOMS_OF_QUADS = {"mirror-box": mirror_box, "mixed-room": mixed_room,
+                  "mixed-box": lambda: mixed_room(rotated=False)}
+
+
+@pytest.mark.parametrize("bounces", [8, 64])
+@pytest.mark.parametrize("name", ROOMS_OF_QUADS)
+def test_closed_rooms_of_quads_trap_every_path(renderer, tmp_path, name, bounces):
+    """Rectangles, convex quads and triangles meeting at edges and corners: no path leaves."""
+    image = enclosure_image(renderer, ROOMS_OF_QUADS[name](), tmp_path, bounces, spp=96)
+    assert not image.any(), f"{int((image > 0).any(axis=2).sum())} pixels see the background"
+
+
+def test_rooms_of_quads_load_as_the_kinds_they_test(tmp_path):
+    """The rooms above test what they say: rectangles only, quads with triangles, and
+    rectangles made quads where they meet triangles."""
+    lab01 = build("lab01-ref")[0]
+
+    def uses(scene):
+        path = scenes.write_scene(tmp_path / "room.json", scene)
+        run = subprocess.run([str(lab01), "--scene", str(path), "--width", "2", "--height", "2",
+                              "--spp", "1", "--json", "--quiet", "--out",
+                              str(tmp_path / "o.ppm")], capture_output=True, text=True,
+                             check=True)
+        u = json.loads(run.stdout.strip().splitlines()[-1])["scene_uses"]
+        return u["triangles"], u["quads"], u["rects"]
+
+    assert uses(mirror_box()) == (0, 0, 12)
+    assert uses(mixed_room()) == (12, 6, 0)
+    triangles, quads, rects = uses(mixed_room(rotated=False))
+    assert (triangles, quads + rects) == (12, 6) and quads == 6
+
+
 ENCLOSURES = {"mirror-sphere": mirror_sphere, "glass-sphere": glass_sphere,
-              "mirror-room": mirror_room}
+              "mirror-room": mirror_room, **ROOMS_OF_QUADS}
 
 
 @pytest.mark.parametrize("name", ENCLOSURES)

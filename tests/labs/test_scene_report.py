@@ -38,7 +38,7 @@ def tiny_bead_in_a_huge_room():
 def test_the_scene_is_described(tmp_path):
     p = render(CORNELL, tmp_path)
     assert p.returncode == 0, p.stderr
-    assert ("scene: 1 sphere, 10 triangles; materials: 4 diffuse; a point light; "
+    assert ("scene: 1 sphere, 5 rectangles; materials: 4 diffuse; a point light; "
             "a black background") in p.stderr
     assert "warning" not in p.stderr
 
@@ -56,7 +56,8 @@ def test_json_says_the_same_and_quiet_says_nothing(tmp_path):
     p = render(tiny_bead_in_a_huge_room(), tmp_path, "--json", "--quiet")
     assert p.returncode == 0 and p.stderr == "", p.stderr
     uses = json.loads(p.stdout)["scene_uses"]
-    assert uses["spheres"] == 1 and uses["triangles"] == 10 and uses["warning"] is True
+    assert uses["spheres"] == 1 and uses["triangles"] == 0 and uses["warning"] is True
+    assert uses["quads"] == 0 and uses["rects"] == 5, uses
     assert uses["smallest"] == 0.01 and uses["extent"] >= 5000, uses
     p = render(CORNELL, tmp_path, "--json", "--quiet")
     assert json.loads(p.stdout)["scene_uses"]["warning"] is False

@@ -10,6 +10,8 @@
 
 #include <errors.h>
 #include <scene_loader.h>
+#include <axis_rect.h>
+#include <convex_quad.h>
 #include <sphere.h>
 #include <triangle.h>
 
@@ -54,6 +56,35 @@ TEST(DoubleBuild, SharedEdgeStaysWatertight) {
         const bool hit = intersect_triangle(ray, shear, t1, kRealMax) < kRealMax ||
                          intersect_triangle(ray, shear, t2, kRealMax) < kRealMax;
         EXPECT_TRUE(hit) << "x = " << x;
+    }
+}
+
+// The same for two convex quads and two rectangles that share an edge off float's grid: the
+// quads' edge functions take the double fallback, the rectangles' canonical ones are doubles.
+TEST(DoubleBuild, SharedEdgesOfQuadsAndRectanglesStayWatertight) {
+    const double e = 0.5 + 1e-12;  // the shared edge x = e, which float would move
+    const ConvexQuad left = make_convex_quad(Vec3(0, 0, 0), Vec3(e, 0, 0), Vec3(e, 1, 0),
+                                             Vec3(0, 1, 0), 0);
+    const ConvexQuad right = make_convex_quad(Vec3(e, 0, 0), Vec3(1, 0, 0), Vec3(1, 1, 0),
+                                              Vec3(e, 1, 0), 0);
+    const Vec3 l[4] = {Vec3(0, 0, 0), Vec3(e, 0, 0), Vec3(e, 1, 0), Vec3(0, 1, 0)};
+    const Vec3 r[4] = {Vec3(e, 0, 0), Vec3(1, 0, 0), Vec3(1, 1, 0), Vec3(e, 1, 0)};
+    ASSERT_EQ(axis_rect_axis(l), 2);
+    const AxisRect rect_l = make_axis_rect(l, 2, 0), rect_r = make_axis_rect(r, 2, 0);
+    EXPECT_EQ(rect_l.hi_u, e);
+    for (int i = 1; i < 1000; ++i) {
+        const double y = i / 1000.0;
+        for (double dx : {-0.3, 0.0, 0.7}) {
+            const Vec3 target(e, y, 0), origin(e + dx, y + 0.1, 1);
+            const Ray ray{origin, normalize(target - origin)};
+            const RayShear shear(ray.direction);
+            EXPECT_TRUE(intersect_quad(ray, shear, left, kRealMax) < kRealMax ||
+                        intersect_quad(ray, shear, right, kRealMax) < kRealMax)
+                << "y = " << y;
+            EXPECT_TRUE(intersect_rect(ray, rect_l, kRealMax) < kRealMax ||
+                        intersect_rect(ray, rect_r, kRealMax) < kRealMax)
+                << "y = " << y;
+        }
     }
 }
 

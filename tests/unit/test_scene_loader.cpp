@@ -1,4 +1,5 @@
-// Strict scene loading: valid files load as written (quads as two triangles), and every
+// Strict scene loading: valid files load as written (each quad as the kind it is: an
+// axis-aligned rectangle, a planar convex quad, or two triangles), and every
 // mistake is an InputError naming the file, the line and column of the offending token, and
 // what was expected.
 //
@@ -14,6 +15,7 @@
 #include <vector>
 
 #include "errors.h"
+#include "scene_centring.h"
 #include "scene_loader.h"
 
 namespace {
@@ -96,7 +98,9 @@ const std::string kGoodSphere = "\"center\": [0, 0, 0], \"radius\": 1, \"materia
 TEST(SceneLoader, CornellLoads) {
     const Scene s = load_scene(std::string(RT_SOURCE_DIR) + "/common/scenes/cornell.json");
     EXPECT_EQ(s.spheres.size(), 1u);
-    EXPECT_EQ(s.triangles.size(), 10u);  // five quads, two triangles each
+    EXPECT_EQ(s.triangles.size(), 0u);
+    EXPECT_EQ(s.quads.size(), 0u);
+    EXPECT_EQ(s.rects.size(), 5u);  // five axis-aligned walls
     EXPECT_EQ(s.materials.size(), 4u);
     EXPECT_EQ(s.material_names.size(), s.materials.size());
     EXPECT_TRUE(s.has_light);
@@ -114,18 +118,19 @@ TEST(SceneLoader, CornellLoads) {
     EXPECT_EQ(s.render.height, 600);
     EXPECT_EQ(s.render.spp, 512);
     EXPECT_EQ(s.render.bounces, 4);
-    for (const Triangle& t : s.triangles) {
-        EXPECT_NEAR(length(t.normal), 1.0f, 1e-6f);
-        ASSERT_GE(t.material, 0);
-        ASSERT_LT(t.material, static_cast<int>(s.materials.size()));
+    for (const AxisRect& r : s.rects) {
+        ASSERT_GE(r.material, 0);
+        ASSERT_LT(r.material, static_cast<int>(s.materials.size()));
+        EXPECT_LT(r.lo_u, r.hi_u);
+        EXPECT_LT(r.lo_v, r.hi_v);
     }
     // The sphere uses "ball".
     EXPECT_EQ(s.material_names[s.spheres[0].material], "ball");
     EXPECT_EQ(s.materials[s.spheres[0].material].type, MaterialType::Diffuse);
     // Every wall faces into the box, towards its centre (0.5, 0.5, -0.5).
-    for (const Triangle& t : s.triangles) {
-        const Vec3 to_centre = Vec3(0.5f, 0.5f, -0.5f) - t.v0;
-        EXPECT_GT(dot(t.normal, to_centre), 0.0f);
+    for (const AxisRect& r : s.rects) {
+        const Vec3 to_centre = Vec3(0.5f, 0.5f, -0.5f) - along_axis(rect_axis(r), r.plane);
+        EXPECT_GT(dot(rect_normal(r), to_centre), 0.0f);
     }
 }
 
@@ -203,7 +208,7 @@ TEST(SceneLoader, EverythingAsWritten) {
   "spheres":   [ { "center": [0.5, 0.2, -0.25], "radius": 0.2, "material": "steel" },
                  { "center": [1, 1, 1], "radius": 3e-4, "material": "glass" } ],
   "triangles": [ { "vertices": [[0,0,0], [1,0,0], [1,0,-1]], "material": "white" } ],
-  "quads":     [ { "vertices": [[0,0,0], [0,1,0], [0,1,-1], [0,0,-1]], "material": "glass" } ],
+  "quads":     [ { "vertices": [[0,0,0], [0,1,0], [0,1,-1.5], [0,0,-1]], "material": "glass" } ],
   "render":    { "width": 320, "height": 240, "spp": 16, "bounces": 7, "seed": 99 }
 })",
                                 kName);
@@ -229,7 +234,143 @@ TEST(SceneLoader, EverythingAsWritten) {
     EXPECT_EQ(s.material_names[s.spheres[0].material], "steel");
     EXPECT_EQ(s.material_names[s.spheres[1].material], "glass");
     EXPECT_FLOAT_EQ(s.spheres[1].radius, 3e-4f);
-    // One triangle plus a quad as two: (v0 v1 v2) and (v0 v2 v3), same material.
+    // One triangle, and a quad that is planar but no rectangle, and shares an edge with the
+    // triangle: a convex quad.
+    ASSERT_EQ(s.triangles.size(), 1u);
+    ASSERT_EQ(s.quads.size(), 1u);
+    EXPECT_EQ(s.material_names[s.triangles[0].material], "white");
+    EXPECT_EQ(s.material_names[s.quads[0].material], "glass");
+    EXPECT_EQ(s.quads[0].v2.z, -1.5f);
+    EXPECT_EQ(s.quads[0].normal.x, -1.0f);  // (v1 - v0) x (v2 - v0) points to -x
+    EXPECT_EQ(s.render.width, 320);
+    EXPECT_EQ(s.render.height, 240);
+    EXPECT_EQ(s.render.spp, 16);
+    EXPECT_EQ(s.render.bounces, 7);
+    EXPECT_EQ(s.render.seed, 99u);
+}
+
+namespace {
+
+// A scene of the given quads (JSON arrays of four points) and triangles, all white.
+std::string scene_of(const std::vector<std::string>& quads,
+                     const std::vector<std::string>& triangles = {}) {
+    std::string text = R"({"camera": {"position": [0.5, 0.5, 3], "look_at": [0.5, 0.5, 0]},
+        "materials": {"white": {"type": "diffuse", "albedo": [0.5, 0.5, 0.5]}}, "quads": [)";
+    for (size_t i = 0; i < quads.size(); ++i)
+        text += (i ? ", " : "") + std::string(R"({"material": "white", "vertices": )") +
+                quads[i] + "}";
+    text += R"(], "triangles": [)";
+    for (size_t i = 0; i < triangles.size(); ++i)
+        text += (i ? ", " : "") + std::string(R"({"material": "white", "vertices": )") +
+                triangles[i] + "}";
+    return text + "]}";
+}
+
+struct Kinds {
+    size_t triangles, quads, rects;
+};
+Kinds kinds_of(const std::string& text) {
+    const Scene s = parse_scene(text, kName);
+    return {s.triangles.size(), s.quads.size(), s.rects.size()};
+}
+
+}  // namespace
+
+TEST(SceneLoader, EachQuadBecomesTheKindItIs) {
+    const auto one = [](const std::string& quad) { return kinds_of(scene_of({quad})); };
+    const auto is = [](Kinds k, size_t t, size_t q, size_t r) {
+        return k.triangles == t && k.quads == q && k.rects == r;
+    };
+    EXPECT_TRUE(is(one("[[0,0,0], [1,0,0], [1,1,0], [0,1,0]]"), 0, 0, 1));  // a rectangle
+    EXPECT_TRUE(is(one("[[0,0,0], [1,0,0], [1.5,1,0], [0.5,1,0]]"), 0, 1, 0));  // parallelogram
+    EXPECT_TRUE(is(one("[[0,0,0], [1,0,0.5], [1,1,0.5], [0,1,0]]"), 0, 1, 0));  // tilted
+    // A parallelogram in decimal, rounded to float, tilted about all three axes.
+    EXPECT_TRUE(is(one("[[0.1,0.2,0.3], [1.3,0.7,-0.1], [1.9,1.6,0.4], [0.7,1.1,0.8]]"), 0, 1, 0));
+    EXPECT_TRUE(is(one("[[0,0,0], [1,0,0], [1,1,0.01], [0,1,0]]"), 2, 0, 0));  // not planar
+    EXPECT_TRUE(is(one("[[0,0,0], [1,0,0], [0.2,0.2,0], [0,1,0]]"), 2, 0, 0));  // not convex
+    EXPECT_TRUE(is(one("[[0,0,0], [1,1,0], [1,0,0], [0,1,0]]"), 2, 0, 0));      // a bow tie
+    EXPECT_TRUE(is(one("[[0,0,0], [1,0,0], [2,0,0], [3,0,0]]"), 2, 0, 0));      // no area
+    // Two halves of a split quad keep the file's order: (v0 v1 v2), (v0 v2 v3).
+    const Scene s = parse_scene(scene_of({"[[0,0,0], [1,0,0], [1,1,0.01], [0,1,0]]"}), kName);
+    EXPECT_EQ(s.triangles[1].v0.x, 0.0f);
+    EXPECT_EQ(s.triangles[1].v1.z, 0.01f);
+    EXPECT_EQ(s.triangles[1].v2.y, 1.0f);
+}
+
+// A rectangle that shares an edge with a triangle or a convex quad becomes a convex quad, and
+// so does a rectangle that shares an edge with that one: no edge is tested two ways.
+TEST(SceneLoader, RectanglesThatShareAnEdgeWithAnotherKindBecomeQuads) {
+    const std::string floor = "[[0,0,0], [1,0,0], [1,0,-1], [0,0,-1]]";
+    const std::string back = "[[0,0,-1], [1,0,-1], [1,1,-1], [0,1,-1]]";
+    const std::string left = "[[0,0,0], [0,0,-1], [0,1,-1], [0,1,0]]";
+    const std::string far_wall = "[[5,0,0], [5,1,0], [5,1,-1], [5,0,-1]]";
+    Kinds k = kinds_of(scene_of({floor, back, left, far_wall}));
+    EXPECT_EQ(k.rects, 4u);
+    // A triangle on the floor's front edge (z = 0): the floor, and the back and left walls
+    // that share its edges, become quads; the far wall, apart from them, stays a rectangle.
+    k = kinds_of(scene_of({floor, back, left, far_wall}, {"[[0,0,0], [0,-1,0.5], [1,0,0]]"}));
+    EXPECT_EQ(k.triangles, 1u);
+    EXPECT_EQ(k.quads, 3u);
+    EXPECT_EQ(k.rects, 1u);
+    // A tilted quad on the back wall's top edge does the same.
+    k = kinds_of(scene_of({floor, back, left, far_wall, "[[0,1,-1], [1,1,-1], [1,2,0], [0,2,0]]"}));
+    EXPECT_EQ(k.quads, 4u);
+    EXPECT_EQ(k.rects, 1u);
+    // Sharing only a corner, or part of an edge, changes nothing.
+    k = kinds_of(scene_of({floor, back, left, far_wall}, {"[[1,0,0], [2,0,0], [2,1,1]]"}));
+    EXPECT_EQ(k.rects, 4u);
+}
+
+// The kind is chosen on the points the renderer uses: the same file moved anywhere gives the
+// same kinds, and centring (which the driver applies) keeps them.
+TEST(SceneLoader, KindsDoNotDependOnWhereTheSceneIs) {
+    const std::vector<std::string> quads = {
+        "[[0,0,0], [1,0,0], [1,1,0], [0,1,0]]", "[[2,0,0], [3,0,0], [3.5,1,0], [2.5,1,0]]",
+        "[[4,0,0], [5,0,0], [5,1,0.01], [4,1,0]]"};  // apart: no shared edges
+    const Kinds here = kinds_of(scene_of(quads));
+    EXPECT_EQ(here.rects, 1u);
+    EXPECT_EQ(here.quads, 1u);
+    EXPECT_EQ(here.triangles, 2u);
+    for (double shift : {0.1, 12345.678, -98765.4321}) {
+        std::vector<std::string> moved;
+        for (const std::string& q : quads) {
+            std::string out = "[";
+            double v[4][3];
+            std::sscanf(q.c_str(), "[[%lf,%lf,%lf], [%lf,%lf,%lf], [%lf,%lf,%lf], [%lf,%lf,%lf]]",
+                        &v[0][0], &v[0][1], &v[0][2], &v[1][0], &v[1][1], &v[1][2], &v[2][0],
+                        &v[2][1], &v[2][2], &v[3][0], &v[3][1], &v[3][2]);
+            for (int k = 0; k < 4; ++k) {
+                char point[128];
+                std::snprintf(point, sizeof point, "%s[%.17g, %.17g, %.17g]", k ? ", " : "",
+                              v[k][0] + shift, v[k][1] - shift, v[k][2] + 0.5 * shift);
+                out += point;
+            }
+            moved.push_back(out + "]");
+        }
+        const Scene s = parse_scene(scene_of(moved), kName);
+        EXPECT_EQ(s.rects.size(), here.rects) << shift;
+        EXPECT_EQ(s.quads.size(), here.quads) << shift;
+        EXPECT_EQ(s.triangles.size(), here.triangles) << shift;
+        const Scene centred = centre_scene(s);
+        ASSERT_EQ(centred.rects.size(), 1u);
+        Vec3 corners[4];
+        rect_corners(centred.rects[0], corners);
+        const Vec3 (&c)[4] = corners;
+        EXPECT_EQ(axis_rect_axis(c), rect_axis(centred.rects[0])) << shift;
+        EXPECT_EQ(centred.rects[0].hi_u - centred.rects[0].lo_u, 1.0f) << shift;
+    }
+}
+
+TEST(SceneLoader, QuadAsTwoTrianglesKeepsItsHalves) {
+    const Scene s = parse_scene(R"({
+  "camera": { "position": [1, 2, 3], "look_at": [0, 0, 0] },
+  "materials": { "white": { "type": "diffuse", "albedo": [0.73, 0.73, 0.73] },
+                 "glass": { "type": "glass", "ior": 1.5 } },
+  "triangles": [ { "vertices": [[0,0,0], [1,0,0], [1,0,-1]], "material": "white" } ],
+  "quads":     [ { "vertices": [[0,0,0], [0,1,0], [0,1,-1], [0,0.8,-0.3]], "material": "glass" } ]
+})",
+                                kName);
+    // One triangle plus a quad that is not convex, as two: (v0 v1 v2) and (v0 v2 v3).
     ASSERT_EQ(s.triangles.size(), 3u);
     EXPECT_EQ(s.material_names[s.triangles[0].material], "white");
     const Triangle& q0 = s.triangles[1];
@@ -240,15 +381,9 @@ TEST(SceneLoader, EverythingAsWritten) {
     EXPECT_FLOAT_EQ(q0.v2.z, -1.0f);
     EXPECT_FLOAT_EQ(q1.v1.z, -1.0f);  // v2 of the quad
     EXPECT_FLOAT_EQ(q1.v1.y, 1.0f);
-    EXPECT_FLOAT_EQ(q1.v2.y, 0.0f);   // v3 of the quad
-    EXPECT_FLOAT_EQ(q1.v2.z, -1.0f);
-    EXPECT_FLOAT_EQ(q0.normal.x, q1.normal.x);  // a planar quad: both halves face one way
+    EXPECT_FLOAT_EQ(q1.v2.y, 0.8f);   // v3 of the quad
+    EXPECT_FLOAT_EQ(q1.v2.z, -0.3f);
     EXPECT_FLOAT_EQ(std::fabs(q0.normal.x), 1.0f);
-    EXPECT_EQ(s.render.width, 320);
-    EXPECT_EQ(s.render.height, 240);
-    EXPECT_EQ(s.render.spp, 16);
-    EXPECT_EQ(s.render.bounces, 7);
-    EXPECT_EQ(s.render.seed, 99u);
 }
 
 TEST(SceneLoader, ViewMirrorsTheArrays) {
@@ -257,7 +392,11 @@ TEST(SceneLoader, ViewMirrorsTheArrays) {
     EXPECT_EQ(v.spheres, s.spheres.data());
     EXPECT_EQ(v.num_spheres, 1);
     EXPECT_EQ(v.triangles, s.triangles.data());
-    EXPECT_EQ(v.num_triangles, 10);
+    EXPECT_EQ(v.num_triangles, 0);
+    EXPECT_EQ(v.quads, s.quads.data());
+    EXPECT_EQ(v.num_quads, 0);
+    EXPECT_EQ(v.rects, s.rects.data());
+    EXPECT_EQ(v.num_rects, 5);
     EXPECT_EQ(v.num_materials, 4);
     EXPECT_EQ(v.materials, s.materials.data());
     EXPECT_TRUE(v.has_light);

@@ -40,10 +40,33 @@ TEST(SceneReport, CountsWhatTheSceneUses) {
     EXPECT_FLOAT_EQ(static_cast<float>(use.smallest), 0.25f);
     EXPECT_FLOAT_EQ(static_cast<float>(use.extent), 2.0f);
     const std::string line = describe(use);
-    EXPECT_NE(line.find("1 sphere, 1 triangle"), std::string::npos) << line;
+    EXPECT_NE(line.find("scene: 1 sphere, 1 triangle;"), std::string::npos) << line;
     EXPECT_NE(line.find("1 diffuse, 1 glass"), std::string::npos) << line;
     EXPECT_NE(line.find("1 : 8"), std::string::npos) << line;
     EXPECT_EQ(scale_warning(use), "");
+}
+
+// Quads and rectangles are counted by kind, and their edges are sizes; kinds the scene does
+// not have are not named.
+TEST(SceneReport, CountsQuadsAndRectanglesByKind) {
+    Scene s = scene_with(0.25, 2.0);
+    s.triangles.clear();
+    const Vec3 r[4] = {{0, 0, 0}, {0.125f, 0, 0}, {0.125f, 0.1f, 0}, {0, 0.1f, 0}};
+    s.rects = {make_axis_rect(r, 2, 0), make_axis_rect(r, 2, 0)};
+    s.quads = {make_convex_quad({0, 0, 0}, {3, 0, 0}, {3.5f, 1, 0}, {0.5f, 1, 0}, 0)};
+    const SceneUse use = scene_use(s);
+    EXPECT_EQ(use.triangles, 0);
+    EXPECT_EQ(use.quads, 1);
+    EXPECT_EQ(use.rects, 2);
+    EXPECT_FLOAT_EQ(static_cast<float>(use.smallest), 0.125f);  // the rectangle's longer side
+    EXPECT_FLOAT_EQ(static_cast<float>(use.extent), 3.5f);      // the quad's corner
+    const std::string line = describe(use);
+    EXPECT_NE(line.find("scene: 1 sphere, 1 convex quad, 2 rectangles;"), std::string::npos)
+        << line;
+    const std::string json = to_json(use);
+    EXPECT_NE(json.find("\"quads\": 1, \"rects\": 2"), std::string::npos) << json;
+    EXPECT_NE(json.find("\"triangles\": 0"), std::string::npos) << json;
+    EXPECT_NE(describe(scene_use(Scene())).find("scene: no primitives;"), std::string::npos);
 }
 
 // The warning starts where a detail spans fewer than 2^14 of the scene's extent.

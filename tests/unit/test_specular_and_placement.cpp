@@ -114,6 +114,38 @@ TEST(StepOffEdges, AMirrorHitOnARoomsEdgeStartsInFrontOfBothFaces) {
     EXPECT_LT(path.ray.origin.x, 1.0f);  // in front of the wall
 }
 
+// The same room with a floor and a wall of each flat kind: a rectangle or a convex quad steps
+// off its edges as a triangle does, and for the specular bounce step lane by lane too
+// (tests/labs/test_properties.py's rooms of quads). Without the step, the next ray starts in
+// the wall's plane and leaves through it.
+TEST(StepOffEdges, RectanglesAndQuadsStepOffTheirEdgesToo) {
+    const Vec3 a(-1, 0, -1), b(-1, 0, 1), c(1, 0, 1), d(1, 0, -1);          // the floor
+    const Vec3 e(1, 0, -1), f(1, 0, 1), g(1, 1, 1), h(1, 1, -1);            // the wall x = 1
+    for (const PrimitiveKind kind : {PrimitiveKind::Rect, PrimitiveKind::Quad}) {
+        Scene scene = mirror_floor();
+        scene.triangles.clear();
+        if (kind == PrimitiveKind::Rect) {
+            const Vec3 floor[4] = {a, b, c, d}, wall[4] = {e, f, g, h};
+            scene.rects = {make_axis_rect(floor, 1, 0), make_axis_rect(wall, 0, 0)};
+        } else {
+            scene.quads = {make_convex_quad(a, b, c, d, 0), make_convex_quad(e, f, g, h, 0)};
+        }
+        const SceneView v = scene.view();
+        const Ray ray{{0.4f, 0.8f, 0.25f}, {0.6f, -0.8f, 0.0f}};
+        const Hit hit = closest_hit(v, ray);
+        ASSERT_EQ(hit.kind, kind);
+        ASSERT_EQ(hit.index, 0) << "the floor";
+        ASSERT_EQ(ray.at(hit.t).x, 1.0f);
+        ASSERT_EQ(ray.at(hit.t).y, 0.0f);
+        PathState path = start_path(ray, 4);
+        ShadowRay shadow;
+        bounce_step(v, hit, kRng, 4, path, shadow);
+        EXPECT_GT(path.ray.origin.y, 0.0f);  // in front of the floor
+        EXPECT_LT(path.ray.origin.x, 1.0f);  // in front of the wall
+        EXPECT_EQ(closest_hit(v, path.ray).index, 1) << "the reflected ray meets the wall";
+    }
+}
+
 // A light exactly at the surface point (distance 0) or within the point's own rounding gives
 // no sample, and nothing that sample_light returns is NaN.
 TEST(SampleLight, ALightAtTheSurfacePointGivesNoSample) {
@@ -164,7 +196,11 @@ TEST(WrittenCoordinates, AGenericOffsetCentresToTheUnmovedScene) {
         centre_scene(parse_scene(scene_text(12345.678, -8765.4321, 3456.789), "moved.json"));
     EXPECT_NEAR(moved.light.position.y, base.light.position.y, 1e-9f);
     EXPECT_NEAR(moved.light.position.x, base.light.position.x, 1e-9f);
-    EXPECT_NEAR(moved.triangles[0].v0.z, base.triangles[0].v0.z, 1e-9f);
+    ASSERT_EQ(moved.rects.size(), 1u);  // the floor, in both
+    ASSERT_EQ(base.rects.size(), 1u);
+    EXPECT_EQ(moved.rects[0].plane, base.rects[0].plane);
+    EXPECT_EQ(moved.rects[0].lo_v, base.rects[0].lo_v);
+    EXPECT_EQ(moved.rects[0].hi_u, base.rects[0].hi_u);
     const Camera a = base.camera.for_image(16, 16), b = moved.camera.for_image(16, 16);
     const Vec3 da = a.ray_through(8, 8).direction, db = b.ray_through(8, 8).direction;
     EXPECT_GT(dot(da, db), 1.0f - 1e-6f) << "the moved camera aims elsewhere";

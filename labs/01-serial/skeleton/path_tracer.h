@@ -17,6 +17,7 @@
 #include <cfloat>
 
 #include <camera.h>
+#include <geometry_set.h>
 #include <material_set.h>
 #include <rng.h>
 #include <sample_sum.h>
@@ -24,17 +25,17 @@
 
 // The nearest surface a ray meets: which primitive and how far.
 struct Hit {
-    real t = kRealMax;  // distance along the ray; kRealMax (real.h) when nothing was hit
-    int sphere = -1;    // index of the sphere hit, or -1
-    int triangle = -1;  // index of the triangle hit, or -1
+    real t = kRealMax;                         // distance along the ray; kRealMax (real.h) when
+    PrimitiveKind kind = PrimitiveKind::None;  // nothing was hit, and then kind is None
+    int index = -1;  // the primitive's index in its kind's array (scene_view.h)
 
-    RT_HD bool found() const { return sphere >= 0 || triangle >= 0; }
+    RT_HD bool found() const { return kind != PrimitiveKind::None; }
 };
 
 // What shading needs to know about a hit point.
 struct SurfacePoint {
     Vec3 position;  // world-space hit point
-    Vec3 normal;    // unit geometric normal: outward for spheres, the front side for triangles
+    Vec3 normal;    // unit geometric normal: outward for spheres, the front side for the others
     real extent;    // the primitive's largest |coordinate|, for offset_ray_origin (ray.h)
     int material;   // index into the material table
 };
@@ -42,40 +43,68 @@ struct SurfacePoint {
 // The position is ray.at(t), not re-projected onto the primitive (pbrt re-projects sphere hits,
 // p = c + r * normalize(p - c)): p - c already rounds to the spacing of floats at |c| + r, the
 // error the offset's extent term covers, and measured on sphere floors of radius 1e3..1e6 the
-// re-projected points rendered no closer to the closed form.
+// re-projected points rendered no closer to the closed form. Primitives (geometry_set.h): the
+// kinds that can have been hit.
+template <class Primitives = AnyGeometry>
 RT_HD inline SurfacePoint surface_at(const SceneView& scene, const Ray& ray, const Hit& hit) {
     const Vec3 p = ray.at(hit.t);
-    if (hit.sphere >= 0) {
-        const Sphere& s = scene.spheres[hit.sphere];
+    if (Primitives::kSpheres && hit.kind == PrimitiveKind::Sphere) {
+        const Sphere& s = scene.spheres[hit.index];
         return {p, normalize(p - s.center), sphere_extent(s), s.material};
     }
-    const Triangle& tri = scene.triangles[hit.triangle];
+    if (Primitives::kRects && hit.kind == PrimitiveKind::Rect) {
+        const AxisRect& r = scene.rects[hit.index];
+        return {p, rect_normal(r), r.extent, r.material};
+    }
+    if (Primitives::kQuads && hit.kind == PrimitiveKind::Quad) {
+        const ConvexQuad& q = scene.quads[hit.index];
+        return {p, q.normal, q.extent, q.material};
+    }
+    const Triangle& tri = scene.triangles[hit.index];
     return {p, tri.normal, tri.extent, tri.material};
 }
 
 // Closest hit by brute force over every primitive: the scenes of this course are small.
+// Primitives (geometry_set.h) is the set of kinds compiled in; each loop keeps the nearest hit
+// with a select, no branch out of the loop, so a GPU warp stays converged.
+template <class Primitives = AnyGeometry>
 RT_HD inline Hit closest_hit(const SceneView& scene, const Ray& ray) {
     Hit hit;
-    // TODO(lab01): this finds spheres only. Loop over the triangles too (build one
-    // RayShear per ray, then intersect_triangle), keeping the nearest hit.
-    for (int i = 0; i < scene.num_spheres; ++i) {
+    // TODO(lab01): this finds spheres only. Loop over the other primitives too, in this
+    // order, keeping the nearest hit: the triangles and the quads (build one RayShear per
+    // ray, then intersect_triangle and intersect_quad), then the axis-aligned rectangles
+    // (intersect_rect: the Cornell box's walls). Each hit records its kind and index.
+    for (int i = 0; Primitives::kSpheres && i < scene.num_spheres; ++i) {
         const real t = intersect_sphere(ray, scene.spheres[i], hit.t);
-        if (t < hit.t) {
-            hit.t = t;
-            hit.sphere = i;
-        }
+        if (t < hit.t) hit = {t, PrimitiveKind::Sphere, i};
     }
     return hit;
 }
 
 // Whether anything blocks the ray before distance t_max. Stops at the first blocker:
 // a shadow ray needs any hit, not the closest. Glass blocks too (no caustics).
+template <class Primitives = AnyGeometry>
 RT_HD inline bool occluded(const SceneView& scene, const Ray& ray, real t_max) {
-    // TODO(lab01): return true when any sphere or triangle lies on the ray before t_max.
+    // TODO(lab01): return true when any primitive (sphere, triangle, quad, rectangle) lies
+    // on the ray before t_max.
     (void)scene;
     (void)ray;
     (void)t_max;
     return false;
+}
+
+// A specular path's step off the edges of the primitive it hit (step_off_edges, triangle.h,
+// convex_quad.h, axis_rect.h); zero on a sphere, which has none.
+template <class Primitives = AnyGeometry>
+RT_HD inline Vec3 step_off_hit_edges(const SceneView& scene, const Hit& hit, Vec3 p,
+                                     real margin) {
+    if (Primitives::kTriangles && hit.kind == PrimitiveKind::Triangle)
+        return step_off_edges(scene.triangles[hit.index], p, margin);
+    if (Primitives::kQuads && hit.kind == PrimitiveKind::Quad)
+        return step_off_edges(scene.quads[hit.index], p, margin);
+    if (Primitives::kRects && hit.kind == PrimitiveKind::Rect)
+        return step_off_edges(scene.rects[hit.index], p, margin);
+    return Vec3(0.0f);
 }
 
 // g++ calls a function as big as the bounce step out of line, and the path state then lives in
@@ -143,8 +172,9 @@ RT_HD inline bool sample_light(const SceneView& scene, Vec3 position, Vec3 origi
 // interactions is spent. Reads random numbers by the path's bounce number only
 // (bounce_dimension), so every renderer that calls it draws the same ones. Materials
 // (material_set.h) is the set of material kinds compiled in: a renderer that knows its scene
-// has no mirror or glass asks for DiffuseOnly and carries no code for them.
-template <class Materials = AnyMaterial, class Rng>
+// has no mirror or glass asks for DiffuseOnly and carries no code for them; Primitives
+// (geometry_set.h), the primitive kinds, likewise.
+template <class Materials = AnyMaterial, class Primitives = AnyGeometry, class Rng>
 RT_HD RT_FORCE_INLINE bool bounce_step(const SceneView& scene, const Hit& hit, const Rng& rng,
                                        int max_bounces, PathState& path, ShadowRay& shadow) {
     // TODO(lab01): the bounce step. Escaped paths pick up the background and end; at a
@@ -164,15 +194,15 @@ RT_HD RT_FORCE_INLINE bool bounce_step(const SceneView& scene, const Hit& hit, c
 // Radiance arriving along a camera ray, estimated by one random path of at most
 // max_bounces surface interactions: closest hit, bounce step, and the shadow ray it asks for
 // traced at once (its radiance added if nothing blocks it), until the path ends.
-template <class Materials = AnyMaterial, class Geometry, class Rng>
+template <class Materials = AnyMaterial, class Primitives = AnyGeometry, class Geometry, class Rng>
 RT_HD inline Vec3 trace_path(const SceneView& scene, const Geometry& geometry, Ray ray,
                              const Rng& rng, int max_bounces) {
     PathState path = start_path(ray, max_bounces);
     while (path.alive) {
-        const Hit hit = closest_hit(geometry, path.ray);
+        const Hit hit = closest_hit<Primitives>(geometry, path.ray);
         ShadowRay shadow;
-        if (bounce_step<Materials>(scene, hit, rng, max_bounces, path, shadow) &&
-            !occluded(geometry, shadow.ray, shadow.t_max)) {
+        if (bounce_step<Materials, Primitives>(scene, hit, rng, max_bounces, path, shadow) &&
+            !occluded<Primitives>(geometry, shadow.ray, shadow.t_max)) {
             path.radiance += shadow.radiance;
         }
     }
@@ -180,18 +210,20 @@ RT_HD inline Vec3 trace_path(const SceneView& scene, const Geometry& geometry, R
 }
 
 // The radiance of one light sample with its shadow ray traced: sample_light, then occluded.
-template <class Geometry>
+template <class Primitives = AnyGeometry, class Geometry>
 RT_HD inline Vec3 direct_light(const SceneView& scene, const Geometry& geometry, Vec3 position,
                                Vec3 origin, Vec3 facing_normal, Vec3 albedo) {
     ShadowRay shadow;
     if (!sample_light(scene, position, origin, facing_normal, albedo, shadow)) return Vec3(0.0f);
-    return occluded(geometry, shadow.ray, shadow.t_max) ? Vec3(0.0f) : shadow.radiance;
+    return occluded<Primitives>(geometry, shadow.ray, shadow.t_max) ? Vec3(0.0f)
+                                                                    : shadow.radiance;
 }
 
 // The estimate of one pixel: the mean of spp paths through uniformly jittered points of the
 // pixel (a box filter). Pixel index and sample number key the random numbers. Materials: the
-// material kinds compiled in (material_set.h), passed on to trace_path.
-template <class Materials = AnyMaterial, class Geometry>
+// material kinds compiled in (material_set.h), Primitives the primitive kinds (geometry_set.h),
+// both passed on to trace_path.
+template <class Materials = AnyMaterial, class Primitives = AnyGeometry, class Geometry>
 RT_HD inline Vec3 render_pixel(const SceneView& scene, const Geometry& geometry,
                                const Camera& camera, const RenderSettings& settings, int x, int y) {
     const uint64_t pixel = static_cast<uint64_t>(y) * settings.width + x;
@@ -200,8 +232,8 @@ RT_HD inline Vec3 render_pixel(const SceneView& scene, const Geometry& geometry,
     // (SampleStream(settings.seed, pixel, s), dimensions kDimPixelX/kDimPixelY).
     // Until then: one path through the pixel's corner.
     const SampleStream rng(settings.seed, pixel, 0);
-    sum.add(
-        trace_path<Materials>(scene, geometry, camera.ray_through(x, y), rng, settings.bounces));
+    sum.add(trace_path<Materials, Primitives>(scene, geometry, camera.ray_through(x, y), rng,
+                                              settings.bounces));
     return sum.mean(1);
 }
 
@@ -211,13 +243,13 @@ RT_HD inline Vec3 direct_light(const SceneView& scene, Vec3 position, Vec3 origi
     return direct_light(scene, scene, position, origin, facing_normal, albedo);
 }
 
-template <class Materials = AnyMaterial, class Rng>
+template <class Materials = AnyMaterial, class Primitives = AnyGeometry, class Rng>
 RT_HD inline Vec3 trace_path(const SceneView& scene, Ray ray, const Rng& rng, int max_bounces) {
-    return trace_path<Materials>(scene, scene, ray, rng, max_bounces);
+    return trace_path<Materials, Primitives>(scene, scene, ray, rng, max_bounces);
 }
 
-template <class Materials = AnyMaterial>
+template <class Materials = AnyMaterial, class Primitives = AnyGeometry>
 RT_HD inline Vec3 render_pixel(const SceneView& scene, const Camera& camera,
                                const RenderSettings& settings, int x, int y) {
-    return render_pixel<Materials>(scene, scene, camera, settings, x, y);
+    return render_pixel<Materials, Primitives>(scene, scene, camera, settings, x, y);
 }

@@ -10,7 +10,8 @@
 // Int8 and kLanes as 8. The width is chosen at build time, by which header an object includes
 // (labs/02-simd/lab.mk); compacted_tracer.h runs the same bounce step on packets it refills.
 //
-// The scene stays as loaded (arrays of spheres, triangles and materials): each primitive is
+// The scene stays as loaded (arrays of spheres, triangles, quads, rectangles and materials):
+// each primitive is
 // broadcast to all lanes and tested against all rays at once, and shading fetches per-lane
 // data with gathers. The structure of arrays is the packet: Vec3xN keeps the rays' x in one
 // register, their y in another, their z in a third.
@@ -22,8 +23,10 @@
 
 #include <cfloat>
 #include <cstddef>
+#include <type_traits>
 
 #include <camera.h>
+#include <geometry_set.h>
 #include <sample_sum.h>
 #include <scene_view.h>
 #include <simd8.h>  // and lane_math.h; a 16-lane build includes simd16.h first
@@ -74,6 +77,8 @@ using RayShear8 = RayShearN<Float8>;
 // it does inside Triangle.
 static_assert(offsetof(Triangle, v2) + 4 * sizeof(float) <= sizeof(Triangle),
               "permuted() reads one float past each vertex of a Triangle");
+static_assert(offsetof(ConvexQuad, v3) + 4 * sizeof(float) <= sizeof(ConvexQuad),
+              "permuted() reads one float past each vertex of a ConvexQuad");
 
 // The two intersection tests are forced inline, as bounce_step is: g++ keeps the 16-lane
 // triangle test out of line where two loops call it, and then reloads the packet's rays and
@@ -137,37 +142,88 @@ RT_PACKET_INLINE F intersect_triangle(const RayPacket<F>& ray, const RayShearN<F
     return select(Mask::first(1), F(t0), t_max);
 }
 
+// intersect_quad (convex_quad.h) for N rays against one quad: the plane cull, the four edge
+// functions of the sheared vertices as the triangle test computes them, and the plane's t.
+template <class F>
+RT_PACKET_INLINE F intersect_quad(const RayPacket<F>& ray, const RayShearN<F>& shear,
+                                  const ConvexQuad& quad, F t_max) {
+    using Mask = MaskOf<F>;
+    const Vec3xN<F> normal(quad.normal);
+    const F denom = dot(normal, ray.direction);
+    const F num = F(quad.plane_offset) - dot(normal, ray.origin);
+    const Mask not_behind = not_less_equal(num * denom, F(0.0f));
+    const Mask not_beyond = not_greater_equal(abs(num), t_max * 1.00001f * abs(denom));
+    const Mask candidates = not_behind & not_beyond;
+    if (none(candidates)) return t_max;
+
+    // TODO(lab02): intersect_quad (common/core/convex_quad.h) in all lanes: as your
+    // intersect_triangle, with four edge functions (v0v1, v1v2, v2v3, v3v0, each computed
+    // as the triangle computes the same edge) and the plane's t = num / denom.
+    // Until then: lane 0 only, with the scalar test.
+    (void)candidates;
+    const Ray ray0 = ray.lane(0);
+    const float t0 = intersect_quad(ray0, RayShear(ray0.direction), quad, t_max.lane(0));
+    (void)shear;
+    return select(Mask::first(1), F(t0), t_max);
+}
+
+// Component `axis` of every lane: the axis is the primitive's, the same in every lane.
+template <class F>
+inline const F& axis_component(const Vec3xN<F>& v, int axis) {
+    return axis == 0 ? v.x : (axis == 1 ? v.y : v.z);
+}
+
+// intersect_rect (axis_rect.h) for N rays against one axis-aligned rectangle. Its axis is the
+// same in every lane, so it picks registers, not lanes: one division and four sign tests.
+template <class F>
+RT_PACKET_INLINE F intersect_rect(const RayPacket<F>& ray, const AxisRect& r, F t_max) {
+    // TODO(lab02): intersect_rect (common/core/axis_rect.h) in all lanes: the rectangle's
+    // axis is the same in every lane, so it picks a register (axis_component), not lanes;
+    // t = (plane - o_a) / d_a, then the four canonical edge functions (two rounded
+    // products, never fused), their signs read as the scalar test reads them.
+    // Until then: lane 0 only, with the scalar test, so 7 of every 8 samples miss the
+    // Cornell box's walls.
+    const float t0 = intersect_rect(ray.lane(0), r, t_max.lane(0));
+    return select(MaskOf<F>::first(1), F(t0), t_max);
+}
+
 // The nearest surface of each lane's ray.
 template <class F>
 struct HitPacket {
     F t;  // distance; t_max where nothing was hit
-    IntOf<F> sphere;  // index of the sphere hit, or -1
-    IntOf<F> triangle;  // index of the triangle hit, or -1
+    IntOf<F> kind;   // PrimitiveKind of the primitive hit, as an int (0: nothing)
+    IntOf<F> index;  // its index in its kind's array
 
-    MaskOf<F> found() const { return ~((sphere == -1) & (triangle == -1)); }
+    MaskOf<F> found() const { return ~(kind == 0); }
+    MaskOf<F> on(PrimitiveKind k) const { return kind == static_cast<int>(k); }
 };
 
 // closest_hit (path_tracer.h) for N rays: every primitive against all lanes, keeping each
-// lane's nearest hit with a masked update. Lanes outside `active` find nothing (their t_max
-// is 0, which every test rejects).
+// lane's nearest hit with a masked update, in the scalar loops' order. Lanes outside `active`
+// find nothing (their t_max is 0, which every test rejects).
 template <class F>
 inline HitPacket<F> closest_hit(const SceneView& scene, const RayPacket<F>& ray, MaskOf<F> active) {
     using I = IntOf<F>;
-    HitPacket<F> hit{select(active, F(FLT_MAX), F(0.0f)), I(-1), I(-1)};
-    for (int i = 0; i < scene.num_spheres; ++i) {
-        const F t = intersect_sphere(ray, scene.spheres[i], hit.t);
+    HitPacket<F> hit{select(active, F(FLT_MAX), F(0.0f)), I(0), I(-1)};
+    const auto keep = [&](F t, PrimitiveKind kind, int i) {
         const auto nearer = t < hit.t;
         hit.t = select(nearer, t, hit.t);
-        hit.sphere = select(nearer, I(i), hit.sphere);
+        hit.kind = select(nearer, I(static_cast<int>(kind)), hit.kind);
+        hit.index = select(nearer, I(i), hit.index);
+    };
+    for (int i = 0; i < scene.num_spheres; ++i)
+        keep(intersect_sphere(ray, scene.spheres[i], hit.t), PrimitiveKind::Sphere, i);
+    if (scene.num_triangles > 0 || scene.num_quads > 0) {
+        const RayShearN<F> shear(ray);
+        for (int i = 0; i < scene.num_triangles; ++i) {
+            keep(intersect_triangle(ray, shear, scene.triangles[i], hit.t), PrimitiveKind::Triangle,
+                 i);
+        }
+        for (int i = 0; i < scene.num_quads; ++i)
+            keep(intersect_quad(ray, shear, scene.quads[i], hit.t), PrimitiveKind::Quad, i);
     }
-    const RayShearN<F> shear(ray);
-    for (int i = 0; i < scene.num_triangles; ++i) {
-        const F t = intersect_triangle(ray, shear, scene.triangles[i], hit.t);
-        const auto nearer = t < hit.t;
-        hit.t = select(nearer, t, hit.t);
-        hit.sphere = select(nearer, I(-1), hit.sphere);
-        hit.triangle = select(nearer, I(i), hit.triangle);
-    }
+    for (int i = 0; i < scene.num_rects; ++i)
+        keep(intersect_rect(ray, scene.rects[i], hit.t), PrimitiveKind::Rect, i);
     return hit;
 }
 
@@ -178,16 +234,27 @@ inline MaskOf<F> occluded(const SceneView& scene, const RayPacket<F>& ray, F t_m
                           MaskOf<F> active) {
     auto blocked = MaskOf<F>::none();
     F limit = select(active, t_max, F(0.0f));
+    // Adds the lanes that `t` blocks; true when every active lane is blocked.
+    const auto block = [&](F t) {
+        blocked |= t < limit;
+        if (none(and_not(active, blocked))) return true;
+        limit = select(blocked, F(0.0f), limit);
+        return false;
+    };
     for (int i = 0; i < scene.num_spheres; ++i) {
-        blocked |= intersect_sphere(ray, scene.spheres[i], limit) < limit;
-        if (none(and_not(active, blocked))) return blocked;
-        limit = select(blocked, F(0.0f), limit);
+        if (block(intersect_sphere(ray, scene.spheres[i], limit))) return blocked;
     }
-    const RayShearN<F> shear(ray);
-    for (int i = 0; i < scene.num_triangles; ++i) {
-        blocked |= intersect_triangle(ray, shear, scene.triangles[i], limit) < limit;
-        if (none(and_not(active, blocked))) return blocked;
-        limit = select(blocked, F(0.0f), limit);
+    if (scene.num_triangles > 0 || scene.num_quads > 0) {
+        const RayShearN<F> shear(ray);
+        for (int i = 0; i < scene.num_triangles; ++i) {
+            if (block(intersect_triangle(ray, shear, scene.triangles[i], limit))) return blocked;
+        }
+        for (int i = 0; i < scene.num_quads; ++i) {
+            if (block(intersect_quad(ray, shear, scene.quads[i], limit))) return blocked;
+        }
+    }
+    for (int i = 0; i < scene.num_rects; ++i) {
+        if (block(intersect_rect(ray, scene.rects[i], limit))) return blocked;
     }
     return blocked;
 }
@@ -220,43 +287,61 @@ inline SurfacePacket<F> surface_at(const SceneView& scene, const RayPacket<F>& r
     using I = IntOf<F>;
     SurfacePacket<F> s;
     s.position = ray.origin + ray.direction * hit.t;
-    const auto on_sphere = and_not(mask, hit.sphere == -1);
-    const auto on_triangle = and_not(mask, on_sphere);
-    Vec3xN<F> sphere_normal(Vec3(0.0f));
-    F sphere_extent(0.0f);
-    I sphere_material(0);
+    s.normal = Vec3xN<F>(Vec3(0.0f));
+    s.extent = F(0.0f);
+    s.material = I(0);
+    // Each kind's lanes gather their primitive's fields; the others keep what they have.
+    const auto take = [&](MaskOf<F> lanes, const Vec3xN<F>& normal, F extent, I material) {
+        s.normal = select(lanes, normal, s.normal);
+        s.extent = select(lanes, extent, s.extent);
+        s.material = select(lanes, material, s.material);
+    };
+    const auto on_sphere = mask & hit.on(PrimitiveKind::Sphere);
     if (any(on_sphere)) {
         constexpr int kS = stride_of<Sphere>();
         const Sphere& s0 = scene.spheres[0];
-        const Vec3xN<F> center(gather(s0.center.x, kS, hit.sphere, on_sphere),
-                               gather(s0.center.y, kS, hit.sphere, on_sphere),
-                               gather(s0.center.z, kS, hit.sphere, on_sphere));
-        sphere_normal = normalize(s.position - center);
+        const Vec3xN<F> center(gather(s0.center.x, kS, hit.index, on_sphere),
+                               gather(s0.center.y, kS, hit.index, on_sphere),
+                               gather(s0.center.z, kS, hit.index, on_sphere));
         // sphere_extent (sphere.h), lane by lane
-        sphere_extent = max_component(abs(center)) + gather(s0.radius, kS, hit.sphere, on_sphere);
-        sphere_material = gather(s0.material, kS, hit.sphere, on_sphere);
+        take(on_sphere, normalize(s.position - center),
+             max_component(abs(center)) + gather(s0.radius, kS, hit.index, on_sphere),
+             gather(s0.material, kS, hit.index, on_sphere));
     }
-    Vec3xN<F> triangle_normal(Vec3(0.0f));
-    F triangle_extent(0.0f);
-    I triangle_material(0);
-    if (any(on_triangle)) {
-        constexpr int kT = stride_of<Triangle>();
-        const Triangle& t0 = scene.triangles[0];
-        triangle_normal = {gather(t0.normal.x, kT, hit.triangle, on_triangle),
-                           gather(t0.normal.y, kT, hit.triangle, on_triangle),
-                           gather(t0.normal.z, kT, hit.triangle, on_triangle)};
-        triangle_extent = gather(t0.extent, kT, hit.triangle, on_triangle);
-        triangle_material = gather(t0.material, kT, hit.triangle, on_triangle);
+    // A flat primitive's own normal, extent and material (Triangle and ConvexQuad alike).
+    const auto take_flat = [&](auto kind, const auto* first) {
+        const auto lanes = mask & hit.on(kind);
+        if (none(lanes)) return;
+        using T = std::remove_cv_t<std::remove_pointer_t<decltype(first)>>;
+        constexpr int kT = stride_of<T>();
+        take(lanes,
+             {gather(first->normal.x, kT, hit.index, lanes),
+              gather(first->normal.y, kT, hit.index, lanes),
+              gather(first->normal.z, kT, hit.index, lanes)},
+             gather(first->extent, kT, hit.index, lanes),
+             gather(first->material, kT, hit.index, lanes));
+    };
+    take_flat(PrimitiveKind::Triangle, scene.triangles);
+    take_flat(PrimitiveKind::Quad, scene.quads);
+    const auto on_rect = mask & hit.on(PrimitiveKind::Rect);
+    if (any(on_rect)) {  // rect_normal (axis_rect.h), lane by lane
+        constexpr int kR = stride_of<AxisRect>();
+        const AxisRect& r0 = scene.rects[0];
+        const I axis_side = gather(r0.axis_side, kR, hit.index, on_rect);
+        const I axis = axis_side & 3;
+        const F side = select(axis_side == axis, F(1.0f), F(-1.0f));  // bit 2: faces -axis
+        const F zero(0.0f);
+        take(on_rect,
+             {select(axis == 0, side, zero), select(axis == 1, side, zero),
+              select(axis == 2, side, zero)},
+             gather(r0.extent, kR, hit.index, on_rect), gather(r0.material, kR, hit.index, on_rect));
     }
-    s.normal = select(on_sphere, sphere_normal, triangle_normal);
-    s.extent = select(on_sphere, sphere_extent, triangle_extent);
-    s.material = select(on_sphere, sphere_material, triangle_material);
     return s;
 }
 
-// ---- specular exits, lane by lane (path_tracer.h's bounce_step, triangle.h's step_off_edges)
-// A specular lane's next origin also steps off the edges of the triangle it hit; a sphere
-// lane's step is zero, as the scalar code adds none.
+// ---- specular exits, lane by lane (path_tracer.h's bounce_step, step_off_hit_edges)
+// A specular lane's next origin also steps off the edges of the triangle, quad or rectangle it
+// hit; a sphere lane's step is zero, as the scalar code adds none.
 template <class F>
 inline Vec3xN<F> cross_lanes(const Vec3xN<F>& a, const Vec3xN<F>& b) {  // cross (vec3.h)
     return {a.y * b.z - a.z * b.y, a.z * b.x - a.x * b.z, a.x * b.y - a.y * b.x};
@@ -270,27 +355,79 @@ inline void step_off_edge(const Vec3xN<F>& normal, const Vec3xN<F>& from, const 
     const auto near = not_greater_equal(depth, margin * inward_length);
     step = select(near, step + inward * (margin / inward_length), step);
 }
+// The vertices of the primitives that `lanes` hit, gathered: a Triangle's or a ConvexQuad's.
+template <class F, class T>
+inline Vec3xN<F> gather_vertex(const T& first, const Vec3& v, const HitPacket<F>& hit,
+                               MaskOf<F> lanes) {
+    constexpr int kT = stride_of<T>();
+    const int offset = static_cast<int>(&v.x - reinterpret_cast<const float*>(&first));
+    const float* base = reinterpret_cast<const float*>(&first) + offset;
+    return {gather(base[0], kT, hit.index, lanes), gather(base[1], kT, hit.index, lanes),
+            gather(base[2], kT, hit.index, lanes)};
+}
 template <class F>
 inline Vec3xN<F> specular_edge_step(const SceneView& scene, const HitPacket<F>& hit,
                                     const SurfacePacket<F>& surface, MaskOf<F> specular) {
-    const auto on_triangle = and_not(specular, hit.triangle == -1);
+    using I = IntOf<F>;
     Vec3xN<F> step(Vec3(0.0f));
-    if (none(on_triangle)) return step;
-    constexpr int kT = stride_of<Triangle>();
-    const Triangle& t0 = scene.triangles[0];
-    const auto vertex = [&](const Vec3& v) {
-        return Vec3xN<F>(gather(v.x, kT, hit.triangle, on_triangle),
-                         gather(v.y, kT, hit.triangle, on_triangle),
-                         gather(v.z, kT, hit.triangle, on_triangle));
-    };
-    const Vec3xN<F> v0 = vertex(t0.v0), v1 = vertex(t0.v1), v2 = vertex(t0.v2);
+    const auto on_triangle = specular & hit.on(PrimitiveKind::Triangle);
+    const auto on_quad = specular & hit.on(PrimitiveKind::Quad);
+    const auto on_rect = specular & hit.on(PrimitiveKind::Rect);
+    if (none(on_triangle | on_quad | on_rect)) return step;
     // ray_offset (ray.h), lane by lane
     const F margin =
         (max_component(abs(surface.position)) + hit.t + surface.extent) * F(1.0f / (1 << 20));
-    step_off_edge(surface.normal, v0, v1, surface.position, margin, step);
-    step_off_edge(surface.normal, v1, v2, surface.position, margin, step);
-    step_off_edge(surface.normal, v2, v0, surface.position, margin, step);
-    return select(on_triangle, step, Vec3xN<F>(Vec3(0.0f)));
+    if (any(on_triangle)) {
+        const Triangle& t0 = scene.triangles[0];
+        const Vec3xN<F> v0 = gather_vertex(t0, t0.v0, hit, on_triangle);
+        const Vec3xN<F> v1 = gather_vertex(t0, t0.v1, hit, on_triangle);
+        const Vec3xN<F> v2 = gather_vertex(t0, t0.v2, hit, on_triangle);
+        Vec3xN<F> s(Vec3(0.0f));
+        step_off_edge(surface.normal, v0, v1, surface.position, margin, s);
+        step_off_edge(surface.normal, v1, v2, surface.position, margin, s);
+        step_off_edge(surface.normal, v2, v0, surface.position, margin, s);
+        step = select(on_triangle, s, step);
+    }
+    if (any(on_quad)) {
+        const ConvexQuad& q0 = scene.quads[0];
+        const Vec3xN<F> v0 = gather_vertex(q0, q0.v0, hit, on_quad);
+        const Vec3xN<F> v1 = gather_vertex(q0, q0.v1, hit, on_quad);
+        const Vec3xN<F> v2 = gather_vertex(q0, q0.v2, hit, on_quad);
+        const Vec3xN<F> v3 = gather_vertex(q0, q0.v3, hit, on_quad);
+        Vec3xN<F> s(Vec3(0.0f));
+        step_off_edge(surface.normal, v0, v1, surface.position, margin, s);
+        step_off_edge(surface.normal, v1, v2, surface.position, margin, s);
+        step_off_edge(surface.normal, v2, v3, surface.position, margin, s);
+        step_off_edge(surface.normal, v3, v0, surface.position, margin, s);
+        step = select(on_quad, s, step);
+    }
+    if (any(on_rect)) {  // step_off_edges (axis_rect.h), lane by lane
+        constexpr int kR = stride_of<AxisRect>();
+        const AxisRect& r0 = scene.rects[0];
+        const I axis = gather(r0.axis_side, kR, hit.index, on_rect) & 3;
+        const Vec3xN<F>& p = surface.position;
+        const F p_u = select(axis == 0, p.y, p.x);  // rect_axis_u, rect_axis_v
+        const F p_w = select(axis == 2, p.y, p.z);
+        const F lo_u = gather(r0.lo_u, kR, hit.index, on_rect);
+        const F hi_u = gather(r0.hi_u, kR, hit.index, on_rect);
+        const F lo_w = gather(r0.lo_v, kR, hit.index, on_rect);
+        const F hi_w = gather(r0.hi_v, kR, hit.index, on_rect);
+        F step_u(0.0f), step_w(0.0f);
+        step_u = select(not_greater_equal(p_u - lo_u, margin), step_u + margin, step_u);
+        step_u = select(not_greater_equal(hi_u - p_u, margin), step_u - margin, step_u);
+        step_w = select(not_greater_equal(p_w - lo_w, margin), step_w + margin, step_w);
+        step_w = select(not_greater_equal(hi_w - p_w, margin), step_w - margin, step_w);
+        // along_axis(u, step_u) + along_axis(w, step_w): u is y for axis x, else x; w is y for
+        // axis z, else z.
+        const F zero(0.0f);
+        const I u = select(axis == 0, I(1), I(0));
+        const I w = select(axis == 2, I(1), I(2));
+        const Vec3xN<F> s(select(u == 0, step_u, zero) + select(w == 0, step_w, zero),
+                          select(u == 1, step_u, zero) + select(w == 1, step_w, zero),
+                          select(u == 2, step_u, zero) + select(w == 2, step_w, zero));
+        step = select(on_rect, s, step);
+    }
+    return step;
 }
 
 // PathState (path_tracer.h) for the paths of a packet. All lanes are at the same bounce:
