@@ -80,6 +80,21 @@ def test_speed_target_verdicts(nvcc):
     assert p.returncode == 0 and "every case holds" in p.stdout, p.stdout + p.stderr
 
 
+def test_kernel_choice_on_the_host(nvcc, tmp_path):
+    """Which of lab05-ref's kernels a scene gets (its memory, material and primitive sets),
+    the constant bank's limit, the scene's rectangles as quads or everything as triangles
+    (the same surface, to the last bit of the distance) and RT_LAB05_GEOMETRY's values:
+    tests/cuda/lab05_kernel_choice_check.cu, host code, no GPU."""
+    binary = tmp_path / "check"
+    p = subprocess.run(["nvcc", "-std=c++17", "-arch=sm_90", "-Xcompiler", "-Wall,-Werror",
+                        "-Werror", "all-warnings", "-Icommon/cuda", "-Icommon/core",
+                        "-Icommon/host", "tests/cuda/lab05_kernel_choice_check.cu", "-o",
+                        str(binary)], cwd=ROOT, capture_output=True, text=True, timeout=600)
+    assert p.returncode == 0, p.stderr
+    p = subprocess.run([str(binary)], capture_output=True, text=True, timeout=60)
+    assert p.returncode == 0 and "every case holds" in p.stdout, p.stdout + p.stderr
+
+
 def test_skeleton_in_sync():
     """The committed skeleton is exactly what tools/skeletons.py makes from the solution."""
     from grading.variants import pristine_skeleton_sources
