@@ -6,10 +6,12 @@
 // It is exact: per lane the arithmetic is the scalar code's, so every distance and every hit
 // is lab 01's and the image is lab 01's, bit for bit. And it gains little (./lab02-prims
 // measures it): only closest_hit and occluded are vectorised, about two thirds of lab 01's
-// time; and even those gain little in a scene of 11 primitives, where a packet runs the full
-// test whenever any of its 8 triangles passes the plane cull (the scalar loop rejects most
-// triangles after the cull alone), 6 of 16 triangle lanes and 7 of 8 sphere lanes are
-// padding, and each packet ends in a horizontal minimum. Part B's packet tracer
+// time; and even those gain little in a scene of 6 primitives (the Cornell box's 5
+// rectangles and a sphere), where 3 of 8 rectangle lanes and 7 of 8 sphere lanes are padding,
+// each lane picks the ray's components for its own axis with selects, and each packet ends in
+// a horizontal minimum (with triangles, a packet also runs the full test whenever any of its 8
+// passes the plane cull, where the scalar loop rejects most after the cull alone). Convex
+// quads, which no shipped scene has, are tested one at a time. Part B's packet tracer
 // (packet_tracer.h) vectorises the whole path instead, 8 rays per instruction.
 #pragma once
 

@@ -6,8 +6,8 @@ scalar: every TODO falls back to scalar code, and the run's summary says so.
 Part B: one path per SIMD lane. ./lab02-ref-avx2 is what students write, finished: 8 paths per
 AVX2 packet. ./lab02-ref runs at the width the CPU has (16 AVX-512 lanes, else 8 of AVX2) with
 compacted packets (survivors repacked after every bounce); ./lab02-bench runs any width and
-method (RT_SIMD_LANES, RT_SIMD_COMPACT). The skeleton tests triangles in lane 0 only, so 7 of
-every 8 samples miss every wall: a dark, wrong image.
+method (RT_SIMD_LANES, RT_SIMD_COMPACT). The skeleton tests rectangles, triangles and quads in
+lane 0 only, so 7 of every 8 samples miss every wall: a dark, wrong image.
 The skeleton tests build the pristine skeleton (as generated from the solution), not the
 student's copy, so `make test` stays green while students fill theirs in.
 
