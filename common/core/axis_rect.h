@@ -131,6 +131,7 @@ RT_HD inline real canonical_edge(real to_i, real d_i, real to_j, real d_j) {
 // its edge function bit for bit and read its sign oppositely, so a ray through the edge
 // passes the test of at least one (both on the line). A ray parallel to the plane misses, and
 // NaN fails every test. Returns the distance in (0, t_max), or t_max for a miss.
+template <bool kConverged = kConvergedTests>  // rt_hd.h
 RT_HD inline real intersect_rect(const Ray& ray, const AxisRect& r, real t_max) {
     const int a = rect_axis(r);
     const int u = rect_axis_u(a), w = rect_axis_v(a);
@@ -138,7 +139,7 @@ RT_HD inline real intersect_rect(const Ray& ray, const AxisRect& r, real t_max) 
     const real to_plane = r.plane - ray.origin[a];
     const real t = to_plane / d_a;
     const bool in_range = (t > 0.0f) & (t < t_max) & (fabs_real(d_a) > 0.0f);  // NaN fails
-    if (!kConvergedTests && !in_range) return t_max;  // on a GPU the final select decides
+    if (!kConverged && !in_range) return t_max;  // on a GPU the final select decides
     const real d_u = ray.direction[u], d_w = ray.direction[w];
     const real o_u = ray.origin[u], o_w = ray.origin[w];
     // u_hit - c = E / d_a when axis a comes before u (E's first term is a's), else -E / d_a.

@@ -121,6 +121,7 @@ RT_HD inline Vec3 step_off_edges(const ConvexQuad& quad, Vec3 p, real margin) {
 // functions have opposite signs (the quad is convex); the distance is then the plane's,
 // num / denom of the cull. Returns the distance in (0, t_max), or t_max for a miss; rays
 // parallel to the plane, quads with no area and NaN miss.
+template <bool kConverged = kConvergedTests>  // rt_hd.h
 RT_HD inline real intersect_quad(const Ray& ray, const RayShear& shear, const ConvexQuad& quad,
                                  real t_max) {
     const real denom = dot(quad.normal, ray.direction);
@@ -128,7 +129,7 @@ RT_HD inline real intersect_quad(const Ray& ray, const RayShear& shear, const Co
     const bool behind = num * denom <= 0.0f;
     const bool beyond = fabs_real(num) >= t_max * real(1.00001f) * fabs_real(denom);
     const bool culled = behind | beyond;
-    if (!kConvergedTests && culled) return t_max;  // on a GPU the cull joins the final select
+    if (!kConverged && culled) return t_max;  // on a GPU the cull joins the final select
 
     const Vec3 a = quad.v0 - ray.origin;
     const Vec3 b = quad.v1 - ray.origin;
@@ -154,7 +155,7 @@ RT_HD inline real intersect_quad(const Ray& ray, const RayShear& shear, const Co
     const bool any_negative = (e01 < 0.0f) | (e12 < 0.0f) | (e23 < 0.0f) | (e30 < 0.0f);
     const bool any_positive = (e01 > 0.0f) | (e12 > 0.0f) | (e23 > 0.0f) | (e30 > 0.0f);
     const bool outside = any_negative & any_positive;  // the ray passes outside an edge
-    if (!kConvergedTests && outside) return t_max;
+    if (!kConverged && outside) return t_max;
 
     const real t = num / denom;
     const bool hit = !(culled | outside) & (t > 0.0f) & (t < t_max);  // NaN fails too

@@ -13,7 +13,9 @@
 // would run that arithmetic anyway for any of its lanes that still needs it, and an early
 // return only splits the warp (its lanes then run the rest of the loop apart and must be
 // joined again): there every lane runs every instruction of the test, and the rejection
-// joins the select that chooses the answer at the end.
+// joins the select that chooses the answer at the end. Each test takes the form as a template
+// argument that defaults to the machine's, so that a CPU can run the GPU's form too: the unit
+// tests check that both return the same bits (tests/unit/test_converged_tests.cpp).
 #if defined(__CUDA_ARCH__)
 constexpr bool kConvergedTests = true;
 #else

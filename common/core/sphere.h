@@ -23,6 +23,7 @@ RT_HD inline real sphere_extent(const Sphere& s) { return max_component(abs(s.ce
 //    ray), not b^2 - c, which loses every digit when the sphere is far away or small;
 //  - the near root is c / q with q = b + sign(b) sqrt(disc), not b - sqrt(disc)
 //    (Haines et al., "Precision Improvements for Ray/Sphere Intersection", Ray Tracing Gems).
+template <bool kConverged = kConvergedTests>  // rt_hd.h
 RT_HD inline real intersect_sphere(const Ray& ray, const Sphere& s, real t_max) {
     const Vec3 f = ray.origin - s.center;
     const real b = -dot(f, ray.direction);  // the ray passes closest to the centre at t = b
@@ -30,7 +31,7 @@ RT_HD inline real intersect_sphere(const Ray& ray, const Sphere& s, real t_max) 
     const real r2 = s.radius * s.radius;
     const real disc = r2 - length_squared(perpendicular);
     const bool meets = disc >= 0.0f;  // false for NaN too
-    if (!kConvergedTests && !meets) return t_max;  // on a GPU the final select decides
+    if (!kConverged && !meets) return t_max;  // on a GPU the final select decides
     // A GPU's miss goes on with the root of 1, whatever it is worth: the root of a negative
     // number, or of 0, would take the slow path of its square root.
     const real q = b + copysign_real(sqrt_real(meets ? disc : real(1)), b);

@@ -144,6 +144,7 @@ RT_HD inline double edge_function_exact(double px, double py, double qx, double 
 // Watertight ray/triangle intersection (Woop, Benthin, Wald, JCGT 2013). Returns the
 // distance in (0, t_max), or t_max for a miss. Rays parallel to the triangle's plane and
 // degenerate triangles give det == 0 and miss; no division happens before that check.
+template <bool kConverged = kConvergedTests>  // rt_hd.h
 RT_HD inline real intersect_triangle(const Ray& ray, const RayShear& shear, const Triangle& tri,
                                      real t_max) {
     // Cheap cull first: skip the triangle when its plane lies behind the ray or clearly beyond
@@ -158,7 +159,7 @@ RT_HD inline real intersect_triangle(const Ray& ray, const RayShear& shear, cons
     const bool behind = num * denom <= 0.0f;
     const bool beyond = fabs_real(num) >= t_max * real(1.00001f) * fabs_real(denom);
     const bool culled = behind | beyond;
-    if (!kConvergedTests && culled) return t_max;
+    if (!kConverged && culled) return t_max;
 
     const Vec3 a = tri.v0 - ray.origin;
     const Vec3 b = tri.v1 - ray.origin;
@@ -179,7 +180,7 @@ RT_HD inline real intersect_triangle(const Ray& ray, const RayShear& shear, cons
     const bool any_negative = (u < 0.0f) | (v < 0.0f) | (w < 0.0f);
     const bool any_positive = (u > 0.0f) | (v > 0.0f) | (w > 0.0f);
     const bool outside = any_negative & any_positive;  // the ray passes outside an edge
-    if (!kConvergedTests && outside) return t_max;
+    if (!kConverged && outside) return t_max;
 
     const real det = u + v + w;  // 0 for a parallel ray or a degenerate triangle: a miss
     const real t_scaled = u * (shear.sz * az) + v * (shear.sz * bz) + w * (shear.sz * cz);
