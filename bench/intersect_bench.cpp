@@ -116,8 +116,7 @@ void BM_intersect_rect(benchmark::State& state) {
     const std::vector<Ray> rays = sample_rays(4096);
     size_t i = 0;
     for (auto _ : state) {
-        benchmark::DoNotOptimize(
-            intersect_rect(rays[i & 4095], rects[i % rects.size()], 1e30f));
+        benchmark::DoNotOptimize(intersect_rect(rays[i & 4095], rects[i % rects.size()], 1e30f));
         ++i;
     }
     state.SetItemsProcessed(state.iterations());

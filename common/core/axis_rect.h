@@ -25,8 +25,7 @@ RT_HD inline int rect_axis_v(int axis) { return axis == 2 ? 1 : 2; }
 
 // The vector with `value` on `axis` and zero elsewhere (no indexed store: a GPU would spill).
 RT_HD inline Vec3 along_axis(int axis, real value) {
-    return {axis == 0 ? value : real(0), axis == 1 ? value : real(0),
-            axis == 2 ? value : real(0)};
+    return {axis == 0 ? value : real(0), axis == 1 ? value : real(0), axis == 2 ? value : real(0)};
 }
 
 // Unit geometric normal: toward the front, as a triangle's of the same winding.

@@ -90,8 +90,7 @@ inline bool is_planar_convex_quad(const Vec3 (&v)[4]) {
     mean /= 4.0;
     const double tolerance = 4.0 * kRealEpsilon * extent;
     for (const auto& q : p) {
-        if (!(std::fabs(n[0] * q[0] + n[1] * q[1] + n[2] * q[2] - mean) <= tolerance))
-            return false;
+        if (!(std::fabs(n[0] * q[0] + n[1] * q[1] + n[2] * q[2] - mean) <= tolerance)) return false;
     }
     for (int k = 0; k < 4; ++k) {  // the turn at vertex k+1, against the normal
         double e1[3], e2[3], turn[3];

@@ -26,9 +26,11 @@
 #include <scene_view.h>
 
 // The nearest surface a ray meets: which primitive and how far.
+// A hit is a kind and an index, not an index per kind: 12 bytes for any number of kinds, and a
+// wavefront packs it into 8 (packed_hit.cuh).
 struct Hit {
-    real t = kRealMax;                         // distance along the ray; kRealMax (real.h) when
-    PrimitiveKind kind = PrimitiveKind::None;  // nothing was hit, and then kind is None
+    real t = kRealMax;                         // distance along the ray; kRealMax (real.h)
+    PrimitiveKind kind = PrimitiveKind::None;  // when nothing was hit, and then kind is None
     int index = -1;  // the primitive's index in its kind's array (scene_view.h)
 
     RT_HD bool found() const { return kind != PrimitiveKind::None; }
@@ -158,8 +160,7 @@ RT_HD inline bool occluded(const SceneView& scene, const Ray& ray, real t_max) {
 // A specular path's step off the edges of the primitive it hit (step_off_edges, triangle.h,
 // convex_quad.h, axis_rect.h); zero on a sphere, which has none.
 template <class Primitives = AnyGeometry>
-RT_HD inline Vec3 step_off_hit_edges(const SceneView& scene, const Hit& hit, Vec3 p,
-                                     real margin) {
+RT_HD inline Vec3 step_off_hit_edges(const SceneView& scene, const Hit& hit, Vec3 p, real margin) {
     if (Primitives::kTriangles && hit.kind == PrimitiveKind::Triangle)
         return step_off_edges(scene.triangles[hit.index], p, margin);
     if (Primitives::kQuads && hit.kind == PrimitiveKind::Quad)
@@ -356,8 +357,7 @@ RT_HD inline Vec3 direct_light(const SceneView& scene, const Geometry& geometry,
                                Vec3 origin, Vec3 facing_normal, Vec3 albedo) {
     ShadowRay shadow;
     if (!sample_light(scene, position, origin, facing_normal, albedo, shadow)) return Vec3(0.0f);
-    return occluded<Primitives>(geometry, shadow.ray, shadow.t_max) ? Vec3(0.0f)
-                                                                    : shadow.radiance;
+    return occluded<Primitives>(geometry, shadow.ray, shadow.t_max) ? Vec3(0.0f) : shadow.radiance;
 }
 
 // The estimate of one pixel: the mean of spp paths through uniformly jittered points of the

@@ -169,7 +169,8 @@ Scene centre_scene(Scene scene) {
     for (size_t i = 0; i < scene.rects.size(); ++i) {
         const WrittenPoint* v = &moved.rect_vertices[4 * i];
         const Vec3 corners[4] = {rounded(v[0]), rounded(v[1]), rounded(v[2]), rounded(v[3])};
-        scene.rects[i] = make_axis_rect(corners, rect_axis(scene.rects[i]), scene.rects[i].material);
+        scene.rects[i] =
+            make_axis_rect(corners, rect_axis(scene.rects[i]), scene.rects[i].material);
     }
     scene.camera.position = rounded(camera_position);
     scene.camera.look_at = rounded(camera_look_at);

@@ -23,10 +23,9 @@ double longest_edge(const Triangle& t) {
 }
 
 double longest_edge(const ConvexQuad& q) {
-    return std::max({static_cast<double>(length(q.v1 - q.v0)),
-                     static_cast<double>(length(q.v2 - q.v1)),
-                     static_cast<double>(length(q.v3 - q.v2)),
-                     static_cast<double>(length(q.v0 - q.v3))});
+    return std::max(
+        {static_cast<double>(length(q.v1 - q.v0)), static_cast<double>(length(q.v2 - q.v1)),
+         static_cast<double>(length(q.v3 - q.v2)), static_cast<double>(length(q.v0 - q.v3))});
 }
 
 double longest_edge(const AxisRect& r) {
@@ -87,10 +86,11 @@ std::string describe(const SceneUse& use) {
     count(use.triangles, "triangle", "triangles");
     count(use.quads, "convex quad", "convex quads");
     count(use.rects, "rectangle", "rectangles");
-    std::string line = "scene: " + (primitives.empty() ? std::string("no primitives") : primitives) +
-                       "; materials: " + (materials.empty() ? "none" : materials) + "; " +
-                       (use.light ? "a point light" : "no light") + "; " +
-                       (use.background ? "a background" : "a black background");
+    std::string line =
+        "scene: " + (primitives.empty() ? std::string("no primitives") : primitives) +
+        "; materials: " + (materials.empty() ? "none" : materials) + "; " +
+        (use.light ? "a point light" : "no light") + "; " +
+        (use.background ? "a background" : "a black background");
     if (use.smallest > 0) {
         line += "; sizes from " + number(use.smallest) + " within coordinates up to " +
                 number(use.extent) + " (1 : " + number(use.extent / use.smallest) + ")";

@@ -17,8 +17,8 @@ struct SceneUse {
     int diffuse = 0, mirrors = 0, glass = 0;  // the material table's entries by kind
     bool light = false;
     bool background = false;  // a background that is not black
-    double smallest = 0;      // the smallest radius or longest edge (0: no primitive)
-    double extent = 0;        // the largest |coordinate| of any primitive, after centring
+    double smallest = 0;  // the smallest radius or longest edge (0: no primitive)
+    double extent = 0;  // the largest |coordinate| of any primitive, after centring
 };
 
 // A detail is resolved while it spans at least this many ray offsets of a ray that crossed
@@ -27,6 +27,6 @@ struct SceneUse {
 constexpr double kResolvedDetail = 1.0 / (1 << 14);
 
 SceneUse scene_use(const Scene& scene);
-std::string describe(const SceneUse& use);       // one line
+std::string describe(const SceneUse& use);  // one line
 std::string scale_warning(const SceneUse& use);  // one line with what to do, or ""
-std::string to_json(const SceneUse& use);        // an object for --json
+std::string to_json(const SceneUse& use);  // an object for --json

@@ -10,9 +10,8 @@
 // (labs/02-simd/lab.mk); compacted_tracer.h runs the same bounce step on packets it refills.
 //
 // The scene stays as loaded (arrays of spheres, triangles, quads, rectangles and materials):
-// each primitive is
-// broadcast to all lanes and tested against all rays at once, and shading fetches per-lane
-// data with gathers. The structure of arrays is the packet: Vec3xN keeps the rays' x in one
+// each primitive is broadcast to all lanes and tested against all rays at once, and shading
+// fetches per-lane data with gathers. The structure of arrays is the packet: Vec3xN keeps the rays' x in one
 // register, their y in another, their z in a third.
 //
 // Per lane the arithmetic is lab 01's, operation for operation (sin and cos included: both
@@ -52,8 +51,8 @@ inline F component(const Vec3xN<F>& v, IntOf<F> k) {
 template <class F>
 struct RayShearN {
     IntOf<F> kx, ky, kz;  // permuted axes, per lane
-    F sx, sy, sz;         // shear constants, per lane
-    Vec3xN<F> origin_k;   // the ray origins permuted: (origin[kx], origin[ky], origin[kz])
+    F sx, sy, sz;  // shear constants, per lane
+    Vec3xN<F> origin_k;  // the ray origins permuted: (origin[kx], origin[ky], origin[kz])
 
     explicit RayShearN(const RayPacket<F>& ray) {
         using I = IntOf<F>;
@@ -259,7 +258,8 @@ RT_PACKET_INLINE F intersect_rect(const RayPacket<F>& ray, const AxisRect& r, F 
     const F sign_w = a < w ? sign_a : -sign_a;
     // canonical_edge (axis_rect.h): the lower axis first, two rounded products, never fused.
     const auto edge = [&](int other, F to_other, const F& d_other) {
-        return a < other ? to_plane * d_other - to_other * d_a : to_other * d_a - to_plane * d_other;
+        return a < other ? to_plane * d_other - to_other * d_a
+                         : to_other * d_a - to_plane * d_other;
     };
     const F lo_u = edge(u, F(r.lo_u) - o_u, d_u) * sign_u;
     const F hi_u = edge(u, F(r.hi_u) - o_u, d_u) * sign_u;
@@ -283,7 +283,7 @@ RT_PACKET_INLINE F intersect_rect(const RayPacket<F>& ray, const AxisRect& r, F 
 template <class F>
 struct HitPacket {
     F t;  // distance; t_max where nothing was hit
-    IntOf<F> kind;   // PrimitiveKind of the primitive hit, as an int (0: nothing)
+    IntOf<F> kind;  // PrimitiveKind of the primitive hit, as an int (0: nothing)
     IntOf<F> index;  // its index in its kind's array
 
     MaskOf<F> found() const { return ~(kind == 0); }
@@ -426,7 +426,8 @@ inline SurfacePacket<F> surface_at(const SceneView& scene, const RayPacket<F>& r
         take(on_rect,
              {select(axis == 0, side, zero), select(axis == 1, side, zero),
               select(axis == 2, side, zero)},
-             gather(r0.extent, kR, hit.index, on_rect), gather(r0.material, kR, hit.index, on_rect));
+             gather(r0.extent, kR, hit.index, on_rect),
+             gather(r0.material, kR, hit.index, on_rect));
     }
     return s;
 }

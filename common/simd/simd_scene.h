@@ -111,10 +111,14 @@ public:
     }
 
     SimdSceneView view() const {
-        return {triangles_.data(), static_cast<int>(triangles_.size()),
-                spheres_.data(),   static_cast<int>(spheres_.size()),
-                rects_.data(),     static_cast<int>(rects_.size()),
-                quads_,            num_quads_};
+        return {triangles_.data(),
+                static_cast<int>(triangles_.size()),
+                spheres_.data(),
+                static_cast<int>(spheres_.size()),
+                rects_.data(),
+                static_cast<int>(rects_.size()),
+                quads_,
+                num_quads_};
     }
 
 private:

@@ -63,10 +63,10 @@ TEST(DoubleBuild, SharedEdgeStaysWatertight) {
 // quads' edge functions take the double fallback, the rectangles' canonical ones are doubles.
 TEST(DoubleBuild, SharedEdgesOfQuadsAndRectanglesStayWatertight) {
     const double e = 0.5 + 1e-12;  // the shared edge x = e, which float would move
-    const ConvexQuad left = make_convex_quad(Vec3(0, 0, 0), Vec3(e, 0, 0), Vec3(e, 1, 0),
-                                             Vec3(0, 1, 0), 0);
-    const ConvexQuad right = make_convex_quad(Vec3(e, 0, 0), Vec3(1, 0, 0), Vec3(1, 1, 0),
-                                              Vec3(e, 1, 0), 0);
+    const ConvexQuad left =
+        make_convex_quad(Vec3(0, 0, 0), Vec3(e, 0, 0), Vec3(e, 1, 0), Vec3(0, 1, 0), 0);
+    const ConvexQuad right =
+        make_convex_quad(Vec3(e, 0, 0), Vec3(1, 0, 0), Vec3(1, 1, 0), Vec3(e, 1, 0), 0);
     const Vec3 l[4] = {Vec3(0, 0, 0), Vec3(e, 0, 0), Vec3(e, 1, 0), Vec3(0, 1, 0)};
     const Vec3 r[4] = {Vec3(e, 0, 0), Vec3(1, 0, 0), Vec3(1, 1, 0), Vec3(e, 1, 0)};
     ASSERT_EQ(axis_rect_axis(l), 2);

@@ -131,7 +131,8 @@ TEST(AxisRect, BoxEdgesAndCornersAreWatertight) {
             const Vec3 lo = (offset + Vec3(-0.3f, -0.7f, -1.1f)) * scale;
             const Vec3 hi = (offset + Vec3(0.9f, 0.6f, 0.2f)) * scale;
             std::vector<AxisRect> walls;
-            for (const auto& f : box_faces(lo, hi)) walls.push_back(rect_of(f[0], f[1], f[2], f[3]));
+            for (const auto& f : box_faces(lo, hi))
+                walls.push_back(rect_of(f[0], f[1], f[2], f[3]));
             const auto corner = [&](int k) {
                 return Vec3(k & 1 ? hi.x : lo.x, k & 2 ? hi.y : lo.y, k & 4 ? hi.z : lo.z);
             };
@@ -143,14 +144,15 @@ TEST(AxisRect, BoxEdgesAndCornersAreWatertight) {
                 if (i % 3 != 0) {  // a point of an edge from this corner
                     const int axis = i / 8 % 3;
                     Vec3 other = target;
-                    other = axis == 0 ? Vec3(target.x == lo.x ? hi.x : lo.x, target.y, target.z)
-                          : axis == 1 ? Vec3(target.x, target.y == lo.y ? hi.y : lo.y, target.z)
-                                      : Vec3(target.x, target.y, target.z == lo.z ? hi.z : lo.z);
+                    other = axis == 0   ? Vec3(target.x == lo.x ? hi.x : lo.x, target.y, target.z)
+                            : axis == 1 ? Vec3(target.x, target.y == lo.y ? hi.y : lo.y, target.z)
+                                        : Vec3(target.x, target.y, target.z == lo.z ? hi.z : lo.z);
                     // Moving along one axis keeps the other two coordinates exactly.
                     const float f = s(gen);
-                    target = axis == 0 ? Vec3(target.x + (other.x - target.x) * f, target.y, target.z)
-                           : axis == 1 ? Vec3(target.x, target.y + (other.y - target.y) * f, target.z)
-                                       : Vec3(target.x, target.y, target.z + (other.z - target.z) * f);
+                    target =
+                        axis == 0   ? Vec3(target.x + (other.x - target.x) * f, target.y, target.z)
+                        : axis == 1 ? Vec3(target.x, target.y + (other.y - target.y) * f, target.z)
+                                    : Vec3(target.x, target.y, target.z + (other.z - target.z) * f);
                 }
                 const Ray ray{inside, normalize(target - inside)};
                 bool any = false;
@@ -166,14 +168,15 @@ TEST(AxisRect, CoplanarNeighboursAreWatertight) {
     std::mt19937 gen(21);
     std::uniform_real_distribution<float> u(-1.0f, 1.0f), s(0.0f, 1.0f);
     // A floor y = 0.25 split at x = 0.3 into two, and a third piece meeting both at z = -0.7.
-    const AxisRect left = rect_of({-1, 0.25f, 0}, {0.3f, 0.25f, 0}, {0.3f, 0.25f, -0.7f},
-                                  {-1, 0.25f, -0.7f});
-    const AxisRect right = rect_of({0.3f, 0.25f, 0}, {1, 0.25f, 0}, {1, 0.25f, -0.7f},
-                                   {0.3f, 0.25f, -0.7f});
-    const AxisRect back = rect_of({-1, 0.25f, -0.7f}, {1, 0.25f, -0.7f}, {1, 0.25f, -2},
-                                  {-1, 0.25f, -2});
+    const AxisRect left =
+        rect_of({-1, 0.25f, 0}, {0.3f, 0.25f, 0}, {0.3f, 0.25f, -0.7f}, {-1, 0.25f, -0.7f});
+    const AxisRect right =
+        rect_of({0.3f, 0.25f, 0}, {1, 0.25f, 0}, {1, 0.25f, -0.7f}, {0.3f, 0.25f, -0.7f});
+    const AxisRect back =
+        rect_of({-1, 0.25f, -0.7f}, {1, 0.25f, -0.7f}, {1, 0.25f, -2}, {-1, 0.25f, -2});
     for (int i = 0; i < 40000; ++i) {
-        Vec3 target = i % 2 ? Vec3(0.3f, 0.25f, -0.7f * s(gen)) : Vec3(2 * s(gen) - 1, 0.25f, -0.7f);
+        Vec3 target =
+            i % 2 ? Vec3(0.3f, 0.25f, -0.7f * s(gen)) : Vec3(2 * s(gen) - 1, 0.25f, -0.7f);
         if (i % 7 == 0) target = Vec3(0.3f, 0.25f, -0.7f);  // where all three meet
         const Vec3 origin = target + Vec3(u(gen), (0.2f + s(gen)) * (i % 4 < 2 ? 1 : -1), u(gen));
         const Ray ray{origin, normalize(target - origin)};
@@ -190,10 +193,10 @@ TEST(AxisRect, ParallelRaysAndNaNMiss) {
     EXPECT_EQ(hit({{0.5f, 0.5f, 0}, {1, 0, 0}}, r), FLT_MAX);  // in the plane, parallel
     EXPECT_EQ(hit({{0.5f, 0.5f, 0}, {-0.0f, 0.6f, 0.8f * 0}}, r), FLT_MAX);
     EXPECT_EQ(hit({{0.5f, 0.5f, 1}, {1, 0, 0}}, r), FLT_MAX);
-    EXPECT_EQ(hit({{0.5f, 0.5f, 1}, {0, 0, 1}}, r), FLT_MAX);      // pointing away
+    EXPECT_EQ(hit({{0.5f, 0.5f, 1}, {0, 0, 1}}, r), FLT_MAX);  // pointing away
     EXPECT_EQ(hit({{0.5f, 0.5f, 1}, {0, 0, -1}}, r, 1.0f), 1.0f);  // not before t_max
-    EXPECT_EQ(hit({{1.5f, 0.5f, 1}, {0, 0, -1}}, r), FLT_MAX);     // beside it
-    EXPECT_EQ(hit({{1.0f, 1.0f, 1}, {0, 0, -1}}, r), 1.0f);        // its corner
+    EXPECT_EQ(hit({{1.5f, 0.5f, 1}, {0, 0, -1}}, r), FLT_MAX);  // beside it
+    EXPECT_EQ(hit({{1.0f, 1.0f, 1}, {0, 0, -1}}, r), 1.0f);  // its corner
     const float nan = std::nanf(""), inf = INFINITY;
     EXPECT_EQ(hit({{nan, 0.5f, 1}, {0, 0, -1}}, r), FLT_MAX);
     EXPECT_EQ(hit({{0.5f, 0.5f, nan}, {0, 0, -1}}, r), FLT_MAX);

@@ -127,8 +127,8 @@ TEST(ConvexQuad, RaysThroughAnEdgeSharedWithATriangleNeverMissBoth) {
         if (!in_front_of_both(origin, q.p[1], q.first.normal, t.normal, 0.2f)) continue;
         const Ray ray{origin, normalize(target - origin)};
         ++tested;
-        const bool either = hit(ray, q.first) < FLT_MAX || hit(ray, t) < FLT_MAX ||
-                            hit(ray, t_other) < FLT_MAX;
+        const bool either =
+            hit(ray, q.first) < FLT_MAX || hit(ray, t) < FLT_MAX || hit(ray, t_other) < FLT_MAX;
         ASSERT_TRUE(either) << "ray " << i;
     }
     EXPECT_GT(tested, 8000);
@@ -166,8 +166,8 @@ TEST(ConvexQuad, WatertightAroundASharedVertex) {
         int k = 0;
         for (int i = -1; i <= 0; ++i) {
             for (int j = -1; j <= 0; ++j)
-                quads[k++] = make_convex_quad(at(i, j), at(i + 1, j), at(i + 1, j + 1),
-                                              at(i, j + 1), 0);
+                quads[k++] =
+                    make_convex_quad(at(i, j), at(i + 1, j), at(i + 1, j + 1), at(i, j + 1), 0);
         }
         const Vec3 n = quads[0].normal;
         const Vec3 spokes[4] = {at(1, 0), at(0, 1), at(-1, 0), at(0, -1)};
@@ -175,7 +175,8 @@ TEST(ConvexQuad, WatertightAroundASharedVertex) {
             const Vec3 target =
                 i % 2 ? centre : on_segment(centre, spokes[i / 2 % 4], 0.9f * s(gen));
             const Vec3 origin = centre + (n * ((0.5f + s(gen)) * (i % 4 < 2 ? 1.0f : -1.0f)) +
-                                          Vec3(u(gen), u(gen), u(gen))) * scale;
+                                          Vec3(u(gen), u(gen), u(gen))) *
+                                             scale;
             const Ray ray{origin, normalize(target - origin)};
             bool any = false;
             for (const ConvexQuad& q : quads) any = any || hit(ray, q) < FLT_MAX;

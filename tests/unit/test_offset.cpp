@@ -11,36 +11,54 @@
 
 namespace {
 
+enum Kind { kTriangle, kSphere, kQuad, kRect };
+
 struct Surface {
     Triangle triangle{};
     Sphere sphere{};
-    bool is_sphere = false;
+    ConvexQuad quad{};
+    AxisRect rect{};
+    Kind kind = kTriangle;
 };
 
 float hit(const Surface& s, const Ray& ray) {
-    return s.is_sphere ? intersect_sphere(ray, s.sphere, FLT_MAX)
-                       : intersect_triangle(ray, RayShear(ray.direction), s.triangle, FLT_MAX);
+    switch (s.kind) {
+        case kSphere: return intersect_sphere(ray, s.sphere, FLT_MAX);
+        case kQuad: return intersect_quad(ray, RayShear(ray.direction), s.quad, FLT_MAX);
+        case kRect: return intersect_rect(ray, s.rect, FLT_MAX);
+        default: return intersect_triangle(ray, RayShear(ray.direction), s.triangle, FLT_MAX);
+    }
 }
 
-// Rays through a camera a few units from a huge surface (a triangle of half-size `half` or a
-// sphere of radius `half`, tilted at random, placed near `where`) hit it, then leave it from
+// Rays through a camera a few units from a huge surface (a triangle, convex quad or
+// axis-aligned rectangle of half-size `half` or a sphere of radius `half`, tilted at random
+// but the rectangle, placed near `where`) hit it, then leave it from
 // the offset point in random directions of the hemisphere, a third of them grazing. Returns
 // how many of those hit the surface they left.
-int self_hits(float half, Vec3 where, bool sphere, std::mt19937& gen, int surfaces = 40) {
+int self_hits(float half, Vec3 where, Kind kind, std::mt19937& gen, int surfaces = 40) {
+    const bool sphere = kind == kSphere;
     std::uniform_real_distribution<float> u(0.0f, 1.0f);
     int hits = 0;
     for (int k = 0; k < surfaces; ++k) {
         Vec3 n = normalize(Vec3(u(gen) - 0.5f, u(gen) - 0.5f, u(gen) - 0.5f));
-        if (k % 4 == 0) n = Vec3(0, 1, 0);  // axis-aligned floors too
+        if (k % 4 == 0 || kind == kRect) n = Vec3(0, 1, 0);  // axis-aligned floors too
         Vec3 t, b;
         orthonormal_basis(n, t, b);
+        if (kind == kRect) t = Vec3(1, 0, 0), b = Vec3(0, 0, -1);
         const Vec3 c0 = where + Vec3(u(gen) - 0.5f, u(gen) - 0.5f, u(gen) - 0.5f) * 4.0f;
         Surface s;
-        s.is_sphere = sphere;
+        s.kind = kind;
         s.sphere = {c0 - n * half, half, 0};
         s.triangle =
             make_triangle(c0 - t * half - b * half, c0 + t * half - b * half, c0 + b * half, 0);
-        const float extent = sphere ? sphere_extent(s.sphere) : s.triangle.extent;
+        const Vec3 corners[4] = {c0 - t * half - b * half, c0 + t * half - b * half,
+                                 c0 + t * half + b * half, c0 - t * half + b * half};
+        s.quad = make_convex_quad(corners[0], corners[1], corners[2], corners[3], 0);
+        if (kind == kRect) s.rect = make_axis_rect(corners, 1, 0);
+        const float extent = sphere          ? sphere_extent(s.sphere)
+                             : kind == kQuad ? s.quad.extent
+                             : kind == kRect ? s.rect.extent
+                                             : s.triangle.extent;
         for (int i = 0; i < 100; ++i) {
             const Vec3 camera = c0 + n * (1.0f + 3.0f * u(gen)) + t * ((u(gen) - 0.5f) * 4.0f);
             const Vec3 target = c0 + t * ((u(gen) - 0.5f) * 20.0f) + b * ((u(gen) - 0.5f) * 20.0f);
@@ -48,7 +66,10 @@ int self_hits(float half, Vec3 where, bool sphere, std::mt19937& gen, int surfac
             const float th = hit(s, primary);
             if (th == FLT_MAX) continue;
             const Vec3 p = primary.at(th);
-            const Vec3 normal = sphere ? normalize(p - s.sphere.center) : s.triangle.normal;
+            const Vec3 normal = sphere          ? normalize(p - s.sphere.center)
+                                : kind == kQuad ? s.quad.normal
+                                : kind == kRect ? rect_normal(s.rect)
+                                                : s.triangle.normal;
             const Vec3 facing = dot(primary.direction, normal) < 0.0f ? normal : -normal;
             const Vec3 origin = offset_ray_origin(p, facing, th, extent);
             for (int j = 0; j < 15; ++j) {
@@ -71,7 +92,7 @@ TEST(Offset, NoSelfHitLeavingHugeTriangles) {
     std::mt19937 gen(5);
     for (float half : {1e3f, 1e4f, 1e5f}) {
         for (const Vec3 where : {Vec3(0.0f), Vec3(1e4f, -7e3f, 3e3f)}) {
-            EXPECT_EQ(self_hits(half, where, false, gen), 0)
+            EXPECT_EQ(self_hits(half, where, kTriangle, gen), 0)
                 << "half-size " << half << " at " << where.x;
         }
     }
@@ -81,8 +102,21 @@ TEST(Offset, NoSelfHitLeavingHugeSpheres) {
     std::mt19937 gen(6);
     for (float radius : {1e3f, 1e4f, 1e5f}) {
         for (const Vec3 where : {Vec3(0.0f), Vec3(1e4f, -7e3f, 3e3f)}) {
-            EXPECT_EQ(self_hits(radius, where, true, gen), 0)
+            EXPECT_EQ(self_hits(radius, where, kSphere, gen), 0)
                 << "radius " << radius << " at " << where.x;
+        }
+    }
+}
+
+TEST(Offset, NoSelfHitLeavingHugeQuadsAndRectangles) {
+    std::mt19937 gen(7);
+    for (const Kind kind : {kQuad, kRect}) {
+        for (float half : {1e3f, 1e4f, 1e5f}) {
+            for (const Vec3 where : {Vec3(0.0f), Vec3(1e4f, -7e3f, 3e3f)}) {
+                EXPECT_EQ(self_hits(half, where, kind, gen), 0)
+                    << (kind == kQuad ? "quad" : "rectangle") << " half-size " << half << " at "
+                    << where.x;
+            }
         }
     }
 }

@@ -257,8 +257,8 @@ std::string scene_of(const std::vector<std::string>& quads,
     std::string text = R"({"camera": {"position": [0.5, 0.5, 3], "look_at": [0.5, 0.5, 0]},
         "materials": {"white": {"type": "diffuse", "albedo": [0.5, 0.5, 0.5]}}, "quads": [)";
     for (size_t i = 0; i < quads.size(); ++i)
-        text += (i ? ", " : "") + std::string(R"({"material": "white", "vertices": )") +
-                quads[i] + "}";
+        text +=
+            (i ? ", " : "") + std::string(R"({"material": "white", "vertices": )") + quads[i] + "}";
     text += R"(], "triangles": [)";
     for (size_t i = 0; i < triangles.size(); ++i)
         text += (i ? ", " : "") + std::string(R"({"material": "white", "vertices": )") +
@@ -355,7 +355,7 @@ TEST(SceneLoader, KindsDoNotDependOnWhereTheSceneIs) {
         ASSERT_EQ(centred.rects.size(), 1u);
         Vec3 corners[4];
         rect_corners(centred.rects[0], corners);
-        const Vec3 (&c)[4] = corners;
+        const Vec3(&c)[4] = corners;
         EXPECT_EQ(axis_rect_axis(c), rect_axis(centred.rects[0])) << shift;
         EXPECT_EQ(centred.rects[0].hi_u - centred.rects[0].lo_u, 1.0f) << shift;
     }
