@@ -715,11 +715,13 @@ LARGE_FLOORS = (1e1, 1e3, 1e5)  # floor half-sizes, in units of the camera's hei
 
 def check_large_primitives(binary) -> CheckResult:
     """A floor far larger than the view renders as a small one: a quad of half-size 10 to
-    1e5 and a sphere of radius 1e3 to 1e5, seen from 1 unit above. An offset that scales
-    only with the hit point and not with the primitive's coordinates lets shadow rays hit the
-    floor they leave: the quad of half-size 1e5 rendered 38% too dark."""
+    1e5 (a rectangle), the same floor as two triangles and a sphere of radius 1e3 to 1e5, seen
+    from 1 unit above. An offset that scales only with the hit point and not with the
+    primitive's coordinates lets shadow rays hit the floor they leave: two triangles of
+    half-size 1e5 rendered 38% too dark. (A rectangle's test subtracts no far coordinate.)"""
     worst = (0.0, "")
-    cases = [("quad", h) for h in LARGE_FLOORS] + [("sphere", h) for h in LARGE_FLOORS[1:]]
+    cases = ([("quad", h) for h in LARGE_FLOORS] + [("triangles", h) for h in LARGE_FLOORS[1:]]
+             + [("sphere", h) for h in LARGE_FLOORS[1:]])
     for kind, half in cases:
         err = float(render_floor(binary, scenes.floor_view(half, kind=kind)).mean())
         if err >= worst[0]:

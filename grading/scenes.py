@@ -215,15 +215,19 @@ FLOOR_LIGHT = [0.5, 1.5, -3.0]
 def floor_view(half: float, albedo: float = 0.5, intensity: float = 2.0,
                kind: str = "quad") -> dict:
     """A diffuse floor under a point light, seen from 1 unit above it: a quad of half-size
-    `half` in the plane y = 0, or (kind "sphere") a sphere of radius `half` whose top is the
+    `half` in the plane y = 0 (an axis-aligned rectangle once loaded), the same floor as two
+    triangles (kind "triangles"), or (kind "sphere") a sphere of radius `half` whose top is the
     origin. Only the floor within a few units of the camera matters to the image, so a floor
     of any size should render alike (floor_view_expected, one bounce)."""
     scene = {"camera": dict(FLOOR_CAMERA),
              "light": {"position": list(FLOOR_LIGHT), "intensity": [intensity] * 3},
              "materials": {"floor": {"type": "diffuse", "albedo": [albedo] * 3}}}
+    corners = [[-half, 0, -half], [-half, 0, half], [half, 0, half], [half, 0, -half]]
     if kind == "quad":
-        scene["quads"] = [{"vertices": [[-half, 0, -half], [-half, 0, half], [half, 0, half],
-                                        [half, 0, -half]], "material": "floor"}]
+        scene["quads"] = [{"vertices": corners, "material": "floor"}]
+    elif kind == "triangles":
+        scene["triangles"] = [{"vertices": [corners[a] for a in t], "material": "floor"}
+                              for t in ((0, 1, 2), (0, 2, 3))]
     else:
         scene["spheres"] = [{"center": [0, -half, 0], "radius": half, "material": "floor"}]
     return scene
@@ -262,7 +266,7 @@ def floor_view_expected(scene: dict, width: int, height: int, subsamples: int = 
         p = pos + t[..., None] * d
         normal = (p - centre) / radius
     else:
-        floor_y = scene["quads"][0]["vertices"][0][1]
+        floor_y = (scene.get("quads") or scene["triangles"])[0]["vertices"][0][1]
         t = (floor_y - pos[1]) / np.where(d[..., 1] < 0, d[..., 1], -1.0)
         hit = d[..., 1] < 0
         p = pos + t[..., None] * d
