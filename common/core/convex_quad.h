@@ -128,7 +128,9 @@ RT_HD inline real intersect_quad(const Ray& ray, const RayShear& shear, const Co
     const bool behind = num * denom <= 0.0f;
     const bool beyond = fabs_real(num) >= t_max * real(1.00001f) * fabs_real(denom);
     const bool culled = behind | beyond;
-    if (!kConverged && culled) return t_max;  // on a GPU the cull joins the final select
+    // Converged, the warp skips the rest when every lane's cull rejects the primitive (the
+    // same answer, t_max, on every lane), and runs it on all of them otherwise.
+    if (kConverged ? !any_lane(!culled) : culled) return t_max;
 
     const Vec3 a = quad.v0 - ray.origin;
     const Vec3 b = quad.v1 - ray.origin;

@@ -155,11 +155,14 @@ RT_HD inline real intersect_triangle(const Ray& ray, const RayShear& shear, cons
     const real denom = dot(tri.normal, ray.direction);
     const real num = tri.plane_offset - dot(tri.normal, ray.origin);  // t_plane = num / denom
     // Bitwise | rather than ||: one well-predicted branch instead of several random ones. On
-    // a GPU no branch: the cull joins the final select (kConvergedTests, rt_hd.h).
+    // a GPU the lanes that passed the cull still run the test together with those that did
+    // not, whose cull joins the final select (kConvergedTests, rt_hd.h).
     const bool behind = num * denom <= 0.0f;
     const bool beyond = fabs_real(num) >= t_max * real(1.00001f) * fabs_real(denom);
     const bool culled = behind | beyond;
-    if (!kConverged && culled) return t_max;
+    // Converged, the warp skips the rest when every lane's cull rejects the primitive (the
+    // same answer, t_max, on every lane), and runs it on all of them otherwise.
+    if (kConverged ? !any_lane(!culled) : culled) return t_max;
 
     const Vec3 a = tri.v0 - ray.origin;
     const Vec3 b = tri.v1 - ray.origin;
