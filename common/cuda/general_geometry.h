@@ -30,14 +30,23 @@ public:
             Vec3 v[4];
             rect_corners(scene.rects[i], v);
             quads_.push_back(make_convex_quad(v[0], v[1], v[2], v[3], scene.rects[i].material));
+            // The rectangle's own normal. make_convex_quad's equals it but for the signs of its
+            // zeros (the cross product can give -0), and the sign of a zero component picks
+            // the tangent frame of cosine sampling (sample_cosine_hemisphere): with a -0 every
+            // bounce off that wall would draw other directions from the same random numbers.
+            quads_.back().normal = rect_normal(scene.rects[i]);
         }
         view.rects = nullptr;
         view.num_rects = 0;
         if (form == GeometryForm::Triangles) {
             triangles_.assign(scene.triangles, scene.triangles + scene.num_triangles);
-            for (const ConvexQuad& q : quads_) {
+            for (size_t k = 0; k < quads_.size(); ++k) {
+                const ConvexQuad& q = quads_[k];
                 triangles_.push_back(make_triangle(q.v0, q.v1, q.v2, q.material));
                 triangles_.push_back(make_triangle(q.v0, q.v2, q.v3, q.material));
+                // A rectangle's two triangles: its normal too, as above.
+                if (k >= static_cast<size_t>(scene.num_quads))
+                    triangles_.end()[-2].normal = triangles_.end()[-1].normal = q.normal;
             }
             quads_.clear();
             view.triangles = triangles_.data();
