@@ -145,7 +145,9 @@ RT_HD RT_FORCE_INLINE real rect_test_on_axis(const Ray& ray, const AxisRect& r, 
     const real to_plane = r.plane - ray.origin[a];
     const real t = to_plane / d_a;
     const bool in_range = (t > 0.0f) & (t < t_max) & (fabs_real(d_a) > 0.0f);  // NaN fails
-    if (!kConverged && !in_range) return t_max;  // on a GPU the final select decides
+    // Converged, only when no lane of the warp has the plane in range (a shadow ray inside a
+    // box meets no wall before the light): otherwise the final select decides.
+    if (kConverged ? !any_lane(in_range) : !in_range) return t_max;
     const real d_u = ray.direction[u], d_w = ray.direction[w];
     const real o_u = ray.origin[u], o_w = ray.origin[w];
     // u_hit - c = E / d_a when axis a comes before u (E's first term is a's), else -E / d_a.

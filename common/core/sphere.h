@@ -31,7 +31,9 @@ RT_HD inline real intersect_sphere(const Ray& ray, const Sphere& s, real t_max) 
     const real r2 = s.radius * s.radius;
     const real disc = r2 - length_squared(perpendicular);
     const bool meets = disc >= 0.0f;  // false for NaN too
-    if (!kConverged && !meets) return t_max;  // on a GPU the final select decides
+    // Converged, only when the line misses the sphere on every lane of the warp; otherwise
+    // the final select decides.
+    if (kConverged ? !any_lane(meets) : !meets) return t_max;
     // A GPU's miss goes on with the root of 1, whatever it is worth: the root of a negative
     // number, or of 0, would take the slow path of its square root.
     const real q = b + copysign_real(sqrt_real(meets ? disc : real(1)), b);
