@@ -6,7 +6,9 @@ instructions and the branches inside it other than the loop's own: a `BSSY` (the
 marks where a warp that may split must rejoin) followed by a forward `BRA` is a branch the
 lanes can take differently. Those that only skip a `CALL` to a slow path (of IEEE division or
 square root, taken for extreme operands) are counted apart: the lanes take them together in
-practice. Needs no GPU, only an object or binary and cuobjdump.
+practice. So are those on a predicate that a `VOTE.ANY` or `VOTE.ALL` set (`__any_sync`,
+`__all_sync`: every lane gets the same answer, so the warp takes them whole). Needs no GPU,
+only an object or binary and cuobjdump.
 
     cuobjdump -sass build/labs/05-cuda-mega/solution/render.o | loop_branches.py [--kernel TEXT]
 """
@@ -43,12 +45,25 @@ def innermost_loops(code: list[tuple[int, str]]) -> list[tuple[int, int]]:
             and not any((a, b) != (c, d) and a <= c and d <= b for c, d in loops)]
 
 
-def branches_in(code: list[tuple[int, str]], first: int, last: int) -> tuple[int, int]:
-    """(divergent, slow-path) forward branches between first and last, the loop's own excluded:
-    a conditional BRA is a slow-path guard when the next instructions before its target hold a
-    CALL (the compiler's slow path of division or square root)."""
+def set_by_vote(body: list[tuple[int, str]], i: int, predicate: str) -> bool:
+    """Whether the last instruction before body[i] that writes `predicate` is a warp vote."""
+    for _, text in reversed(body[:i]):
+        operands = re.sub(r"^@!?U?P\d+\s+", "", text).split(None, 1)
+        if len(operands) < 2:
+            continue
+        destinations = [d.strip() for d in operands[1].split(",")[:2]]
+        if predicate in destinations:
+            return operands[0].startswith(("VOTE.ANY", "VOTE.ALL"))
+    return False
+
+
+def branches_in(code: list[tuple[int, str]], first: int, last: int) -> tuple[int, int, int]:
+    """(divergent, slow-path, warp-uniform) forward branches between first and last, the loop's
+    own excluded: a conditional BRA is a slow-path guard when the next instructions before its
+    target hold a CALL (the compiler's slow path of division or square root), and warp-uniform
+    when a vote set its predicate."""
     body = [(a, t) for a, t in code if first <= a < last]
-    divergent = slow = 0
+    divergent = slow = uniform = 0
     for i, (address, text) in enumerate(body):
         m = TARGET.search(text)
         if not m or not text.startswith("@") or int(m[1], 16) <= address:
@@ -57,9 +72,11 @@ def branches_in(code: list[tuple[int, str]], first: int, last: int) -> tuple[int
         skipped = [t for a, t in body[i + 1:] if a < target]
         if any(t.startswith("CALL") for t in skipped) and len(skipped) <= 4:
             slow += 1
+        elif set_by_vote(body, i, text.split()[0].lstrip("@!")):
+            uniform += 1
         else:
             divergent += 1
-    return divergent, slow
+    return divergent, slow, uniform
 
 
 def main() -> int:
@@ -76,10 +93,11 @@ def main() -> int:
         found = True
         print(name)
         for first, last in innermost_loops(code):
-            divergent, slow = branches_in(code, first, last)
+            divergent, slow, uniform = branches_in(code, first, last)
             length = sum(1 for a, _ in code if first <= a <= last)
             print(f"  loop {first:#06x}-{last:#06x}: {length} instructions, "
-                  f"{divergent} divergent branches, {slow} slow-path guards")
+                  f"{divergent} divergent branches, {slow} slow-path guards, "
+                  f"{uniform} warp-uniform branches")
     if not found:
         print(f"loop_branches: no function matching {args.kernel!r}", file=sys.stderr)
         return 1

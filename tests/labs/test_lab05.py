@@ -134,7 +134,7 @@ def test_kernel_report(nvcc):
 def test_loop_branches_reads_machine_code():
     """labs/05-cuda-mega/loop_branches.py finds a kernel's innermost loops in cuobjdump's
     listing and tells a branch that can split the warp from one that only guards the CALL of
-    a slow path; the trap at a kernel's end (a branch to itself) is no loop. A made-up
+    a slow path or follows a warp vote; the trap at a kernel's end (a branch to itself) is no loop. A made-up
     listing, so no cuobjdump is needed."""
     code = [
         (0x00, "MOV R1, c[0x0][0x28]"),
@@ -145,7 +145,9 @@ def test_loop_branches_reads_machine_code():
         (0x50, "@!P1 BRA 0x80"),  # skips only the call of a slow path
         (0x60, "MOV R0, 0x70"),
         (0x70, "CALL.REL.NOINC 0x200"),
-        (0x80, "ISETP.GE.AND P2, PT, R6, R7, PT"),
+        (0x80, "VOTE.ANY P3, P4"),
+        (0x88, "ISETP.GE.AND P2, PT, R6, R7, PT"),
+        (0x8c, "@!P3 BRA 0x90"),  # on a vote: the whole warp takes it or none
         (0x90, "@!P2 BRA 0x10"),  # the loop
         (0xa0, "EXIT"),
         (0xb0, "BRA 0xb0"),
@@ -157,8 +159,8 @@ def test_loop_branches_reads_machine_code():
                        timeout=60)
     assert p.returncode == 0, p.stderr
     loops = [ln.strip() for ln in p.stdout.splitlines() if ln.strip().startswith("loop")]
-    assert loops == ["loop 0x0010-0x0090: 9 instructions, 1 divergent branches, "
-                     "1 slow-path guards"], p.stdout
+    assert loops == ["loop 0x0010-0x0090: 11 instructions, 1 divergent branches, "
+                     "1 slow-path guards, 1 warp-uniform branches"], p.stdout
     p = subprocess.run(["python3", str(script), "--kernel", "no_such_kernel"], input=listing,
                        capture_output=True, text=True, timeout=60)
     assert p.returncode == 1 and "no function matching" in p.stderr, p.stderr
