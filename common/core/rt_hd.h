@@ -20,8 +20,9 @@
 // returns at once and skips the arithmetic that the rejection made needless. A GPU warp
 // would run that arithmetic anyway for any of its lanes that still needs it, and an early
 // return only splits the warp (its lanes then run the rest of the loop apart and must be
-// joined again): there every lane runs every instruction of the test, and the rejection
-// joins the select that chooses the answer at the end. Each test takes the form as a template
+// joined again): there the rejection joins the select that chooses the answer at the end,
+// and the warp skips the rest of the test only when the cheap test rejects the primitive on
+// every one of its lanes (any_lane, below), a branch all its lanes take together. Each test takes the form as a template
 // argument that defaults to the machine's, so that a CPU can run the GPU's form too: the unit
 // tests check that both return the same bits (tests/unit/test_converged_tests.cpp).
 #if defined(__CUDA_ARCH__)
