@@ -11,6 +11,7 @@
 #pragma once
 
 #include <cstdint>
+#include <cstring>
 
 #include <path_tracer.h>
 
@@ -34,9 +35,22 @@ struct CameraSample {
     SampleStream rng;
     Ray ray;
 };
+// The stream's key is three 64-bit hashes, about 70 instructions, and the compiler would
+// rather compute it again at every bounce than hold its two registers across the path: an
+// empty asm that may change it stops that (its result is only known by keeping it).
+__device__ inline SampleStream kept_in_registers(SampleStream rng) {
+    static_assert(sizeof(SampleStream) == sizeof(unsigned long long), "one 64-bit key");
+    unsigned long long key;
+    memcpy(&key, &rng, sizeof key);
+    asm("" : "+l"(key));
+    memcpy(&rng, &key, sizeof key);
+    return rng;
+}
+
 __device__ inline CameraSample camera_sample(const KernelArgs& args, int x, int y, uint64_t pixel,
                                              int s) {
-    const SampleStream rng(args.settings.seed, pixel, static_cast<uint64_t>(s));
+    const SampleStream rng = kept_in_registers(
+        SampleStream(args.settings.seed, pixel, static_cast<uint64_t>(s)));
     return {rng,
             args.camera.ray_through(x + real(rng.at(kDimPixelX)), y + real(rng.at(kDimPixelY)))};
 }
