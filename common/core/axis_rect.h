@@ -135,8 +135,8 @@ RT_HD inline real canonical_edge(real to_i, real d_i, real to_j, real d_j) {
 // rectangle's. On a GPU every lane of a warp tests the same rectangle, so a branch on its axis
 // is taken by the whole warp, and each branch's copy of the test, inlined with `a` a constant,
 // reads ray.direction.x rather than choosing among x, y and z at every access (a runtime index
-// into a Vec3 is a select per read on a GPU: about a third of the loop's instructions). A CPU
-// indexes memory at no cost and keeps one copy. The same operations either way: the same bits.
+// into a Vec3 is two selects per read on a GPU). A CPU indexes memory at no cost and keeps one
+// copy. The same operations either way: the same bits.
 template <bool kConverged>
 RT_HD RT_FORCE_INLINE real rect_test_on_axis(const Ray& ray, const AxisRect& r, real t_max,
                                              const int a) {

@@ -134,8 +134,8 @@ def test_kernel_report(nvcc):
 def test_loop_branches_reads_machine_code():
     """labs/05-cuda-mega/loop_branches.py finds a kernel's innermost loops in cuobjdump's
     listing and tells a branch that can split the warp from one that only guards the CALL of
-    a slow path or follows a warp vote; the trap at a kernel's end (a branch to itself) is no loop. A made-up
-    listing, so no cuobjdump is needed."""
+    a slow path or follows a warp vote; the trap at a kernel's end (a branch to itself) is no
+    loop. A made-up listing, so no cuobjdump is needed."""
     code = [
         (0x00, "MOV R1, c[0x0][0x28]"),
         (0x10, "FADD R2, R2, R3"),

@@ -44,8 +44,8 @@ __device__ inline SampleStream kept_in_registers(SampleStream rng) {
 
 __device__ inline CameraSample camera_sample(const KernelArgs& args, int x, int y, uint64_t pixel,
                                              int s) {
-    const SampleStream rng = kept_in_registers(
-        SampleStream(args.settings.seed, pixel, static_cast<uint64_t>(s)));
+    const SampleStream rng =
+        kept_in_registers(SampleStream(args.settings.seed, pixel, static_cast<uint64_t>(s)));
     return {rng,
             args.camera.ray_through(x + real(rng.at(kDimPixelX)), y + real(rng.at(kDimPixelY)))};
 }
