@@ -130,13 +130,24 @@ RT_HD inline real canonical_edge(real to_i, real d_i, real to_j, real d_j) {
 // its edge function bit for bit and read its sign oppositely, so a ray through the edge
 // passes the test of at least one (both on the line). A ray parallel to the plane misses, and
 // NaN fails every test. Returns the distance in (0, t_max), or t_max for a miss.
-RT_HD inline real intersect_rect(const Ray& ray, const AxisRect& r, real t_max) {
-    const int a = rect_axis(r);
+//
+// rect_test_on_axis is that test with the axis `a` as an argument; intersect_rect passes the
+// rectangle's. On a GPU every lane of a warp tests the same rectangle, so a branch on its axis
+// is taken by the whole warp, and each branch's copy of the test, inlined with `a` a constant,
+// reads ray.direction.x rather than choosing among x, y and z at every access (a runtime index
+// into a Vec3 is two selects per read on a GPU). A CPU indexes memory at no cost and keeps one
+// copy. The same operations either way: the same bits.
+template <bool kConverged>
+RT_HD RT_FORCE_INLINE real rect_test_on_axis(const Ray& ray, const AxisRect& r, real t_max,
+                                             const int a) {
     const int u = rect_axis_u(a), w = rect_axis_v(a);
     const real d_a = ray.direction[a];
     const real to_plane = r.plane - ray.origin[a];
     const real t = to_plane / d_a;
-    if (!(t > 0.0f) || !(t < t_max) || !(fabs_real(d_a) > 0.0f)) return t_max;
+    const bool in_range = (t > 0.0f) & (t < t_max) & (fabs_real(d_a) > 0.0f);  // NaN fails
+    // Converged, only when no lane of the warp has the plane in range (a shadow ray inside a
+    // box meets no wall before the light): otherwise the final select decides.
+    if (kConverged ? !any_lane(in_range) : !in_range) return t_max;
     const real d_u = ray.direction[u], d_w = ray.direction[w];
     const real o_u = ray.origin[u], o_w = ray.origin[w];
     // u_hit - c = E / d_a when axis a comes before u (E's first term is a's), else -E / d_a.
@@ -152,5 +163,18 @@ RT_HD inline real intersect_rect(const Ray& ray, const AxisRect& r, real t_max) 
     const real lo_w = edge(w, r.lo_v - o_w, d_w) * sign_w;
     const real hi_w = edge(w, r.hi_v - o_w, d_w) * sign_w;
     const bool inside = (lo_u >= 0.0f) & (hi_u <= 0.0f) & (lo_w >= 0.0f) & (hi_w <= 0.0f);
-    return inside ? t : t_max;
+    return (in_range & inside) ? t : t_max;
+}
+template <bool kConverged = kConvergedTests>  // rt_hd.h
+RT_HD inline real intersect_rect(const Ray& ray, const AxisRect& r, real t_max) {
+    const int a = rect_axis(r);
+    if constexpr (kConverged) {
+        switch (a) {
+            case 0: return rect_test_on_axis<kConverged>(ray, r, t_max, 0);
+            case 1: return rect_test_on_axis<kConverged>(ray, r, t_max, 1);
+            case 2: return rect_test_on_axis<kConverged>(ray, r, t_max, 2);
+            default: break;  // no rectangle has axis 3; it still gets the same answer
+        }
+    }
+    return rect_test_on_axis<kConverged>(ray, r, t_max, a);
 }

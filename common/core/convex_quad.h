@@ -120,13 +120,17 @@ RT_HD inline Vec3 step_off_edges(const ConvexQuad& quad, Vec3 p, real margin) {
 // functions have opposite signs (the quad is convex); the distance is then the plane's,
 // num / denom of the cull. Returns the distance in (0, t_max), or t_max for a miss; rays
 // parallel to the plane, quads with no area and NaN miss.
+template <bool kConverged = kConvergedTests>  // rt_hd.h
 RT_HD inline real intersect_quad(const Ray& ray, const RayShear& shear, const ConvexQuad& quad,
                                  real t_max) {
     const real denom = dot(quad.normal, ray.direction);
     const real num = quad.plane_offset - dot(quad.normal, ray.origin);
     const bool behind = num * denom <= 0.0f;
     const bool beyond = fabs_real(num) >= t_max * real(1.00001f) * fabs_real(denom);
-    if (behind | beyond) return t_max;
+    const bool culled = behind | beyond;
+    // Converged, the warp skips the rest when every lane's cull rejects the primitive (the
+    // same answer, t_max, on every lane), and runs it on all of them otherwise.
+    if (kConverged ? !any_lane(!culled) : culled) return t_max;
 
     const Vec3 a = quad.v0 - ray.origin;
     const Vec3 b = quad.v1 - ray.origin;
@@ -143,7 +147,7 @@ RT_HD inline real intersect_quad(const Ray& ray, const RayShear& shear, const Co
     real e12 = edge_function(cx, cy, bx, by);
     real e23 = edge_function(dx, dy, cx, cy);
     real e30 = edge_function(ax, ay, dx, dy);
-    if (e01 == 0.0f || e12 == 0.0f || e23 == 0.0f || e30 == 0.0f) {  // rare, as the triangle's
+    if (!culled && (e01 == 0.0f || e12 == 0.0f || e23 == 0.0f || e30 == 0.0f)) {  // rare
         e01 = static_cast<real>(edge_function_exact(bx, by, ax, ay));
         e12 = static_cast<real>(edge_function_exact(cx, cy, bx, by));
         e23 = static_cast<real>(edge_function_exact(dx, dy, cx, cy));
@@ -151,9 +155,10 @@ RT_HD inline real intersect_quad(const Ray& ray, const RayShear& shear, const Co
     }
     const bool any_negative = (e01 < 0.0f) | (e12 < 0.0f) | (e23 < 0.0f) | (e30 < 0.0f);
     const bool any_positive = (e01 > 0.0f) | (e12 > 0.0f) | (e23 > 0.0f) | (e30 > 0.0f);
-    if (any_negative & any_positive) return t_max;  // the ray passes outside an edge
+    const bool outside = any_negative & any_positive;  // the ray passes outside an edge
+    if (!kConverged && outside) return t_max;
 
     const real t = num / denom;
-    if (!(t > 0.0f) || !(t < t_max)) return t_max;  // NaN fails too
-    return t;
+    const bool hit = !(culled | outside) & (t > 0.0f) & (t < t_max);  // NaN fails too
+    return hit ? t : t_max;
 }

@@ -23,20 +23,26 @@ RT_HD inline real sphere_extent(const Sphere& s) { return max_component(abs(s.ce
 //    ray), not b^2 - c, which loses every digit when the sphere is far away or small;
 //  - the near root is c / q with q = b + sign(b) sqrt(disc), not b - sqrt(disc)
 //    (Haines et al., "Precision Improvements for Ray/Sphere Intersection", Ray Tracing Gems).
+template <bool kConverged = kConvergedTests>  // rt_hd.h
 RT_HD inline real intersect_sphere(const Ray& ray, const Sphere& s, real t_max) {
     const Vec3 f = ray.origin - s.center;
     const real b = -dot(f, ray.direction);  // the ray passes closest to the centre at t = b
     const Vec3 perpendicular = f + ray.direction * b;  // centre-to-ray offset at that point
     const real r2 = s.radius * s.radius;
     const real disc = r2 - length_squared(perpendicular);
-    if (!(disc >= 0.0f)) return t_max;
-    const real q = b + copysign_real(sqrt_real(disc), b);
+    const bool meets = disc >= 0.0f;  // false for NaN too
+    // Converged, only when the line misses the sphere on every lane of the warp; otherwise
+    // the final select decides.
+    if (kConverged ? !any_lane(meets) : !meets) return t_max;
+    // A GPU's miss goes on with the root of 1, whatever it is worth: the root of a negative
+    // number, or of 0, would take the slow path of its square root.
+    const real q = b + copysign_real(sqrt_real(meets ? disc : real(1)), b);
     const real c = length_squared(f) - r2;
     const real t_a = c / q;
     const real t_b = q;
     const real t_near = min_float(t_a, t_b);
     const real t_far = max_float(t_a, t_b);
-    if (t_near > 0.0f && t_near < t_max) return t_near;
-    if (t_far > 0.0f && t_far < t_max) return t_far;
-    return t_max;
+    const bool near_ok = (t_near > 0.0f) & (t_near < t_max);
+    const bool far_ok = (t_far > 0.0f) & (t_far < t_max);
+    return !meets ? t_max : near_ok ? t_near : far_ok ? t_far : t_max;
 }

@@ -144,6 +144,7 @@ RT_HD inline double edge_function_exact(double px, double py, double qx, double 
 // Watertight ray/triangle intersection (Woop, Benthin, Wald, JCGT 2013). Returns the
 // distance in (0, t_max), or t_max for a miss. Rays parallel to the triangle's plane and
 // degenerate triangles give det == 0 and miss; no division happens before that check.
+template <bool kConverged = kConvergedTests>  // rt_hd.h
 RT_HD inline real intersect_triangle(const Ray& ray, const RayShear& shear, const Triangle& tri,
                                      real t_max) {
     // Cheap cull first: skip the triangle when its plane lies behind the ray or clearly beyond
@@ -153,10 +154,15 @@ RT_HD inline real intersect_triangle(const Ray& ray, const RayShear& shear, cons
     // degenerate triangles (zero normal) have denom == 0 and are culled too.
     const real denom = dot(tri.normal, ray.direction);
     const real num = tri.plane_offset - dot(tri.normal, ray.origin);  // t_plane = num / denom
-    // Bitwise | rather than ||: one well-predicted branch instead of several random ones.
+    // Bitwise | rather than ||: one well-predicted branch instead of several random ones. On
+    // a GPU the lanes that passed the cull still run the test together with those that did
+    // not, whose cull joins the final select (kConvergedTests, rt_hd.h).
     const bool behind = num * denom <= 0.0f;
     const bool beyond = fabs_real(num) >= t_max * real(1.00001f) * fabs_real(denom);
-    if (behind | beyond) return t_max;
+    const bool culled = behind | beyond;
+    // Converged, the warp skips the rest when every lane's cull rejects the primitive (the
+    // same answer, t_max, on every lane), and runs it on all of them otherwise.
+    if (kConverged ? !any_lane(!culled) : culled) return t_max;
 
     const Vec3 a = tri.v0 - ray.origin;
     const Vec3 b = tri.v1 - ray.origin;
@@ -169,22 +175,25 @@ RT_HD inline real intersect_triangle(const Ray& ray, const RayShear& shear, cons
     real u = edge_function(cx, cy, bx, by);
     real v = edge_function(ax, ay, cx, cy);
     real w = edge_function(bx, by, ax, ay);
-    if (u == 0.0f || v == 0.0f || w == 0.0f) {  // rare: on an edge, or rounded to zero
+    if (!culled && (u == 0.0f || v == 0.0f || w == 0.0f)) {  // rare: on an edge, or rounded
         u = static_cast<real>(edge_function_exact(cx, cy, bx, by));
         v = static_cast<real>(edge_function_exact(ax, ay, cx, cy));
         w = static_cast<real>(edge_function_exact(bx, by, ax, ay));
     }
     const bool any_negative = (u < 0.0f) | (v < 0.0f) | (w < 0.0f);
     const bool any_positive = (u > 0.0f) | (v > 0.0f) | (w > 0.0f);
-    if (any_negative & any_positive) return t_max;  // the ray passes outside an edge
+    const bool outside = any_negative & any_positive;  // the ray passes outside an edge
+    if (!kConverged && outside) return t_max;
 
-    const real det = u + v + w;
-    if (det == 0.0f) return t_max;  // parallel ray or degenerate triangle
+    const real det = u + v + w;  // 0 for a parallel ray or a degenerate triangle: a miss
     const real t_scaled = u * (shear.sz * az) + v * (shear.sz * bz) + w * (shear.sz * cz);
     // t = t_scaled / det must lie in (0, t_max); compare without dividing first.
     const real sign = copysign_real(real(1), det);
     const real t_signed = t_scaled * sign;
     const real det_abs = det * sign;
-    if (!(t_signed > 0.0f) || !(t_signed < t_max * det_abs)) return t_max;
-    return t_scaled / det;
+    const bool hit = !(culled | outside) & (det != 0.0f) & (t_signed > 0.0f) &
+                     (t_signed < t_max * det_abs);  // false for NaN
+    // Divided before the select: written inside it, the division becomes a branch on a GPU.
+    const real t = t_scaled / det;
+    return hit ? t : t_max;
 }

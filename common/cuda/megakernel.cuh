@@ -11,6 +11,7 @@
 #pragma once
 
 #include <cstdint>
+#include <cstring>
 
 #include <path_tracer.h>
 
@@ -34,30 +35,46 @@ struct CameraSample {
     SampleStream rng;
     Ray ray;
 };
+// The stream's key is three 64-bit hashes, about 70 instructions, and the compiler would
+// rather compute it again at every bounce than hold its two registers across the path: an
+// empty asm that may change it stops that (its result is only known by keeping it).
+__device__ inline SampleStream kept_in_registers(SampleStream rng) {
+    static_assert(sizeof(SampleStream) == sizeof(unsigned long long), "one 64-bit key");
+    unsigned long long key;
+    memcpy(&key, &rng, sizeof key);
+    asm("" : "+l"(key));
+    memcpy(&rng, &key, sizeof key);
+    return rng;
+}
+
 __device__ inline CameraSample camera_sample(const KernelArgs& args, int x, int y, uint64_t pixel,
                                              int s) {
-    const SampleStream rng(args.settings.seed, pixel, static_cast<uint64_t>(s));
+    const SampleStream rng =
+        kept_in_registers(SampleStream(args.settings.seed, pixel, static_cast<uint64_t>(s)));
     return {rng,
             args.camera.ray_through(x + real(rng.at(kDimPixelX)), y + real(rng.at(kDimPixelY)))};
 }
 
 // One thread's samples of pixel (x, y): s = first, first + stride, ... below spp, one after
-// the other, each path traced to its end by the core's trace_path. Simple, but a warp's lanes
-// wait for each other at every sample: a lane whose path escapes after one bounce idles
-// while another's bounces on, so each sample costs the warp its longest path. Materials: the
-// material kinds compiled in (material_set.h), passed on to the core.
-template <class Materials>
+// the other, each path traced to its end by the core's trace_path. A warp's lanes wait for
+// each other at every sample (a lane whose path escapes after one bounce idles while
+// another's bounces on), but they stay together: every lane starts its next sample at the
+// same time, and inside a path they run the same primitive loops. Materials and Primitives:
+// the material and primitive kinds compiled in (material_set.h, geometry_set.h), passed on
+// to the core.
+template <class Materials, class Primitives>
 __device__ inline SampleSum trace_samples(const SceneView& scene, const KernelArgs& args, int x,
                                           int y, uint64_t pixel, int first, int stride) {
     SampleSum sum;  // in double, as render_pixel's
     // BEGIN SOLUTION
     for (int s = first; s < args.settings.spp; s += stride) {
         const CameraSample c = camera_sample(args, x, y, pixel, s);
-        sum.add(trace_path<Materials>(scene, c.ray, c.rng, args.settings.bounces));
+        sum.add(trace_path<Materials, Primitives>(scene, c.ray, c.rng, args.settings.bounces));
     }
     // SKELETON
     //> // TODO(lab05): trace samples first, first + stride, ... below args.settings.spp with
-    //> // camera_sample and trace_path<Materials>, adding each path's radiance to sum.
+    //> // camera_sample and trace_path<Materials, Primitives>, adding each path's radiance to
+    //> // sum.
     //> (void)scene;
     //> (void)x;
     //> (void)y;
@@ -73,9 +90,12 @@ __device__ inline SampleSum trace_samples(const SceneView& scene, const KernelAr
 // query, as in trace_path's loop), and a lane whose path has ended starts its next sample in
 // the same iteration ("path regeneration"). The warp's lanes then stay busy until each has
 // run out of samples: a warp costs about its longest lane's total of bounces rather than the
-// sum over samples of the longest path. The image is bit for bit trace_samples' (the same
-// operations on each path, the samples added in the same order).
-template <class Materials>
+// sum over samples of the longest path. But starting a path is code that only the lanes whose
+// path ended run, in every iteration, while the others wait, and the loop carries more state
+// in registers: on the baseline the reference traces whole paths (handouts/05-cuda-mega.md,
+// "Where the time went"). The image is bit for bit trace_samples' (the same operations on
+// each path, the samples added in the same order).
+template <class Materials, class Primitives>
 __device__ inline SampleSum trace_samples_regenerating(const SceneView& scene,
                                                        const KernelArgs& args, int x, int y,
                                                        uint64_t pixel, int first, int stride) {
@@ -88,10 +108,10 @@ __device__ inline SampleSum trace_samples_regenerating(const SceneView& scene,
     PathState path = start_path(c.ray, bounces);
     for (;;) {
         if (path.alive) {
-            const Hit hit = closest_hit(scene, path.ray);
+            const Hit hit = closest_hit<Primitives>(scene, path.ray);
             ShadowRay shadow;
-            if (bounce_step<Materials>(scene, hit, c.rng, bounces, path, shadow) &&
-                !occluded(scene, shadow.ray, shadow.t_max)) {
+            if (bounce_step<Materials, Primitives>(scene, hit, c.rng, bounces, path, shadow) &&
+                !occluded<Primitives>(scene, shadow.ray, shadow.t_max)) {
                 path.radiance += shadow.radiance;
             }
         }
@@ -104,11 +124,11 @@ __device__ inline SampleSum trace_samples_regenerating(const SceneView& scene,
         }
     }
     // SKELETON
-    //> // TODO(lab05, for speed, once trace_samples works): the same samples, but one bounce
-    //> // per loop iteration (closest_hit, bounce_step<Materials>, occluded, as trace_path's
-    //> // loop does), starting the lane's next sample as soon as its path ends. Until then:
-    //> // trace_samples.
-    //> sum = trace_samples<Materials>(scene, args, x, y, pixel, first, stride);
+    //> // TODO(lab05, optional, once trace_samples works): the same samples, but one bounce
+    //> // per loop iteration (closest_hit<Primitives>, bounce_step<Materials, Primitives>,
+    //> // occluded<Primitives>, as trace_path's loop does), starting the lane's next sample as
+    //> // soon as its path ends. Until then: trace_samples.
+    //> sum = trace_samples<Materials, Primitives>(scene, args, x, y, pixel, first, stride);
     // END SOLUTION
     return sum;
 }
@@ -133,13 +153,14 @@ __device__ inline SampleSum sum_across_lanes(SampleSum sum) {
 
 // kThreadsPerPixel threads per pixel, neighbours in one warp; thread k of a pixel traces its
 // samples k, k + kThreadsPerPixel, k + 2 kThreadsPerPixel, ... (the counts differ by at most
-// one), by bounces (kRegenerate) or by whole paths. kMemory: where the scene is read from
+// one), by whole paths or by bounces (kRegenerate). kMemory: where the scene is read from
 // (scene_pool.cuh). __launch_bounds__ tells the compiler the block size; kMaxRegisters caps
 // the registers per thread (255, the hardware's most, caps nothing), so that more threads fit
-// on a multiprocessor, at the price of spills. Materials: the material kinds the scene uses
-// (material_set.h); a kernel for DiffuseOnly carries no mirror or glass code.
-template <int kThreadsPerPixel, SceneMemory kMemory, int kBlockThreads, bool kRegenerate = true,
-          int kMaxRegisters = 255, class Materials = AnyMaterial>
+// on a multiprocessor, at the price of spills. Materials and Primitives: the material and
+// primitive kinds the scene uses (material_set.h, geometry_set.h); a kernel for DiffuseOnly
+// carries no mirror or glass code, one for BoxGeometry no triangle or quad test.
+template <int kThreadsPerPixel, SceneMemory kMemory, int kBlockThreads, bool kRegenerate = false,
+          int kMaxRegisters = 255, class Materials = AnyMaterial, class Primitives = AnyGeometry>
 __global__ void __launch_bounds__(kBlockThreads) __maxnreg__(kMaxRegisters)
     render_kernel(const KernelArgs args) {
     extern __shared__ float4 shared_pool[];  // used only when kMemory is Shared
@@ -158,10 +179,10 @@ __global__ void __launch_bounds__(kBlockThreads) __maxnreg__(kMaxRegisters)
 
     SampleSum sum;
     if (inside) {
-        sum = kRegenerate ? trace_samples_regenerating<Materials>(scene, args, x, y, pixel,
-                                                                  first_sample, kThreadsPerPixel)
-                          : trace_samples<Materials>(scene, args, x, y, pixel, first_sample,
-                                                     kThreadsPerPixel);
+        sum = kRegenerate ? trace_samples_regenerating<Materials, Primitives>(
+                                scene, args, x, y, pixel, first_sample, kThreadsPerPixel)
+                          : trace_samples<Materials, Primitives>(scene, args, x, y, pixel,
+                                                                 first_sample, kThreadsPerPixel);
     }
     sum = sum_across_lanes<kThreadsPerPixel>(sum);
     if (inside && first_sample == 0) args.pixels[band_pixel] = sum.mean(args.settings.spp);
@@ -169,7 +190,7 @@ __global__ void __launch_bounds__(kBlockThreads) __maxnreg__(kMaxRegisters)
     //> // TODO(lab05): the kernel. Give each thread its share of the band's work: from
     //> // blockIdx.x, kBlockThreads and threadIdx.x, its pixel (x, y) and the first of that
     //> // pixel's samples it traces (kThreadsPerPixel threads per pixel,
-    //> // trace_samples<Materials>); skip what lies past the band's last pixel; combine the
+    //> // trace_samples<Materials, Primitives>); skip what lies past the band's last pixel; combine the
     //> // pixel's partial sums (sum_across_lanes) and store sum.mean(spp) once per pixel in
     //> // args.pixels (band-relative index). Until then: one thread per image row walks the
     //> // row's pixels, one path each.

@@ -21,6 +21,12 @@ struct SpeedTarget {
 
 constexpr const char kTargetGpu[] = "H200";  // the GPU the bars are set on (in its name)
 
+// Lab 05's bars (lab05-bench's configurations): the reference as lab05-ref renders the
+// baseline, with the kernel for the scene's own primitives (the walls as axis-aligned
+// rectangles), and "general", the same walls as convex quads with the kernel for every kind
+// but rectangles: the speed of a scene whose walls are not aligned with the axes.
+constexpr SpeedTarget kLab05Targets[] = {{"reference", 13.0, nullptr}, {"general", 18.0, nullptr}};
+
 // Why this run is not the one the bars are set for, or "" when it is.
 inline std::string why_not_judged(const cudaDeviceProp& prop, const std::string& scene_path,
                                   const RenderSettings& s) {

@@ -42,7 +42,9 @@
 #include <device_array.h>
 #include <gpu_device.h>
 #include <gpu_timer.h>
+#include <kernel_choice.cuh>
 #include <megakernel.cuh>
+#include <scene_constant.cuh>
 #include <scene_pool.cuh>
 #include <speed_targets.h>
 #include <wavefront_renderer.cuh>
@@ -91,17 +93,18 @@ static Config wavefront(const Setup& s, std::string name, std::string change,
             }};
 }
 
-// Lab 05's reference megakernel (megakernel.cuh, in the shape lab05-ref launches it) over
-// the whole image in one launch.
+// Lab 05's reference megakernel (megakernel.cuh, in the shape lab05-ref launches it, for the
+// scene's memory and kinds: kernel_choice.cuh) over the whole image in one launch.
 constexpr int kLab05ThreadsPerPixel = 32, kLab05BlockThreads = 64;
-template <SceneMemory kMemory, class Materials>
+template <class Choice>
 constexpr auto lab05_kernel =
-    render_kernel<kLab05ThreadsPerPixel, kMemory, kLab05BlockThreads, true, 72, Materials>;
+    render_kernel<kLab05ThreadsPerPixel, Choice::kMemory, kLab05BlockThreads, false, 255,
+                  typename Choice::Materials, typename Choice::Primitives>;
 
-template <SceneMemory kMemory, class Materials>
+template <class Choice>
 static double megakernel(const Setup& s, Image& image) {
-    constexpr auto kernel = lab05_kernel<kMemory, Materials>;
-    const size_t shared = kMemory == SceneMemory::Shared ? s.layout.bytes() : 0;
+    constexpr auto kernel = lab05_kernel<Choice>;
+    const size_t shared = Choice::kMemory == SceneMemory::Shared ? s.layout.bytes() : 0;
     DeviceArray<Vec3> pixels(static_cast<size_t>(s.settings.width) * s.settings.height,
                              "allocating the image");
     const KernelArgs args{s.layout,          s.pool,       s.camera, s.settings, 0,
@@ -257,27 +260,22 @@ int run_wavefront_bench(int argc, char** argv, const SpeedTarget (&targets)[N]) 
 
     std::vector<Config> configs;
     add_all_pools<Pools...>(s, configs);
-    const bool small = choose_scene_memory(s.layout) == SceneMemory::Shared;
     const bool specular = has_specular_material(scene.view().materials, scene.view().num_materials);
-    // Lab 05's reference as lab05-ref runs it: the scene's memory and material kinds.
-    const void* const lab05 =
-        small
-            ? (specular
-                   ? reinterpret_cast<const void*>(lab05_kernel<SceneMemory::Shared, AnyMaterial>)
-                   : reinterpret_cast<const void*>(lab05_kernel<SceneMemory::Shared, DiffuseOnly>))
-            : (specular
-                   ? reinterpret_cast<const void*>(lab05_kernel<SceneMemory::Global, AnyMaterial>)
-                   : reinterpret_cast<const void*>(lab05_kernel<SceneMemory::Global, DiffuseOnly>));
+    // Lab 05's reference as lab05-ref runs it: the scene's memory and kinds.
+    const SceneMemory lab05_memory = choose_megakernel_scene_memory(s.layout);
+    if (lab05_memory == SceneMemory::Constant) upload_to_constant(host_pool, s.layout);
+    const GeometryKinds kinds = geometry_kinds(scene.view());
+    const void* const lab05 = with_kernel_choice(lab05_memory, specular, kinds, [](auto choice) {
+        return reinterpret_cast<const void*>(lab05_kernel<decltype(choice)>);
+    });
     configs.push_back(
         {"megakernel",
-         small ? "lab 05's reference kernel" : "lab 05's kernel, scene in global memory",
-         [s, small, specular](Image& image, WavefrontStats*) {
-             if (small) {
-                 return specular ? megakernel<SceneMemory::Shared, AnyMaterial>(s, image)
-                                 : megakernel<SceneMemory::Shared, DiffuseOnly>(s, image);
-             }
-             return specular ? megakernel<SceneMemory::Global, AnyMaterial>(s, image)
-                             : megakernel<SceneMemory::Global, DiffuseOnly>(s, image);
+         lab05_memory == SceneMemory::Constant ? "lab 05's reference kernel"
+                                               : "lab 05's kernel, scene in global memory",
+         [s, lab05_memory, specular, kinds](Image& image, WavefrontStats*) {
+             return with_kernel_choice(lab05_memory, specular, kinds, [&](auto choice) {
+                 return megakernel<decltype(choice)>(s, image);
+             });
          }});
     if (list) {
         for (const Config& c : configs) std::printf("%s\t%s\n", c.name.c_str(), c.change.c_str());
@@ -351,7 +349,7 @@ int run_wavefront_bench(int argc, char** argv, const SpeedTarget (&targets)[N]) 
             int blocks = 0;
             check(cudaFuncGetAttributes(&a, lab05), "reading the megakernel's attributes");
             check(cudaOccupancyMaxActiveBlocksPerMultiprocessor(&blocks, lab05, kLab05BlockThreads,
-                                                                small ? s.layout.bytes() : 0),
+                                                                0),
                   "computing the megakernel's occupancy");
             std::printf(
                 ", \"registers\": %d, \"local_bytes\": %zu, \"blocks_per_sm\": %d, \"occupancy\": %.3f",

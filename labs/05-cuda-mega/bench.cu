@@ -1,27 +1,32 @@
 // The measurements behind lab 05's choices (handouts/05-cuda-mega.md): the megakernel in
 // several shapes, each timed by CUDA events on the same scene and settings, after a
-// warm-up, best and median of --repeat runs. Prints one JSON object, ending with lab 05's
-// speed targets (speed_targets.h) and whether this run meets them.
+// warm-up, best and median of --repeat runs. Prints one JSON object, one line per shape,
+// ending with lab 05's speed targets (speed_targets.h) and whether this run meets them.
 //
 //   ./lab05-bench [the shared flags: --scene --width --height --spp --bounces --seed]
 //                 [--repeat N] [--only NAME[,NAME...]] [--list]
 //
-// The variants: "reference" is what lab05-ref runs on a scene without mirrors or glass: 32
-// threads per pixel, path regeneration, scene in shared memory, blocks of 64, at most 72
-// registers, compiled for DiffuseOnly (material_set.h); "all-materials" is the same shape
-// compiled for every material, what lab05-ref runs on the others; the "diffuse-" variants
-// change one choice of the reference. "plain" is the first kernel anyone writes (one thread
-// per pixel calling the core's render_pixel, 16x16 blocks, the scene in global memory).
-// The grid after it changes one choice at a time from "reference-16", the previous
-// reference (16 threads per pixel, at most 64 registers, every material kind), whose
-// measurements the handout's older tables quote. The DiffuseOnly variants are left out on a
-// scene with mirrors or glass (they would render it wrong); the first variant run is then
-// "all-materials". Every image is compared with the first one's.
+// "reference" is what lab05-ref runs on the Cornell baseline: 32 threads per pixel, blocks of
+// 64, whole paths, no register cap, the scene in the constant bank, a kernel compiled for
+// the scene's kinds of material (DiffuseOnly) and primitive (spheres and axis-aligned
+// rectangles: BoxGeometry). Every other shape changes one thing: the scene's primitives
+// (its rectangles as convex quads, or every quad as two triangles, general_geometry.h, each
+// with a kernel for those kinds; "general" is what lab05-ref runs with
+// RT_LAB05_GEOMETRY=general), the kinds compiled in, where the scene lives, path
+// regeneration, a register cap, the work split or the block. "plain" is the first kernel
+// anyone writes (one thread per pixel calling the core's render_pixel, 16x16 blocks, the
+// scene in global memory). A shape compiled for kinds the scene does not fit (DiffuseOnly on
+// a scene with mirrors or glass, BoxGeometry on one with triangles) is left out; the first
+// shape run is the image the others are compared with, bit for bit where they render the
+// same primitives. The previous reference (triangles, branching primitive loops, shared
+// memory, path regeneration, at most 72 registers) is this file's "reference" at commit
+// df6fc16.
 #include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <cstring>
+#include <iterator>
 #include <string>
 #include <type_traits>
 #include <utility>
@@ -33,9 +38,13 @@
 #include <bench_main.h>
 #include <cuda_check.h>
 #include <device_array.h>
+#include <general_geometry.h>
+#include <geometry_set.h>
 #include <gpu_device.h>
 #include <gpu_timer.h>
+#include <kernel_choice.cuh>
 #include <megakernel.cuh>
+#include <scene_constant.cuh>
 #include <scene_pool.cuh>
 #include <speed_targets.h>
 
@@ -49,6 +58,10 @@ __global__ void plain_kernel(SceneView scene, Camera camera, RenderSettings sett
         render_pixel(scene, camera, settings, x, y);
 }
 
+// Kernels for the scene's walls in one kind of primitive only, besides the sphere.
+using SpheresAndQuads = GeometrySet<true, false, true, false>;
+using SpheresAndTriangles = GeometrySet<true, true, false, false>;
+
 struct Variant {
     const char* name;    // as in the handout's tables
     const char* change;  // what differs from the reference shape
@@ -58,15 +71,19 @@ struct Variant {
     bool regenerate;  // by bounces, starting the next sample at once (else trace_path per sample)
     int max_registers;  // render_kernel's cap (255: none)
     bool diffuse_only;  // compiled for DiffuseOnly (material_set.h), else for AnyMaterial
+    GeometryForm form;  // the scene's primitives as loaded, or re-expressed (general_geometry.h)
+    const char* primitives;  // the primitive kinds compiled in (geometry_set.h)
+    bool (*fits)(const GeometryKinds&);  // whether those kinds render the scene in `form`
     const void* kernel;
     void (*launch)(const KernelArgs&, size_t shared_bytes);
 };
 
-template <int kT, SceneMemory kM, int kB, bool kRegenerate, int kMaxRegisters, class Materials>
+template <int kT, SceneMemory kM, int kB, bool kRegenerate, int kMaxRegisters, class Materials,
+          class Primitives>
 void launch_megakernel(const KernelArgs& args, size_t shared_bytes) {
     const long long threads = static_cast<long long>(args.rows) * args.settings.width * kT;
     const unsigned blocks = static_cast<unsigned>((threads + kB - 1) / kB);
-    render_kernel<kT, kM, kB, kRegenerate, kMaxRegisters, Materials>
+    render_kernel<kT, kM, kB, kRegenerate, kMaxRegisters, Materials, Primitives>
         <<<blocks, kB, shared_bytes>>>(args);
 }
 
@@ -77,70 +94,64 @@ void launch_plain(const KernelArgs& args, size_t) {
                                   args.pixels);
 }
 
-#define MEGA_FOR(name, change, t, m, b, regen, regs, mats)                                         \
-    Variant {                                                                                      \
-        name, change, t, SceneMemory::m, b, regen, regs, std::is_same_v<mats, DiffuseOnly>,        \
-            reinterpret_cast<const void*>(render_kernel<t, SceneMemory::m, b, regen, regs, mats>), \
-            launch_megakernel<t, SceneMemory::m, b, regen, regs, mats>                             \
+template <class Primitives>
+bool fits(const GeometryKinds& kinds) {
+    return kinds.fits<Primitives>();
+}
+
+// One shape: t threads per pixel, scene memory m, blocks of b, regeneration, register cap,
+// material kinds, primitive kinds, the scene's geometry form.
+#define MEGA(name, change, t, m, b, regen, regs, mats, prims, form)                         \
+    Variant {                                                                               \
+        name, change, t, SceneMemory::m, b, regen, regs, std::is_same_v<mats, DiffuseOnly>, \
+            GeometryForm::form, #prims, fits<prims>,                                        \
+            reinterpret_cast<const void*>(                                                  \
+                render_kernel<t, SceneMemory::m, b, regen, regs, mats, prims>),             \
+            launch_megakernel<t, SceneMemory::m, b, regen, regs, mats, prims>               \
     }
-#define MEGA(name, change, t, m, b, regen, regs) \
-    MEGA_FOR(name, change, t, m, b, regen, regs, AnyMaterial)
-#define MEGA_DIFFUSE(name, change, t, m, b, regen, regs) \
-    MEGA_FOR(name, change, t, m, b, regen, regs, DiffuseOnly)
+// The reference's shape with one change.
+#define SHAPE(name, change, t, m, b, regen, regs) \
+    MEGA(name, change, t, m, b, regen, regs, DiffuseOnly, BoxGeometry, AsLoaded)
 
 static const std::vector<Variant>& variants() {
     static const std::vector<Variant> all = {
-        // The first of these two that the scene allows is the image the others are compared to.
-        MEGA_DIFFUSE("reference", "none", 32, Shared, 64, true, 72),
-        MEGA("all-materials", "compiled for every material kind", 32, Shared, 64, true, 72),
-        MEGA_DIFFUSE("diffuse-split-16", "16 threads per pixel", 16, Shared, 64, true, 72),
-        MEGA_DIFFUSE("diffuse-regs-64", "at most 64 registers", 32, Shared, 64, true, 64),
-        MEGA_DIFFUSE("diffuse-regs-any", "no register cap", 32, Shared, 64, true, 255),
-        MEGA_DIFFUSE("diffuse-whole-paths", "trace_path per sample (no regeneration)", 32, Shared,
-                     64, false, 72),
-        MEGA_DIFFUSE("diffuse-block-32", "blocks of 32", 32, Shared, 32, true, 72),
-        MEGA_DIFFUSE("diffuse-block-128", "blocks of 128", 32, Shared, 128, true, 72),
-        MEGA_DIFFUSE("diffuse-scene-global", "scene in global memory", 32, Global, 64, true, 72),
-        // From here on, compiled for every material kind: one choice changed from reference-16.
-        MEGA("reference-16",
-             "the previous reference: 16 threads per pixel, at most 64 registers, every material",
-             16, Shared, 64, true, 64),
-        {"plain", "render_pixel per pixel, 16x16 blocks, global memory", 1, SceneMemory::Global,
-         256, false, 255, false, reinterpret_cast<const void*>(plain_kernel), launch_plain},
-        MEGA("whole-paths", "trace_path per sample (no regeneration)", 16, Shared, 64, false, 64),
-        MEGA("whole-paths-split-1", "trace_path per sample, 1 thread per pixel", 1, Shared, 64,
-             false, 64),
-        MEGA("split-1", "1 thread per pixel", 1, Shared, 64, true, 64),
-        MEGA("split-2", "2 threads per pixel", 2, Shared, 64, true, 64),
-        MEGA("split-4", "4 threads per pixel", 4, Shared, 64, true, 64),
-        MEGA("split-8", "8 threads per pixel", 8, Shared, 64, true, 64),
-        MEGA("split-32", "32 threads per pixel", 32, Shared, 64, true, 64),
-        MEGA("scene-global", "scene in global memory", 16, Global, 64, true, 64),
-        MEGA("scene-constant", "scene in the constant bank", 16, Constant, 64, true, 64),
-        MEGA("whole-paths-global", "trace_path per sample, scene in global memory", 16, Global, 64,
-             false, 64),
-        MEGA("whole-paths-constant", "trace_path per sample, scene in the constant bank", 16,
-             Constant, 64, false, 64),
-        MEGA("regs-any", "no register cap", 16, Shared, 64, true, 255),
-        MEGA("whole-paths-regs-any", "trace_path per sample, no register cap", 16, Shared, 64,
-             false, 255),
-        MEGA("global-regs-any", "scene in global memory, no register cap", 16, Global, 64, true,
-             255),
-        MEGA("constant-regs-any", "scene in the constant bank, no register cap", 16, Constant, 64,
-             true, 255),
-        MEGA("regs-56", "at most 56 registers", 16, Shared, 64, true, 56),
-        MEGA("regs-48", "at most 48 registers", 16, Shared, 64, true, 48),
-        MEGA("regs-40", "at most 40 registers", 16, Shared, 64, true, 40),
-        MEGA("block-32", "blocks of 32", 16, Shared, 32, true, 64),
-        MEGA("block-128", "blocks of 128", 16, Shared, 128, true, 64),
-        MEGA("block-256", "blocks of 256", 16, Shared, 256, true, 64),
-        MEGA("block-512", "blocks of 512", 16, Shared, 512, true, 64),
+        // The first of these two that the scene fits is the image the others are compared to.
+        SHAPE("reference", "none", 32, Constant, 64, false, 255),
+        MEGA("all-materials",
+             "compiled for every material and primitive kind (lab05-ref on a "
+             "scene with mirrors, glass or triangles)",
+             32, Constant, 64, false, 255, AnyMaterial, AnyGeometry, AsLoaded),
+        // The primitives: the same walls as other kinds, each with a kernel for its kinds.
+        MEGA("general",
+             "walls as convex quads, kernel for every kind but rectangles "
+             "(lab05-ref with RT_LAB05_GEOMETRY=general)",
+             32, Constant, 64, false, 255, DiffuseOnly, GeneralGeometry, Quads),
+        MEGA("quads", "walls as convex quads, kernel for spheres and quads", 32, Constant, 64,
+             false, 255, DiffuseOnly, SpheresAndQuads, Quads),
+        MEGA("triangles", "walls as two triangles each, kernel for spheres and triangles", 32,
+             Constant, 64, false, 255, DiffuseOnly, SpheresAndTriangles, Triangles),
+        MEGA("any-geometry", "compiled for every primitive kind", 32, Constant, 64, false, 255,
+             DiffuseOnly, AnyGeometry, AsLoaded),
+        // Where the scene lives.
+        SHAPE("scene-shared", "scene in shared memory", 32, Shared, 64, false, 255),
+        SHAPE("scene-global", "scene in global memory", 32, Global, 64, false, 255),
+        MEGA("triangles-shared", "walls as two triangles each, scene in shared memory", 32, Shared,
+             64, false, 255, DiffuseOnly, SpheresAndTriangles, Triangles),
+        // What the previous reference chose and the converged kernel measured again.
+        SHAPE("regenerate", "path regeneration (trace_samples_regenerating)", 32, Constant, 64,
+              true, 255),
+        SHAPE("regs-64", "at most 64 registers", 32, Constant, 64, false, 64),
+        SHAPE("regs-56", "at most 56 registers", 32, Constant, 64, false, 56),
+        SHAPE("split-16", "16 threads per pixel", 16, Constant, 64, false, 255),
+        SHAPE("split-1", "1 thread per pixel", 1, Constant, 64, false, 255),
+        SHAPE("block-32", "blocks of 32", 32, Constant, 32, false, 255),
+        SHAPE("block-128", "blocks of 128", 32, Constant, 128, false, 255),
+        {"plain", "render_pixel per pixel, 16x16 blocks, global memory, every kind", 1,
+         SceneMemory::Global, 256, false, 255, false, GeometryForm::AsLoaded, "AnyGeometry",
+         fits<AnyGeometry>, reinterpret_cast<const void*>(plain_kernel), launch_plain},
     };
     return all;
 }
-
-// Lab 05's bar: the reference kernel (what lab05-ref runs on the baseline) on an H200.
-constexpr SpeedTarget kLab05Targets[] = {{"reference", 13.0, nullptr}};
 
 struct Timing {
     double best_ms, median_ms;
@@ -183,6 +194,14 @@ static double max_relative_difference(const std::vector<Vec3>& a, const std::vec
     return worst;
 }
 
+// The mean of every channel of every pixel: renders of the same surfaces by other primitive
+// tests differ pixel by pixel where a ray meets an edge, but not in their mean.
+static double image_mean(const std::vector<Vec3>& image) {
+    double sum = 0;
+    for (const Vec3& p : image) sum += double(p.x) + p.y + p.z;
+    return image.empty() ? 0.0 : sum / (3.0 * image.size());
+}
+
 static bool wanted(const std::string& only, const char* name) {
     if (only.empty()) return true;
     const std::string list = "," + only + ",";
@@ -215,32 +234,76 @@ static int run(int argc, char** argv) {
     const auto ms_since = [&](std::chrono::steady_clock::time_point t) {
         return std::chrono::duration<double, std::milli>(now() - t).count();
     };
+    // The scene in each geometry form a shape may ask for (general_geometry.h), each with its
+    // pool on the host and in global memory; a shape in the constant bank gets its form's
+    // pool copied there before it runs.
+    struct Form {
+        GeometryForm form;
+        const char* name;
+        SceneInForm scene;
+        SceneLayout layout;
+        std::vector<float4> host_pool;
+        Form(const SceneView& view, GeometryForm f, const char* n)
+            : form(f),
+              name(n),
+              scene(view, f),
+              layout(layout_of(scene.view)),
+              host_pool(pack(scene.view, layout)) {}
+    };
+    const Form forms[] = {{scene.view(), GeometryForm::AsLoaded, "as loaded"},
+                          {scene.view(), GeometryForm::Quads, "rectangles as quads"},
+                          {scene.view(), GeometryForm::Triangles, "quads as triangles"}};
+    const auto form_of = [&](GeometryForm f) -> const Form& {
+        for (const Form& form : forms)
+            if (form.form == f) return form;
+        return forms[0];
+    };
+    for (const Form& form : forms) {
+        if (!fits_constant(form.layout))
+            throw InputError("lab05-bench: the scene (" + std::string(form.name) +
+                             ") does not fit in the constant bank (" +
+                             std::to_string(form.layout.bytes()) + " bytes, at most " +
+                             std::to_string(kConstantPoolBytes) + ")");
+    }
+
     auto t0 = now();
     const cudaDeviceProp prop = open_device();
     const double context_ms = ms_since(t0);
 
-    const SceneLayout layout = layout_of(scene.view());
-    const std::vector<float4> host_pool = pack(scene.view(), layout);
-    t0 = now();
-    DeviceArray<float4> pool(host_pool.size(), "allocating the scene on the GPU");
-    check(cudaMemcpy(pool.data(), host_pool.data(), pool.bytes(), cudaMemcpyHostToDevice),
-          "copying the scene to the GPU");
-    const double scene_upload_ms = ms_since(t0);
-    if (!fits_constant(layout))
-        throw GpuError("the benchmark needs a scene that fits in constant memory");
-    check(cudaMemcpyToSymbol(constant_pool, host_pool.data(), layout.bytes()),
-          "copying the scene to the GPU's constant memory");
+    std::vector<DeviceArray<float4>> pools;
+    pools.reserve(std::size(forms));
+    double scene_upload_ms = 0;
+    for (const Form& form : forms) {
+        t0 = now();
+        pools.emplace_back(form.host_pool.size(), "allocating the scene on the GPU");
+        check(cudaMemcpy(pools.back().data(), form.host_pool.data(), pools.back().bytes(),
+                         cudaMemcpyHostToDevice),
+              "copying the scene to the GPU");
+        if (form.form == GeometryForm::AsLoaded) scene_upload_ms = ms_since(t0);
+    }
+    const Form* in_constant_bank = nullptr;  // the form whose pool the bank holds
     const size_t n = static_cast<size_t>(settings.width) * settings.height;
     t0 = now();
     DeviceArray<Vec3> pixels(n, "allocating the image");
     const double image_alloc_ms = ms_since(t0);
-    const KernelArgs args{
-        layout,       pool.data(), scene.camera.for_image(settings.width, settings.height),
-        settings,     0,           settings.height,
-        pixels.data()};
+    const Camera camera = scene.camera.for_image(settings.width, settings.height);
     const double paths = double(n) * settings.spp;
 
+    // The image the others are compared with: the first shape the scene fits.
+    const bool specular = has_specular_material(scene.view().materials, scene.view().num_materials);
+    const auto runs_on_scene = [&](const Variant& v) {
+        return !(v.diffuse_only && specular) && v.fits(geometry_kinds(form_of(v.form).scene.view));
+    };
+    const char* image_reference = nullptr;
+    for (const Variant& v : variants()) {
+        if (runs_on_scene(v)) {
+            image_reference = v.name;
+            break;
+        }
+    }
+
     std::vector<Vec3> reference_image;
+    double reference_mean = 0;
     std::printf(
         "{\"device\": \"%s\", \"scene\": \"%s\", \"width\": %d, \"height\": %d, "
         "\"spp\": %d, \"bounces\": %d, \"seed\": %llu, \"repeat\": %d, "
@@ -251,16 +314,27 @@ static int run(int argc, char** argv) {
     bool first = true;
     double first_load_ms = 0, download_ms = 0;
     std::vector<std::pair<std::string, double>> best_ms;  // of each variant run
-    const bool specular = has_specular_material(scene.view().materials, scene.view().num_materials);
-    const char* const image_reference = specular ? "all-materials" : "reference";
     for (const Variant& v : variants()) {
-        if (v.diffuse_only && specular) continue;
+        if (!runs_on_scene(v)) continue;
         if (!wanted(only, v.name) && std::strcmp(v.name, image_reference) != 0) continue;
-        const size_t shared_bytes = v.memory == SceneMemory::Shared ? layout.bytes() : 0;
+        const Form& form = form_of(v.form);
+        const DeviceArray<float4>& pool = pools[&form - forms];
+        if (v.memory == SceneMemory::Constant && in_constant_bank != &form) {
+            upload_to_constant(form.host_pool, form.layout);
+            in_constant_bank = &form;
+        }
+        const KernelArgs args{form.layout, pool.data(),     camera,       settings,
+                              0,           settings.height, pixels.data()};
+        const size_t shared_bytes = v.memory == SceneMemory::Shared ? form.layout.bytes() : 0;
         cudaFuncAttributes attr{};
         t0 = now();
         check(cudaFuncGetAttributes(&attr, v.kernel), "reading a kernel's attributes");
         if (first) first_load_ms = ms_since(t0);  // loads the module (CUDA loads lazily)
+        if (shared_bytes > 0) {
+            check(cudaFuncSetAttribute(v.kernel, cudaFuncAttributeMaxDynamicSharedMemorySize,
+                                       static_cast<int>(shared_bytes)),
+                  "giving a kernel the shared memory for the scene");
+        }
         int blocks_per_sm = 0;
         check(cudaOccupancyMaxActiveBlocksPerMultiprocessor(&blocks_per_sm, v.kernel,
                                                             v.block_threads, shared_bytes),
@@ -270,7 +344,10 @@ static int run(int argc, char** argv) {
         t0 = now();
         const std::vector<Vec3> image = download(pixels);
         if (first) download_ms = ms_since(t0);
-        if (reference_image.empty()) reference_image = image;
+        if (reference_image.empty()) {
+            reference_image = image;
+            reference_mean = image_mean(image);
+        }
         size_t nonfinite = 0;
         for (const Vec3& p : image)
             nonfinite += !(std::isfinite(p.x) && std::isfinite(p.y) && std::isfinite(p.z));
@@ -280,20 +357,23 @@ static int run(int argc, char** argv) {
             double(blocks_per_sm) * v.block_threads / prop.maxThreadsPerMultiProcessor;
         std::printf(
             "%s\n  {\"name\": \"%s\", \"change\": \"%s\", \"threads_per_pixel\": %d, "
-            "\"scene_memory\": \"%s\", \"block_threads\": %d, \"regenerate\": %s, \"max_registers\": %d, "
-            "\"materials\": \"%s\", "
-            "\"registers\": %d, \"local_bytes\": %zu, \"blocks_per_sm\": %d, "
-            "\"occupancy\": %.3f, \"best_ms\": %.3f, \"median_ms\": %.3f, "
-            "\"paths_per_second\": %.4g, \"nonfinite_pixels\": %zu, "
-            "\"identical_to_reference\": %s, \"max_relative_difference\": %.3g}",
+            "\"scene_memory\": \"%s\", \"block_threads\": %d, \"regenerate\": %s, "
+            "\"max_registers\": %d, \"materials\": \"%s\", \"primitives\": \"%s\", "
+            "\"geometry\": \"%s\", \"registers\": %d, \"local_bytes\": %zu, "
+            "\"blocks_per_sm\": %d, \"occupancy\": %.3f, \"best_ms\": %.3f, "
+            "\"median_ms\": %.3f, \"paths_per_second\": %.4g, \"nonfinite_pixels\": %zu, "
+            "\"identical_to_reference\": %s, \"max_relative_difference\": %.3g, "
+            "\"mean_ratio_to_reference\": %.5f}",
             first ? "" : ",", v.name, v.change, v.threads_per_pixel,
             v.memory == SceneMemory::Global     ? "global"
             : v.memory == SceneMemory::Constant ? "constant"
                                                 : "shared",
             v.block_threads, v.regenerate ? "true" : "false", v.max_registers,
-            v.diffuse_only ? "diffuse only" : "any", attr.numRegs, attr.localSizeBytes,
-            blocks_per_sm, occupancy, t.best_ms, t.median_ms, paths / (t.best_ms * 1e-3), nonfinite,
-            identical ? "true" : "false", max_relative_difference(reference_image, image));
+            v.diffuse_only ? "diffuse only" : "any", v.primitives, form.name, attr.numRegs,
+            attr.localSizeBytes, blocks_per_sm, occupancy, t.best_ms, t.median_ms,
+            paths / (t.best_ms * 1e-3), nonfinite, identical ? "true" : "false",
+            max_relative_difference(reference_image, image),
+            reference_mean > 0 ? image_mean(image) / reference_mean : 0.0);
         std::fflush(stdout);
         best_ms.emplace_back(v.name, t.best_ms);
         first = false;

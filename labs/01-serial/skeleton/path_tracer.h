@@ -110,12 +110,7 @@ RT_HD inline Vec3 step_off_hit_edges(const SceneView& scene, const Hit& hit, Vec
 
 // g++ calls a function as big as the bounce step out of line, and the path state then lives in
 // memory: +9% instructions per path on the Cornell box (callgrind). Inlined into the path
-// loop, the step costs 1% over the loop body it replaced.
-#if defined(__CUDACC__)
-#define RT_FORCE_INLINE __forceinline__
-#else
-#define RT_FORCE_INLINE inline __attribute__((always_inline))
-#endif
+// loop, the step costs 1% over the loop body it replaced (RT_FORCE_INLINE, rt_hd.h).
 
 // One camera path between two closest-hit queries: all that the bounce step reads and writes.
 // A wavefront renderer keeps this per path in its queues, plus the path's pixel and sample
