@@ -21,11 +21,12 @@ from labkit.compare import compare
 from labkit.harness import ROOT, build, golden, run_lab
 
 LAB = "05-cuda-mega"
-# The H200 tests' bars: lab 05's speed targets (common/cuda/speed_targets.h: 13 ms for the
-# reference on the baseline, 18 ms with RT_LAB05_GEOMETRY=general) with at least 15% to spare,
-# so that a slower clock of the same GPU fails nothing that works.
-H200_BAR_MS = 16.0
-H200_GENERAL_BAR_MS = 21.0
+# The H200 tests' bars: loose guards, at least 15% above what the reference measures on an
+# H200 (reference/gpu/h200/summary.md), so that a slower clock of the same GPU fails nothing
+# that works. The speed targets themselves (common/cuda/speed_targets.h: 13 ms for the
+# reference on the baseline, 18 ms with RT_LAB05_GEOMETRY=general) are judged by lab05-bench.
+H200_BAR_MS = 30.0
+H200_GENERAL_BAR_MS = 36.0
 
 
 def make(*args, **kwargs):
