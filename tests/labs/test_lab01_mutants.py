@@ -39,12 +39,12 @@ MUTANTS = {
                                "(cos_theta / (kPi * distance))", ["interior", "plane"]),
     "shadow rays ignore spheres": (
         "path_tracer.h",
-        "if (intersect_sphere(ray, scene.spheres[i], t_max) < t_max) return true;",
-        "continue;", ["cornell"]),
+        "blocked |= intersect_sphere(ray, scene.spheres[i], t_max) < t_max;",
+        "blocked |= false;", ["cornell"]),
     "shadow rays ignore triangles": (
         "path_tracer.h",
-        "if (intersect_triangle(ray, shear, scene.triangles[i], t_max) < t_max) return true;",
-        "continue;", ["showcase"]),
+        "blocked |= intersect_triangle(ray, shear, scene.triangles[i], t_max) < t_max;",
+        "blocked |= false;", ["showcase"]),
     "every rectangle hit names rectangle 0": (
         "path_tracer.h", "hit = {t, PrimitiveKind::Rect, i};", "hit = {t, PrimitiveKind::Rect, 0};",
         ["cornell", "showcase"]),
