@@ -373,7 +373,10 @@ def grade_all(lab: str, todo: list[str], found: dict[str, pathlib.Path], out: pa
                 where = f" on GPU {device}" if device is not None else ""
                 print(f"[{done[0] + 1}/{len(todo)}] {student}{where} ..."
                       f"{eta(done[0], len(todo), time.monotonic() - start)}", flush=True)
-            local = env if device is None else {**env, "CUDA_VISIBLE_DEVICES": device}
+            # The index counts as nvidia-smi does (PCI bus order), for CUDA and for the
+            # sandbox, which shows this GPU's node only (labkit/gpu.py: assigned_node).
+            local = env if device is None else {**env, "CUDA_VISIBLE_DEVICES": device,
+                                                "CUDA_DEVICE_ORDER": "PCI_BUS_ID"}
             r = grade_one(lab, found[student], out / student, extra, local)
         finally:
             free.put(device)

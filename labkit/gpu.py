@@ -75,16 +75,53 @@ def lib_dirs(candidates=DRIVER_LIB_DIRS, environment: str | None = None) -> list
     return found
 
 
-def sandbox_args(dev: str = DEV, libs: list[str] | None = None, sysfs=SYSFS) -> list[str]:
+def gpu_minor_numbers() -> dict[str, str]:
+    """nvidia-smi's index of each GPU -> the minor number of its device node (/dev/nvidiaN);
+    {} where nvidia-smi lists none. The two differ on some hosts: the index follows the PCI bus,
+    the minor number the order the driver found the devices in."""
+    try:
+        p = subprocess.run(["nvidia-smi", "--query-gpu=index,minor_number",
+                            "--format=csv,noheader"], capture_output=True, text=True, timeout=30)
+    except (OSError, subprocess.TimeoutExpired):
+        return {}
+    pairs = [line.split(",") for line in p.stdout.splitlines()] if p.returncode == 0 else []
+    return {i.strip(): m.strip() for i, m in (pair for pair in pairs if len(pair) == 2)
+            if i.strip().isdigit() and m.strip().isdigit()}
+
+
+def assigned_node(environment=None, minors=None) -> str | None:
+    """The device node of the one GPU this grader was given, or None (then every GPU's node is
+    shown). grading/batch.py gives each grader one GPU as CUDA_VISIBLE_DEVICES=<nvidia-smi
+    index> with CUDA_DEVICE_ORDER=PCI_BUS_ID (so CUDA counts as nvidia-smi does). The sandbox
+    clears the environment, so the assignment reaches a sandboxed program as the one node it
+    shows: CUDA then finds that GPU only, as in a container given one GPU."""
+    environment = os.environ if environment is None else environment
+    visible = environment.get("CUDA_VISIBLE_DEVICES", "").strip()
+    if not visible.isdigit():  # unset, several GPUs, a UUID: not one index
+        return None
+    minor = (gpu_minor_numbers() if minors is None else minors).get(visible)
+    return f"nvidia{minor}" if minor is not None else None
+
+
+_FROM_ENVIRONMENT = object()
+
+
+def sandbox_args(dev: str = DEV, libs: list[str] | None = None, sysfs=SYSFS,
+                 only=_FROM_ENVIRONMENT) -> list[str]:
     """bubblewrap arguments that give a sandboxed CUDA program the GPU: each NVIDIA device
     node, bound as a device (`--dev-bind`; it must come after `--dev /dev`), the `sysfs`
     folders read-only where they exist, and each folder holding libcuda.so, read-only, with
     LD_LIBRARY_PATH naming them (it must come after `--clearenv`). Built from what exists:
-    on a machine without a GPU (no device node) it is empty."""
+    on a machine without a GPU (no device node) it is empty. `only` (default: assigned_node()
+    of the grader's environment) names the one GPU node to show; the others are left out, and
+    the nodes every GPU shares (nvidiactl, nvidia-uvm, ...) stay."""
     libs = lib_dirs() if libs is None else libs
     nodes = device_nodes(dev)
     if not nodes:
         return []
+    only = assigned_node() if only is _FROM_ENVIRONMENT else only
+    if only is not None and only in nodes:
+        nodes = [n for n in nodes if n == only or not n.removeprefix("nvidia").isdigit()]
     args: list[str] = []
     for name in nodes:
         args += ["--dev-bind", os.path.join(dev, name), f"/dev/{name}"]

@@ -477,6 +477,9 @@ class Runner:
             scratch = str(self._scratch_dir())
             full_env = {"PATH": "/usr/local/bin:/usr/bin:/bin", "HOME": scratch,
                         "TMPDIR": scratch, "LANG": "C.UTF-8", **env}
+            if self.gpu:  # no mount namespace to show one GPU's node: name the grader's GPU
+                full_env.update({k: os.environ[k] for k in
+                                 ("CUDA_VISIBLE_DEVICES", "CUDA_DEVICE_ORDER") if k in os.environ})
             cwd = scratch
         else:
             full_env, cwd = None, self.root

@@ -203,6 +203,8 @@ def test_a_gpu_lab_grades_one_submission_per_gpu_at_once(tmp_path, monkeypatch):
             running[0] += 1
             most[0] = max(most[0], running[0])
             seen.append(env["CUDA_VISIBLE_DEVICES"])
+            if lab == "05":  # a GPU's index counted as nvidia-smi counts it
+                assert env["CUDA_DEVICE_ORDER"] == "PCI_BUS_ID"
         import time
         time.sleep(0.3)
         with lock:

@@ -228,7 +228,7 @@ def test_gpu_binds_are_built_from_what_exists(tmp_path):
     libs = gpu.lib_dirs([str(with_driver), str(without_driver), str(tmp_path / "absent")],
                         environment=f"{from_env}:{with_driver}")
     assert libs == [str(from_env), str(with_driver)]
-    args = gpu.sandbox_args(dev=str(dev), libs=libs, sysfs=("/sys/bus/pci",))
+    args = gpu.sandbox_args(dev=str(dev), libs=libs, sysfs=("/sys/bus/pci",), only=None)
     assert args == [
         "--dev-bind", f"{dev}/nvidia-caps", "/dev/nvidia-caps",
         "--dev-bind", f"{dev}/nvidia-uvm", "/dev/nvidia-uvm",
@@ -239,6 +239,17 @@ def test_gpu_binds_are_built_from_what_exists(tmp_path):
         "--ro-bind", str(from_env), str(from_env),
         "--ro-bind", str(with_driver), str(with_driver),
         "--setenv", "LD_LIBRARY_PATH", f"{from_env}:{with_driver}"]
+    # A grader given one GPU (grading/batch.py) shows that GPU's node only, found by its
+    # minor number, with the nodes all GPUs share; an index nvidia-smi does not list shows all.
+    one = gpu.sandbox_args(dev=str(dev), libs=[], sysfs=(),
+                           only=gpu.assigned_node({"CUDA_VISIBLE_DEVICES": "1"}, {"1": "0"}))
+    assert [a for a in one if a.startswith("/dev/")] == [
+        "/dev/nvidia-caps", "/dev/nvidia-uvm", "/dev/nvidia0", "/dev/nvidiactl"]
+    assert gpu.assigned_node({"CUDA_VISIBLE_DEVICES": "0,1"}, {"0": "0", "1": "1"}) is None
+    assert gpu.assigned_node({"CUDA_VISIBLE_DEVICES": "3"}, {"0": "0"}) is None
+    assert gpu.assigned_node({}, {"0": "0"}) is None
+    every = gpu.sandbox_args(dev=str(dev), libs=[], sysfs=(), only=None)
+    assert "/dev/nvidia1" in every and "/dev/nvidia0" in every
     empty = tmp_path / "empty"  # no device node: no GPU, nothing to show
     empty.mkdir()
     assert gpu.sandbox_args(dev=str(empty), libs=libs) == []
