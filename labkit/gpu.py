@@ -75,18 +75,30 @@ def lib_dirs(candidates=DRIVER_LIB_DIRS, environment: str | None = None) -> list
     return found
 
 
-def gpu_minor_numbers() -> dict[str, str]:
+def gpu_minor_numbers(proc: str = "/proc/driver/nvidia/gpus") -> dict[str, str]:
     """nvidia-smi's index of each GPU -> the minor number of its device node (/dev/nvidiaN);
-    {} where nvidia-smi lists none. The two differ on some hosts: the index follows the PCI bus,
-    the minor number the order the driver found the devices in."""
+    {} where nvidia-smi lists none. The two can differ: the index follows the PCI bus, the
+    minor number the order the driver found the devices in. nvidia-smi gives each index's PCI
+    address; the driver's folder for that address (`proc`) names its minor number."""
     try:
-        p = subprocess.run(["nvidia-smi", "--query-gpu=index,minor_number",
+        p = subprocess.run(["nvidia-smi", "--query-gpu=index,pci.bus_id",
                             "--format=csv,noheader"], capture_output=True, text=True, timeout=30)
     except (OSError, subprocess.TimeoutExpired):
         return {}
-    pairs = [line.split(",") for line in p.stdout.splitlines()] if p.returncode == 0 else []
-    return {i.strip(): m.strip() for i, m in (pair for pair in pairs if len(pair) == 2)
-            if i.strip().isdigit() and m.strip().isdigit()}
+    minors = {}
+    for line in p.stdout.splitlines() if p.returncode == 0 else []:
+        index, _, bus = (part.strip() for part in line.partition(","))
+        # nvidia-smi writes an 8-digit PCI domain (00000000:00:06.0), the driver 4 digits.
+        folder = os.path.join(proc, bus.lower()[-12:], "information")
+        try:
+            with open(folder) as f:
+                minor = next((line.split(":", 1)[1].strip() for line in f
+                              if line.startswith("Device Minor:")), "")
+        except OSError:
+            continue
+        if index.isdigit() and minor.isdigit():
+            minors[index] = minor
+    return minors
 
 
 def assigned_node(environment=None, minors=None) -> str | None:

@@ -255,6 +255,22 @@ def test_gpu_binds_are_built_from_what_exists(tmp_path):
     assert gpu.sandbox_args(dev=str(empty), libs=libs) == []
 
 
+def test_a_gpus_node_is_found_through_its_pci_address(tmp_path, monkeypatch):
+    """nvidia-smi's index -> the device node's minor number, through the GPU's PCI address
+    and the driver's folder for it: the two numberings differ here, as they may on a host."""
+    bin_dir, proc = tmp_path / "bin", tmp_path / "gpus"
+    bin_dir.mkdir()
+    smi = bin_dir / "nvidia-smi"
+    smi.write_text("#!/bin/sh\nprintf '0, 00000000:00:06.0\\n1, 00000000:00:07.0\\n'\n")
+    smi.chmod(0o755)
+    for bus, minor in (("0000:00:06.0", 1), ("0000:00:07.0", 0)):
+        (proc / bus).mkdir(parents=True)
+        (proc / bus / "information").write_text(f"Model: \t\t X\nDevice Minor: \t {minor}\n")
+    monkeypatch.setenv("PATH", f"{bin_dir}:{os.environ['PATH']}")
+    assert gpu.gpu_minor_numbers(str(proc)) == {"0": "1", "1": "0"}
+    assert gpu.gpu_minor_numbers(str(tmp_path / "absent")) == {}
+
+
 def test_sandboxed_cuda_builds_target_the_gpu_here(monkeypatch, tmp_path):
     """A submission's CUDA build in the sandbox (where nvidia-smi cannot reach the driver)
     gets the architecture of the GPU the grader sees, not cuda.mk's six-target fallback; with
