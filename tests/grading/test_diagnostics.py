@@ -43,9 +43,12 @@ def test_a_source_mistake_is_identified(mistake, tmp_path):
         if other != mistake:
             assert other_words not in text, text
     # At home every check runs: the golden images say what they saw while the hidden scene
-    # fails, their points waiting for it.
+    # fails, their points waiting for it. (The hidden scene is drawn from a new secret each
+    # grade, and a mistake as small as one bounce too many does not fail every draw of it.)
     golden = output_of(results, "golden-cornell")
-    assert golden.startswith("not counted until the hidden scene passes; it saw: FAIL"), text
+    waiting = "not counted until the hidden scene passes; it saw: "
+    assert (golden.removeprefix(waiting) if golden.startswith(waiting) else golden).startswith(
+        "FAIL"), text
     assert (tmp_path / "cornell-yours.png").exists() and (tmp_path / "cornell-diff.png").exists()
 
 

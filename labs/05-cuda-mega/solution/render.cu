@@ -30,9 +30,9 @@ const char* const kLabName = "05-cuda-mega";
 // times are in handouts/05-cuda-mega.md): 32 threads share a pixel's samples (a grid of
 // millions of threads, so the last wave of blocks is a small part of the work, while a
 // pixel's threads still fit in one warp for the shuffles; section 3); blocks of 64 threads
-// (section 5); whole paths, no register cap (section 7: with the primitive loops converged,
-// neither path regeneration nor a cap paid); only the kinds of material and primitive the
-// scene uses (sections 6 and 7).
+// (section 5); whole paths (section 7: path regeneration did not pay); no register cap
+// (section 7 measures what a cap gives this kernel); only the kinds of material and
+// primitive the scene uses (sections 6 and 7).
 constexpr int kThreadsPerPixel = 32;
 constexpr int kBlockThreads = 64;
 constexpr bool kRegenerate = false;
