@@ -5,6 +5,8 @@ import json
 import math
 import pathlib
 
+import numpy as np
+
 from labkit.harness import SCENES
 
 
@@ -181,6 +183,27 @@ def scaled(scene: dict, factor: float) -> dict:
     for kind in ("triangles", "quads"):
         for prim in s.get(kind, []):
             prim["vertices"] = [mul(v) for v in prim["vertices"]]
+    return s
+
+
+def transformed(scene: dict, matrix=np.eye(3), offset=(0, 0, 0), scale=1.0) -> dict:  # noqa: B008
+    """The scene rotated by `matrix`, scaled by `scale` (intensity by its square) and moved by
+    `offset`, computed in double: the image should not change. scaled() and
+    translated() are its two special cases as the grader's checks compute them."""
+    s = json.loads(json.dumps(scene))
+    point = lambda p: [float(c) for c in scale * (matrix @ np.asarray(p, float)) + offset]  # noqa: E731
+    s["camera"]["position"] = point(s["camera"]["position"])
+    s["camera"]["look_at"] = point(s["camera"]["look_at"])
+    s["camera"]["up"] = [float(c) for c in matrix @ np.asarray(s["camera"].get("up", [0, 1, 0]))]
+    if "light" in s:
+        s["light"]["position"] = point(s["light"]["position"])
+        s["light"]["intensity"] = [c * scale**2 for c in s["light"]["intensity"]]
+    for sp in s.get("spheres", []):
+        sp["center"] = point(sp["center"])
+        sp["radius"] *= scale
+    for kind in ("triangles", "quads"):
+        for prim in s.get(kind, []):
+            prim["vertices"] = [point(v) for v in prim["vertices"]]
     return s
 
 

@@ -47,26 +47,6 @@ def rotation(axis, degrees):
     return np.eye(3) + math.sin(t) * k + (1 - math.cos(t)) * (k @ k)
 
 
-def transformed(scene: dict, matrix=np.eye(3), offset=(0, 0, 0), scale=1.0) -> dict:  # noqa: B008
-    """The scene rotated by `matrix`, scaled by `scale` (intensity by its square) and moved by
-    `offset`, computed in double: the image should not change."""
-    s = json.loads(json.dumps(scene))
-    point = lambda p: [float(c) for c in scale * (matrix @ np.asarray(p, float)) + offset]  # noqa: E731
-    s["camera"]["position"] = point(s["camera"]["position"])
-    s["camera"]["look_at"] = point(s["camera"]["look_at"])
-    s["camera"]["up"] = [float(c) for c in matrix @ np.asarray(s["camera"].get("up", [0, 1, 0]))]
-    if "light" in s:
-        s["light"]["position"] = point(s["light"]["position"])
-        s["light"]["intensity"] = [c * scale**2 for c in s["light"]["intensity"]]
-    for sp in s.get("spheres", []):
-        sp["center"] = point(sp["center"])
-        sp["radius"] *= scale
-    for kind in ("triangles", "quads"):
-        for prim in s.get(kind, []):
-            prim["vertices"] = [point(v) for v in prim["vertices"]]
-    return s
-
-
 def box_quads(lo, hi, material):
     """The six faces of the box lo..hi as quads."""
     corner = lambda i, j, k: [(lo[0], hi[0])[i], (lo[1], hi[1])[j], (lo[2], hi[2])[k]]  # noqa: E731
@@ -161,7 +141,7 @@ def mirror_room():
     a, b, c, d = [0.2, -0.9, -0.6], [0.8, -0.9, -0.3], [0.5, -0.9, 0.2], [0.5, -0.2, -0.25]
     room["triangles"] = [{"vertices": t, "material": "glass"}
                          for t in ([a, c, b], [a, b, d], [b, c, d], [c, a, d])]
-    return transformed(room, rotation([0.3, 1.0, 0.2], 23.7), offset=[0.37, -0.21, 0.11])
+    return scenes.transformed(room, rotation([0.3, 1.0, 0.2], 23.7), offset=[0.37, -0.21, 0.11])
 
 
 def mirror_box():
@@ -187,7 +167,7 @@ def mixed_room(rotated=True):
     room["triangles"] = as_triangles(walls[1::2] + glass[0::2])
     if not rotated:
         return room
-    return transformed(room, rotation([0.3, 1.0, 0.2], 23.7), offset=[0.37, -0.21, 0.11])
+    return scenes.transformed(room, rotation([0.3, 1.0, 0.2], 23.7), offset=[0.37, -0.21, 0.11])
 
 
 def enclosure_image(binary, scene, tmp_path, bounces, width=48, height=48, spp=48):
@@ -328,7 +308,7 @@ def test_generic_translation_with_a_close_look_at(renderer, tmp_path):
     base = render_or_refusal(renderer, base_scene, tmp_path, "base.json", **settings)
     assert base is not None and base.mean() > 0
     for i, offset in enumerate(generic_offsets(10.0)):
-        moved = render_or_refusal(renderer, transformed(base_scene, offset=offset), tmp_path,
+        moved = render_or_refusal(renderer, scenes.transformed(base_scene, offset=offset), tmp_path,
                                   f"moved-{i}.json", **settings)
         if moved is None:
             continue
@@ -351,7 +331,7 @@ def test_rotated_moved_scaled_cornell_is_the_golden_image(renderer, tmp_path, mo
     """The Cornell box under a generic rotation, translation and scale is still the golden
     image's scene: the noise-aware comparison passes (or the loader refuses it in one line)."""
     g = golden("cornell")
-    scene = transformed(scenes.load("cornell"), **RIGID_MOTIONS[motion])
+    scene = scenes.transformed(scenes.load("cornell"), **RIGID_MOTIONS[motion])
     spp = 64
     image = render_or_refusal(renderer, scene, tmp_path, "moved.json", width=g.meta["width"],
                               height=g.meta["height"], spp=spp, bounces=g.meta["bounces"],
