@@ -118,18 +118,36 @@ RT_HD inline Vec3 step_off_edges(const AxisRect& r, Vec3 p, real margin) {
 // The canonical 2D edge function of the edge line {p_i = c_i, p_j = c_j} (i < j: the lower
 // axis first) as the ray passes it: (c_i - o_i) d_j - (c_j - o_j) d_i, two rounded products
 // and a rounded difference (edge_function, never fused). Any rectangle with this edge, in the
-// plane p_i = c_i or in p_j = c_j, computes the same bits; it is zero where the ray meets the
-// line.
+// plane p_i = c_i or in p_j = c_j, computes it to the same bits up to its sign (below); it is
+// zero where the ray meets the line.
 RT_HD inline real canonical_edge(real to_i, real d_i, real to_j, real d_j) {
     return edge_function(to_i, to_j, d_i, d_j);
 }
 
+// The rectangle's four edge lines as the ray crosses its plane: whether the crossing lies on
+// the inner side of every one. For the edge at c on axis `other`, u_hit - c is
+// canonical_edge(...) / d_a when a comes before `other`, its negation otherwise; both are
+//     (to_plane * sign(d_a)) * d_other - (c - o_other) * |d_a|,   divided by |d_a|,
+// since multiplying by +-1 is exact and a rounded difference changes sign exactly with its
+// operands. That form reads every sign without a division and without a multiplication by the
+// sign per edge, and it is still canonical_edge bit for bit up to the sign, so two rectangles
+// that share an edge compute it identically and read it oppositely: a ray through the edge
+// passes the test of at least one (both on the line). NaN fails every comparison.
+RT_HD RT_FORCE_INLINE bool rect_contains_crossing(const Ray& ray, const AxisRect& r,
+                                                  real to_plane_signed, real d_a_abs, const int a) {
+    const int u = rect_axis_u(a), w = rect_axis_v(a);
+    const real d_u = ray.direction[u], d_w = ray.direction[w];
+    const real o_u = ray.origin[u], o_w = ray.origin[w];
+    const auto from_edge = [&](real to_edge, real d_other) {  // (u_hit - c) * |d_a|
+        return edge_function(to_plane_signed, to_edge, d_a_abs, d_other);
+    };
+    return (from_edge(r.lo_u - o_u, d_u) >= 0.0f) & (from_edge(r.hi_u - o_u, d_u) <= 0.0f) &
+           (from_edge(r.lo_v - o_w, d_w) >= 0.0f) & (from_edge(r.hi_v - o_w, d_w) <= 0.0f);
+}
+
 // Ray/rectangle intersection: t = (plane - o_a) / d_a, and the hit lies inside when it is on
-// the inner side of each of the four edge lines, told by the sign of its canonical edge
-// function (no division: u_hit - c = +-E / d_a). Two rectangles that share an edge compute
-// its edge function bit for bit and read its sign oppositely, so a ray through the edge
-// passes the test of at least one (both on the line). A ray parallel to the plane misses, and
-// NaN fails every test. Returns the distance in (0, t_max), or t_max for a miss.
+// the inner side of each of the four edge lines (rect_contains_crossing). A ray parallel to
+// the plane misses. Returns the distance in (0, t_max), or t_max for a miss.
 //
 // rect_test_on_axis is that test with the axis `a` as an argument; intersect_rect passes the
 // rectangle's. On a GPU every lane of a warp tests the same rectangle, so a branch on its axis
@@ -140,31 +158,39 @@ RT_HD inline real canonical_edge(real to_i, real d_i, real to_j, real d_j) {
 template <bool kConverged>
 RT_HD RT_FORCE_INLINE real rect_test_on_axis(const Ray& ray, const AxisRect& r, real t_max,
                                              const int a) {
-    const int u = rect_axis_u(a), w = rect_axis_v(a);
     const real d_a = ray.direction[a];
     const real to_plane = r.plane - ray.origin[a];
     const real t = to_plane / d_a;
     const bool in_range = (t > 0.0f) & (t < t_max) & (fabs_real(d_a) > 0.0f);  // NaN fails
-    // Converged, only when no lane of the warp has the plane in range (a shadow ray inside a
-    // box meets no wall before the light): otherwise the final select decides.
+    // Converged, only when no lane of the warp has the plane in range: otherwise the final
+    // select decides.
     if (kConverged ? !any_lane(in_range) : !in_range) return t_max;
-    const real d_u = ray.direction[u], d_w = ray.direction[w];
-    const real o_u = ray.origin[u], o_w = ray.origin[w];
-    // u_hit - c = E / d_a when axis a comes before u (E's first term is a's), else -E / d_a.
-    const real sign_a = copysign_real(real(1), d_a);
-    const real sign_u = a < u ? sign_a : -sign_a;
-    const real sign_w = a < w ? sign_a : -sign_a;
-    const auto edge = [&](int other, real to_other, real d_other) {
-        return a < other ? canonical_edge(to_plane, d_a, to_other, d_other)
-                         : canonical_edge(to_other, d_other, to_plane, d_a);
-    };
-    const real lo_u = edge(u, r.lo_u - o_u, d_u) * sign_u;  // u_hit - lo_u, up to a factor
-    const real hi_u = edge(u, r.hi_u - o_u, d_u) * sign_u;
-    const real lo_w = edge(w, r.lo_v - o_w, d_w) * sign_w;
-    const real hi_w = edge(w, r.hi_v - o_w, d_w) * sign_w;
-    const bool inside = (lo_u >= 0.0f) & (hi_u <= 0.0f) & (lo_w >= 0.0f) & (hi_w <= 0.0f);
+    const real to_plane_signed = to_plane * copysign_real(real(1), d_a);
+    const bool inside = rect_contains_crossing(ray, r, to_plane_signed, fabs_real(d_a), a);
     return (in_range & inside) ? t : t_max;
 }
+
+// Whether the rectangle lies on the ray before t_max: intersect_rect(...) < t_max, the same
+// answer for every ray, for a shadow ray. It culls before it divides: a shadow ray inside a
+// room meets no wall before the light, so on a GPU most warps then skip the division too. The
+// cull only rejects what the test rejects: t > 0 needs to_plane * sign(d_a) > 0, and t < t_max
+// needs to_plane * sign(d_a) < t_max |d_a|, which the bound exceeds by its 1e-5 margin
+// (and by kRealMin where the product would round below the normal floats).
+template <bool kConverged>
+RT_HD RT_FORCE_INLINE bool rect_blocks_on_axis(const Ray& ray, const AxisRect& r, real t_max,
+                                               const int a) {
+    const real d_a = ray.direction[a];
+    const real d_a_abs = fabs_real(d_a);
+    const real to_plane = r.plane - ray.origin[a];
+    const real to_plane_signed = to_plane * copysign_real(real(1), d_a);
+    const real bound = max_float(t_max * real(1.00001f) * d_a_abs, kRealMin);
+    const bool culled = !(to_plane_signed > 0.0f) | (to_plane_signed >= bound);
+    if (kConverged ? !any_lane(!culled) : culled) return false;
+    const real t = to_plane / d_a;
+    const bool in_range = (t > 0.0f) & (t < t_max) & (d_a_abs > 0.0f);
+    return in_range & rect_contains_crossing(ray, r, to_plane_signed, d_a_abs, a);
+}
+
 template <bool kConverged = kConvergedTests>  // rt_hd.h
 RT_HD inline real intersect_rect(const Ray& ray, const AxisRect& r, real t_max) {
     const int a = rect_axis(r);
@@ -173,8 +199,21 @@ RT_HD inline real intersect_rect(const Ray& ray, const AxisRect& r, real t_max) 
             case 0: return rect_test_on_axis<kConverged>(ray, r, t_max, 0);
             case 1: return rect_test_on_axis<kConverged>(ray, r, t_max, 1);
             case 2: return rect_test_on_axis<kConverged>(ray, r, t_max, 2);
-            default: break;  // no rectangle has axis 3; it still gets the same answer
+            default: return t_max;  // no rectangle has axis 3 (make_axis_rect)
         }
     }
     return rect_test_on_axis<kConverged>(ray, r, t_max, a);
+}
+template <bool kConverged = kConvergedTests>  // rt_hd.h
+RT_HD inline bool rect_blocks(const Ray& ray, const AxisRect& r, real t_max) {
+    const int a = rect_axis(r);
+    if constexpr (kConverged) {
+        switch (a) {
+            case 0: return rect_blocks_on_axis<kConverged>(ray, r, t_max, 0);
+            case 1: return rect_blocks_on_axis<kConverged>(ray, r, t_max, 1);
+            case 2: return rect_blocks_on_axis<kConverged>(ray, r, t_max, 2);
+            default: return false;
+        }
+    }
+    return rect_blocks_on_axis<kConverged>(ray, r, t_max, a);
 }

@@ -125,7 +125,7 @@ RT_HD inline real intersect_quad(const Ray& ray, const RayShear& shear, const Co
                                  real t_max) {
     const real denom = dot(quad.normal, ray.direction);
     const real num = quad.plane_offset - dot(quad.normal, ray.origin);
-    const bool behind = num * denom <= 0.0f;
+    const bool behind = !(num * denom > 0.0f);  // NaN is culled too
     const bool beyond = fabs_real(num) >= t_max * real(1.00001f) * fabs_real(denom);
     const bool culled = behind | beyond;
     // Converged, the warp skips the rest when every lane's cull rejects the primitive (the

@@ -142,7 +142,7 @@ RT_HD inline bool occluded(const SceneView& scene, const Ray& ray, real t_max) {
     }
     if constexpr (Primitives::kRects) {
         for (int i = 0; i < scene.num_rects; ++i) {
-            blocked |= intersect_rect(ray, scene.rects[i], t_max) < t_max;
+            blocked |= rect_blocks(ray, scene.rects[i], t_max);
             if (!kConvergedTests && blocked) return true;
         }
     }

@@ -18,11 +18,13 @@
 #if defined(RT_DOUBLE)
 using real = double;
 constexpr real kRealMax = DBL_MAX;
+constexpr real kRealMin = DBL_MIN;  // the smallest normal real
 constexpr real kRealEpsilon = DBL_EPSILON;  // the spacing of reals at 1
 constexpr const char* kPrecisionName = "double";
 #else
 using real = float;
 constexpr real kRealMax = FLT_MAX;
+constexpr real kRealMin = FLT_MIN;
 constexpr real kRealEpsilon = FLT_EPSILON;
 constexpr const char* kPrecisionName = "float";
 #endif

@@ -157,7 +157,7 @@ RT_HD inline real intersect_triangle(const Ray& ray, const RayShear& shear, cons
     // Bitwise | rather than ||: one well-predicted branch instead of several random ones. On
     // a GPU the lanes that passed the cull still run the test together with those that did
     // not, whose cull joins the final select (kConvergedTests, rt_hd.h).
-    const bool behind = num * denom <= 0.0f;
+    const bool behind = !(num * denom > 0.0f);  // NaN is culled too
     const bool beyond = fabs_real(num) >= t_max * real(1.00001f) * fabs_real(denom);
     const bool culled = behind | beyond;
     // Converged, the warp skips the rest when every lane's cull rejects the primitive (the

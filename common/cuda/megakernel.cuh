@@ -55,6 +55,15 @@ __device__ inline CameraSample camera_sample(const KernelArgs& args, int x, int 
             args.camera.ray_through(x + real(rng.at(kDimPixelX)), y + real(rng.at(kDimPixelY)))};
 }
 
+// How a thread traces its samples. Every form draws the same numbers, runs the same
+// operations on each path and adds the samples in the same order: the same image, bit for
+// bit; lab05-bench times each (handouts/05-cuda-mega.md, section 7).
+enum class PathLoop {
+    WholePaths,  // trace_samples: the core's trace_path, one sample after the other
+    Together,    // trace_samples_together: the same, with the warp's lanes kept together
+    Regenerate,  // trace_samples_regenerating: by bounces, a new sample as soon as one ends
+};
+
 // One thread's samples of pixel (x, y): s = first, first + stride, ... below spp, one after
 // the other, each path traced to its end by the core's trace_path. A warp's lanes wait for
 // each other at every sample (a lane whose path escapes after one bounce idles while
@@ -81,6 +90,56 @@ __device__ inline SampleSum trace_samples(const SceneView& scene, const KernelAr
     //> (void)pixel;
     //> (void)first;
     //> (void)stride;
+    // END SOLUTION
+    return sum;
+}
+
+// A ray that meets nothing: NaN fails every primitive test and every cull, so a lane that
+// traces it never keeps the warp inside a test that the other lanes skip.
+__device__ inline Ray ray_meeting_nothing() {
+    return {Vec3(0.0f), Vec3(__int_as_float(0x7fffffff))};
+}
+
+// trace_samples with the warp's lanes kept together. In trace_path's `while (path.alive)`
+// a lane whose path has ended leaves the loop and waits, and the warp runs every later
+// bounce split: each vote of a primitive test (any_lane) then goes through the slow path of
+// a warp-wide operation in a split warp, and each branch pays for joining the lanes again.
+// Here a lane whose path has ended stays in the loop and traces ray_meeting_nothing() until
+// every lane's path has ended: the warp runs the bounces' primitive loops whole, which costs
+// no more issue slots (the instructions are issued for the live lanes anyway), and only the
+// bounce step, which is branchy by nature, runs on the live lanes alone.
+template <class Materials, class Primitives>
+__device__ inline SampleSum trace_samples_together(const SceneView& scene, const KernelArgs& args,
+                                                   int x, int y, uint64_t pixel, int first,
+                                                   int stride) {
+    SampleSum sum;
+    // BEGIN SOLUTION
+    const int spp = args.settings.spp, bounces = args.settings.bounces;
+    // The lanes' sample counts differ by at most one: a lane past its last sample traces
+    // nothing while the others finish theirs.
+    for (int s = first; any_lane(s < spp); s += stride) {
+        const bool sampled = s < spp;
+        const CameraSample c = camera_sample(args, x, y, pixel, sampled ? s : first);
+        PathState path = start_path(c.ray, sampled ? bounces : 0);
+        if (!path.alive) path.ray = ray_meeting_nothing();
+        while (any_lane(path.alive)) {
+            const Hit hit = closest_hit<Primitives>(scene, path.ray);
+            ShadowRay shadow{ray_meeting_nothing(), 0.0f, Vec3(0.0f)};
+            bool lit = false;
+            if (path.alive) {
+                lit = bounce_step<Materials, Primitives>(scene, hit, c.rng, bounces, path, shadow);
+                if (!path.alive) path.ray = ray_meeting_nothing();
+            }
+            if (any_lane(lit) && !occluded<Primitives>(scene, shadow.ray, shadow.t_max) && lit)
+                path.radiance += shadow.radiance;
+        }
+        if (sampled) sum.add(path.radiance);
+    }
+    // SKELETON
+    //> // TODO(lab05, optional, once trace_samples works): the same samples with the warp's
+    //> // lanes kept together: a lane whose path has ended stays in the bounce loop, tracing
+    //> // ray_meeting_nothing(), until every lane's has (any_lane). Until then: trace_samples.
+    //> sum = trace_samples<Materials, Primitives>(scene, args, x, y, pixel, first, stride);
     // END SOLUTION
     return sum;
 }
@@ -153,14 +212,15 @@ __device__ inline SampleSum sum_across_lanes(SampleSum sum) {
 
 // kThreadsPerPixel threads per pixel, neighbours in one warp; thread k of a pixel traces its
 // samples k, k + kThreadsPerPixel, k + 2 kThreadsPerPixel, ... (the counts differ by at most
-// one), by whole paths or by bounces (kRegenerate). kMemory: where the scene is read from
+// one), in the form kLoop says (PathLoop). kMemory: where the scene is read from
 // (scene_pool.cuh). __launch_bounds__ tells the compiler the block size; kMaxRegisters caps
 // the registers per thread (255, the hardware's most, caps nothing), so that more threads fit
 // on a multiprocessor, at the price of spills. Materials and Primitives: the material and
 // primitive kinds the scene uses (material_set.h, geometry_set.h); a kernel for DiffuseOnly
 // carries no mirror or glass code, one for BoxGeometry no triangle or quad test.
-template <int kThreadsPerPixel, SceneMemory kMemory, int kBlockThreads, bool kRegenerate = false,
-          int kMaxRegisters = 255, class Materials = AnyMaterial, class Primitives = AnyGeometry>
+template <int kThreadsPerPixel, SceneMemory kMemory, int kBlockThreads,
+          PathLoop kLoop = PathLoop::WholePaths, int kMaxRegisters = 255,
+          class Materials = AnyMaterial, class Primitives = AnyGeometry>
 __global__ void __launch_bounds__(kBlockThreads) __maxnreg__(kMaxRegisters)
     render_kernel(const KernelArgs args) {
     extern __shared__ float4 shared_pool[];  // used only when kMemory is Shared
@@ -179,10 +239,16 @@ __global__ void __launch_bounds__(kBlockThreads) __maxnreg__(kMaxRegisters)
 
     SampleSum sum;
     if (inside) {
-        sum = kRegenerate ? trace_samples_regenerating<Materials, Primitives>(
-                                scene, args, x, y, pixel, first_sample, kThreadsPerPixel)
-                          : trace_samples<Materials, Primitives>(scene, args, x, y, pixel,
-                                                                 first_sample, kThreadsPerPixel);
+        if constexpr (kLoop == PathLoop::Together) {
+            sum = trace_samples_together<Materials, Primitives>(scene, args, x, y, pixel,
+                                                                first_sample, kThreadsPerPixel);
+        } else if constexpr (kLoop == PathLoop::Regenerate) {
+            sum = trace_samples_regenerating<Materials, Primitives>(scene, args, x, y, pixel,
+                                                                    first_sample, kThreadsPerPixel);
+        } else {
+            sum = trace_samples<Materials, Primitives>(scene, args, x, y, pixel, first_sample,
+                                                       kThreadsPerPixel);
+        }
     }
     sum = sum_across_lanes<kThreadsPerPixel>(sum);
     if (inside && first_sample == 0) args.pixels[band_pixel] = sum.mean(args.settings.spp);

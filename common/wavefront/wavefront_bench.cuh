@@ -98,8 +98,8 @@ static Config wavefront(const Setup& s, std::string name, std::string change,
 constexpr int kLab05ThreadsPerPixel = 32, kLab05BlockThreads = 64;
 template <class Choice>
 constexpr auto lab05_kernel =
-    render_kernel<kLab05ThreadsPerPixel, Choice::kMemory, kLab05BlockThreads, false, 255,
-                  typename Choice::Materials, typename Choice::Primitives>;
+    render_kernel<kLab05ThreadsPerPixel, Choice::kMemory, kLab05BlockThreads, PathLoop::WholePaths,
+                  255, typename Choice::Materials, typename Choice::Primitives>;
 
 template <class Choice>
 static double megakernel(const Setup& s, Image& image) {

@@ -68,7 +68,7 @@ struct Variant {
     int threads_per_pixel;
     SceneMemory memory;
     int block_threads;
-    bool regenerate;  // by bounces, starting the next sample at once (else trace_path per sample)
+    PathLoop loop;  // how a thread traces its samples (megakernel.cuh)
     int max_registers;  // render_kernel's cap (255: none)
     bool diffuse_only;  // compiled for DiffuseOnly (material_set.h), else for AnyMaterial
     GeometryForm form;  // the scene's primitives as loaded, or re-expressed (general_geometry.h)
@@ -78,12 +78,12 @@ struct Variant {
     void (*launch)(const KernelArgs&, size_t shared_bytes);
 };
 
-template <int kT, SceneMemory kM, int kB, bool kRegenerate, int kMaxRegisters, class Materials,
+template <int kT, SceneMemory kM, int kB, PathLoop kLoop, int kMaxRegisters, class Materials,
           class Primitives>
 void launch_megakernel(const KernelArgs& args, size_t shared_bytes) {
     const long long threads = static_cast<long long>(args.rows) * args.settings.width * kT;
     const unsigned blocks = static_cast<unsigned>((threads + kB - 1) / kB);
-    render_kernel<kT, kM, kB, kRegenerate, kMaxRegisters, Materials, Primitives>
+    render_kernel<kT, kM, kB, kLoop, kMaxRegisters, Materials, Primitives>
         <<<blocks, kB, shared_bytes>>>(args);
 }
 
@@ -99,58 +99,77 @@ bool fits(const GeometryKinds& kinds) {
     return kinds.fits<Primitives>();
 }
 
-// One shape: t threads per pixel, scene memory m, blocks of b, regeneration, register cap,
+// One shape: t threads per pixel, scene memory m, blocks of b, path loop, register cap,
 // material kinds, primitive kinds, the scene's geometry form.
-#define MEGA(name, change, t, m, b, regen, regs, mats, prims, form)                         \
-    Variant {                                                                               \
-        name, change, t, SceneMemory::m, b, regen, regs, std::is_same_v<mats, DiffuseOnly>, \
-            GeometryForm::form, #prims, fits<prims>,                                        \
-            reinterpret_cast<const void*>(                                                  \
-                render_kernel<t, SceneMemory::m, b, regen, regs, mats, prims>),             \
-            launch_megakernel<t, SceneMemory::m, b, regen, regs, mats, prims>               \
+#define MEGA(name, change, t, m, b, loop, regs, mats, prims, form)                       \
+    Variant {                                                                            \
+        name, change, t, SceneMemory::m, b, PathLoop::loop, regs,                        \
+            std::is_same_v<mats, DiffuseOnly>, GeometryForm::form, #prims, fits<prims>,  \
+            reinterpret_cast<const void*>(                                               \
+                render_kernel<t, SceneMemory::m, b, PathLoop::loop, regs, mats, prims>), \
+            launch_megakernel<t, SceneMemory::m, b, PathLoop::loop, regs, mats, prims>   \
     }
 // The reference's shape with one change.
-#define SHAPE(name, change, t, m, b, regen, regs) \
-    MEGA(name, change, t, m, b, regen, regs, DiffuseOnly, BoxGeometry, AsLoaded)
+#define SHAPE(name, change, t, m, b, loop, regs) \
+    MEGA(name, change, t, m, b, loop, regs, DiffuseOnly, BoxGeometry, AsLoaded)
 
 static const std::vector<Variant>& variants() {
     static const std::vector<Variant> all = {
         // The first of these two that the scene fits is the image the others are compared to.
-        SHAPE("reference", "none", 32, Constant, 64, false, 255),
+        SHAPE("reference", "none", 32, Constant, 64, WholePaths, 255),
         MEGA("all-materials",
              "compiled for every material and primitive kind (lab05-ref on a "
              "scene with mirrors, glass or triangles)",
-             32, Constant, 64, false, 255, AnyMaterial, AnyGeometry, AsLoaded),
+             32, Constant, 64, WholePaths, 255, AnyMaterial, AnyGeometry, AsLoaded),
         // The primitives: the same walls as other kinds, each with a kernel for its kinds.
         MEGA("general",
              "walls as convex quads, kernel for every kind but rectangles "
              "(lab05-ref with RT_LAB05_GEOMETRY=general)",
-             32, Constant, 64, false, 255, DiffuseOnly, GeneralGeometry, Quads),
+             32, Constant, 64, WholePaths, 255, DiffuseOnly, GeneralGeometry, Quads),
         MEGA("quads", "walls as convex quads, kernel for spheres and quads", 32, Constant, 64,
-             false, 255, DiffuseOnly, SpheresAndQuads, Quads),
+             WholePaths, 255, DiffuseOnly, SpheresAndQuads, Quads),
         MEGA("triangles", "walls as two triangles each, kernel for spheres and triangles", 32,
-             Constant, 64, false, 255, DiffuseOnly, SpheresAndTriangles, Triangles),
-        MEGA("any-geometry", "compiled for every primitive kind", 32, Constant, 64, false, 255,
+             Constant, 64, WholePaths, 255, DiffuseOnly, SpheresAndTriangles, Triangles),
+        MEGA("any-geometry", "compiled for every primitive kind", 32, Constant, 64, WholePaths, 255,
              DiffuseOnly, AnyGeometry, AsLoaded),
         // Where the scene lives.
-        SHAPE("scene-shared", "scene in shared memory", 32, Shared, 64, false, 255),
-        SHAPE("scene-global", "scene in global memory", 32, Global, 64, false, 255),
+        SHAPE("scene-shared", "scene in shared memory", 32, Shared, 64, WholePaths, 255),
+        SHAPE("scene-global", "scene in global memory", 32, Global, 64, WholePaths, 255),
         MEGA("triangles-shared", "walls as two triangles each, scene in shared memory", 32, Shared,
-             64, false, 255, DiffuseOnly, SpheresAndTriangles, Triangles),
+             64, WholePaths, 255, DiffuseOnly, SpheresAndTriangles, Triangles),
         // What the previous reference chose and the converged kernel measured again.
         SHAPE("regenerate", "path regeneration (trace_samples_regenerating)", 32, Constant, 64,
-              true, 255),
-        SHAPE("regs-64", "at most 64 registers", 32, Constant, 64, false, 64),
-        SHAPE("regs-56", "at most 56 registers", 32, Constant, 64, false, 56),
-        SHAPE("split-16", "16 threads per pixel", 16, Constant, 64, false, 255),
-        SHAPE("split-1", "1 thread per pixel", 1, Constant, 64, false, 255),
-        SHAPE("block-32", "blocks of 32", 32, Constant, 32, false, 255),
-        SHAPE("block-128", "blocks of 128", 32, Constant, 128, false, 255),
+              Regenerate, 255),
+        SHAPE("together", "the warp's lanes kept together (trace_samples_together)", 32, Constant,
+              64, Together, 255),
+        SHAPE("regs-64", "at most 64 registers", 32, Constant, 64, WholePaths, 64),
+        SHAPE("regs-56", "at most 56 registers", 32, Constant, 64, WholePaths, 56),
+        SHAPE("regs-48", "at most 48 registers", 32, Constant, 64, WholePaths, 48),
+        SHAPE("shared-regs-56", "scene in shared memory, at most 56 registers", 32, Shared, 64,
+              WholePaths, 56),
+        SHAPE("together-regs-56", "lanes kept together, at most 56 registers", 32, Constant, 64,
+              Together, 56),
+        SHAPE("together-shared", "lanes kept together, scene in shared memory", 32, Shared, 64,
+              Together, 255),
+        SHAPE("together-shared-regs-56",
+              "lanes kept together, scene in shared memory, at most 56 registers", 32, Shared, 64,
+              Together, 56),
+        SHAPE("split-16", "16 threads per pixel", 16, Constant, 64, WholePaths, 255),
+        SHAPE("split-1", "1 thread per pixel", 1, Constant, 64, WholePaths, 255),
+        SHAPE("block-32", "blocks of 32", 32, Constant, 32, WholePaths, 255),
+        SHAPE("block-128", "blocks of 128", 32, Constant, 128, WholePaths, 255),
         {"plain", "render_pixel per pixel, 16x16 blocks, global memory, every kind", 1,
-         SceneMemory::Global, 256, false, 255, false, GeometryForm::AsLoaded, "AnyGeometry",
-         fits<AnyGeometry>, reinterpret_cast<const void*>(plain_kernel), launch_plain},
+         SceneMemory::Global, 256, PathLoop::WholePaths, 255, false, GeometryForm::AsLoaded,
+         "AnyGeometry", fits<AnyGeometry>, reinterpret_cast<const void*>(plain_kernel),
+         launch_plain},
     };
     return all;
+}
+
+static const char* path_loop_name(PathLoop loop) {
+    return loop == PathLoop::Together     ? "together"
+           : loop == PathLoop::Regenerate ? "regenerate"
+                                          : "whole paths";
 }
 
 struct Timing {
@@ -357,7 +376,7 @@ static int run(int argc, char** argv) {
             double(blocks_per_sm) * v.block_threads / prop.maxThreadsPerMultiProcessor;
         std::printf(
             "%s\n  {\"name\": \"%s\", \"change\": \"%s\", \"threads_per_pixel\": %d, "
-            "\"scene_memory\": \"%s\", \"block_threads\": %d, \"regenerate\": %s, "
+            "\"scene_memory\": \"%s\", \"block_threads\": %d, \"path_loop\": \"%s\", "
             "\"max_registers\": %d, \"materials\": \"%s\", \"primitives\": \"%s\", "
             "\"geometry\": \"%s\", \"registers\": %d, \"local_bytes\": %zu, "
             "\"blocks_per_sm\": %d, \"occupancy\": %.3f, \"best_ms\": %.3f, "
@@ -368,7 +387,7 @@ static int run(int argc, char** argv) {
             v.memory == SceneMemory::Global     ? "global"
             : v.memory == SceneMemory::Constant ? "constant"
                                                 : "shared",
-            v.block_threads, v.regenerate ? "true" : "false", v.max_registers,
+            v.block_threads, path_loop_name(v.loop), v.max_registers,
             v.diffuse_only ? "diffuse only" : "any", v.primitives, form.name, attr.numRegs,
             attr.localSizeBytes, blocks_per_sm, occupancy, t.best_ms, t.median_ms,
             paths / (t.best_ms * 1e-3), nonfinite, identical ? "true" : "false",

@@ -124,6 +124,77 @@ TEST(ConvergedTests, RectanglesAgree) {
     }
 }
 
+// The rectangle test as it was first written: the edge functions in canonical order, each
+// multiplied by its sign. rect_contains_crossing folds the sign into the operands instead;
+// the two must agree to the bit, or lab 02's packets (written in this form) leave lab 01.
+real rect_as_first_written(const Ray& ray, const AxisRect& r, real t_max) {
+    const int a = rect_axis(r);
+    const int u = rect_axis_u(a), w = rect_axis_v(a);
+    const real d_a = ray.direction[a];
+    const real to_plane = r.plane - ray.origin[a];
+    const real t = to_plane / d_a;
+    const bool in_range = (t > 0.0f) & (t < t_max) & (fabs_real(d_a) > 0.0f);
+    const real sign_a = copysign_real(real(1), d_a);
+    const auto edge = [&](int other, real to_other, real d_other) {
+        return a < other ? canonical_edge(to_plane, d_a, to_other, d_other)
+                         : canonical_edge(to_other, d_other, to_plane, d_a);
+    };
+    const real sign_u = a < u ? sign_a : -sign_a, sign_w = a < w ? sign_a : -sign_a;
+    const real lo_u = edge(u, r.lo_u - ray.origin[u], ray.direction[u]) * sign_u;
+    const real hi_u = edge(u, r.hi_u - ray.origin[u], ray.direction[u]) * sign_u;
+    const real lo_w = edge(w, r.lo_v - ray.origin[w], ray.direction[w]) * sign_w;
+    const real hi_w = edge(w, r.hi_v - ray.origin[w], ray.direction[w]) * sign_w;
+    const bool inside = (lo_u >= 0.0f) & (hi_u <= 0.0f) & (lo_w >= 0.0f) & (hi_w <= 0.0f);
+    return (in_range & inside) ? t : t_max;
+}
+
+// The shadow ray's rectangle test culls before it divides; it must answer exactly as the
+// closest-hit test does, for limits far, near, exactly at the hit, one ulp either side of it,
+// and for rectangles from 1e-30 to 1e30 across.
+TEST(ConvergedTests, RectangleBlocksIsTheTestItself) {
+    Cases c;
+    int hits = 0, at_limit = 0;
+    for (int shape = 0; shape < 90; ++shape) {
+        const int axis = shape % 3;
+        const real scale = std::pow(real(10), real(shape % 15) * 4 - 28);  // 1e-28 .. 1e28
+        const int u = rect_axis_u(axis), w = rect_axis_v(axis);
+        Vec3 v[4];
+        const Vec3 lo = c.point() * scale;
+        const Vec3 size =
+            Vec3(c.uniform(real(0.1), 2), c.uniform(real(0.1), 2), c.uniform(real(0.1), 2)) * scale;
+        for (int k = 0; k < 4; ++k) {
+            v[k] = lo;
+            if (k == 1 || k == 2) v[k] = v[k] + along_axis(u, size[u]);
+            if (k >= 2) v[k] = v[k] + along_axis(w, size[w]);
+        }
+        if (shape % 2) std::swap(v[1], v[3]);
+        const int found = axis_rect_axis(v);
+        if (found < 0) continue;  // corners that rounded together at this scale
+        const AxisRect rect = make_axis_rect(v, found, 0);
+        for (int i = 0; i < kRays; ++i) {
+            Ray ray = c.ray({v[0], v[1], v[2], v[3]}, along_axis(u, real(1)));
+            ray.origin = ray.origin * scale;
+            if (i % 4 == 0) ray.direction = normalize(v[i / 4 % 4] - ray.origin);
+            const real t_hit = intersect_rect<false>(ray, rect, kRealMax);
+            real t_max = c.t_max() * scale;
+            if (t_hit < kRealMax && i % 3 != 2) {  // the limit at the hit, or an ulp off it
+                const int k = i % 3;
+                t_max = k == 0 ? t_hit : std::nextafter(t_hit, k == 1 ? real(0) : kRealMax);
+                ++at_limit;
+            }
+            const bool expected = intersect_rect<false>(ray, rect, t_max) < t_max;
+            hits += expected;
+            ASSERT_EQ(rect_blocks<false>(ray, rect, t_max), expected) << scale;
+            ASSERT_EQ(rect_blocks<true>(ray, rect, t_max), expected) << scale;
+            const real first = rect_as_first_written(ray, rect, t_max);
+            ASSERT_TRUE(same_bits(intersect_rect<false>(ray, rect, t_max), first));
+            ASSERT_TRUE(same_bits(intersect_rect<true>(ray, rect, t_max), first));
+        }
+    }
+    EXPECT_GT(hits, 3000);  // the cases reach both answers
+    EXPECT_GT(at_limit, 10000);
+}
+
 TEST(ConvergedTests, NaNRaysMissInBothForms) {
     const Ray nan_ray{Vec3(0.0f), Vec3(NAN, 0.0f, 1.0f)};
     const Sphere s{Vec3(0, 0, 3), 1, 0};

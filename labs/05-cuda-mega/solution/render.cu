@@ -35,7 +35,7 @@ const char* const kLabName = "05-cuda-mega";
 // primitive the scene uses (sections 6 and 7).
 constexpr int kThreadsPerPixel = 32;
 constexpr int kBlockThreads = 64;
-constexpr bool kRegenerate = false;
+constexpr PathLoop kLoop = PathLoop::WholePaths;
 constexpr int kMaxRegisters = 255;
 
 // One kernel per place for the scene (choose_megakernel_scene_memory, scene_constant.cuh),
@@ -44,7 +44,7 @@ constexpr int kMaxRegisters = 255;
 // with the sphere and rectangle tests only (kernel_choice.cuh).
 template <class Choice>
 constexpr auto kernel_for =
-    render_kernel<kThreadsPerPixel, Choice::kMemory, kBlockThreads, kRegenerate, kMaxRegisters,
+    render_kernel<kThreadsPerPixel, Choice::kMemory, kBlockThreads, kLoop, kMaxRegisters,
                   typename Choice::Materials, typename Choice::Primitives>;
 
 // The most bytes of device memory the image's pixels may take at once; more rows than that
