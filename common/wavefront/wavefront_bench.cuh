@@ -95,11 +95,11 @@ static Config wavefront(const Setup& s, std::string name, std::string change,
 
 // Lab 05's reference megakernel (megakernel.cuh, in the shape lab05-ref launches it, for the
 // scene's memory and kinds: kernel_choice.cuh) over the whole image in one launch.
-constexpr int kLab05ThreadsPerPixel = 32, kLab05BlockThreads = 64;
+constexpr int kLab05ThreadsPerPixel = 32, kLab05BlockThreads = 64, kLab05MaxRegisters = 56;
 template <class Choice>
 constexpr auto lab05_kernel =
     render_kernel<kLab05ThreadsPerPixel, Choice::kMemory, kLab05BlockThreads, PathLoop::WholePaths,
-                  255, typename Choice::Materials, typename Choice::Primitives>;
+                  kLab05MaxRegisters, typename Choice::Materials, typename Choice::Primitives>;
 
 template <class Choice>
 static double megakernel(const Setup& s, Image& image) {
@@ -124,23 +124,36 @@ static double megakernel(const Setup& s, Image& image) {
     return timer.seconds();
 }
 
-template <class Pool, class Materials>
+// A configuration of the bench: the reference's choices (wavefront_kernels.cuh) but those given.
+template <class Pool, class Primitives, SceneMemory kMemory, Reserve kHow, class Materials,
+          int kMinBlocks = 1, bool kPrefetch = false, bool kGridPerItem = true>
+using BenchConfig = WavefrontConfig<Pool, kMemory, kHow, Materials, kMinBlocks, kPrefetch,
+                                    kGridPerItem, Primitives>;
+
+template <class Pool, class Materials, class Primitives>
 static void add_pool_configs(const Setup& s, std::vector<Config>& configs) {
-    using Shared = WavefrontConfig<Pool, SceneMemory::Shared, Reserve::kPerBlock, Materials>;
-    using SharedEach = WavefrontConfig<Pool, SceneMemory::Shared, Reserve::kPerThread, Materials>;
-    using SharedWarp = WavefrontConfig<Pool, SceneMemory::Shared, Reserve::kPerWarp, Materials>;
-    using SharedAny = WavefrontConfig<Pool, SceneMemory::Shared, Reserve::kPerBlock, AnyMaterial>;
-    using Global = WavefrontConfig<Pool, SceneMemory::Global, Reserve::kPerBlock, Materials>;
+    using Shared =
+        BenchConfig<Pool, Primitives, SceneMemory::Shared, Reserve::kPerBlock, Materials>;
+    using SharedEach =
+        BenchConfig<Pool, Primitives, SceneMemory::Shared, Reserve::kPerThread, Materials>;
+    using SharedWarp =
+        BenchConfig<Pool, Primitives, SceneMemory::Shared, Reserve::kPerWarp, Materials>;
+    using SharedAny =
+        BenchConfig<Pool, Primitives, SceneMemory::Shared, Reserve::kPerBlock, AnyMaterial>;
+    using SharedAnyGeometry =
+        BenchConfig<Pool, AnyGeometry, SceneMemory::Shared, Reserve::kPerBlock, Materials>;
+    using Global =
+        BenchConfig<Pool, Primitives, SceneMemory::Global, Reserve::kPerBlock, Materials>;
     using Occupancy50 =
-        WavefrontConfig<Pool, SceneMemory::Shared, Reserve::kPerBlock, Materials, 8>;
+        BenchConfig<Pool, Primitives, SceneMemory::Shared, Reserve::kPerBlock, Materials, 8>;
     using Occupancy75 =
-        WavefrontConfig<Pool, SceneMemory::Shared, Reserve::kPerBlock, Materials, 12>;
+        BenchConfig<Pool, Primitives, SceneMemory::Shared, Reserve::kPerBlock, Materials, 12>;
     using Occupancy100 =
-        WavefrontConfig<Pool, SceneMemory::Shared, Reserve::kPerBlock, Materials, 16>;
+        BenchConfig<Pool, Primitives, SceneMemory::Shared, Reserve::kPerBlock, Materials, 16>;
     using Prefetch =
-        WavefrontConfig<Pool, SceneMemory::Shared, Reserve::kPerBlock, Materials, 1, true>;
-    using GridStride =
-        WavefrontConfig<Pool, SceneMemory::Shared, Reserve::kPerBlock, Materials, 1, false, false>;
+        BenchConfig<Pool, Primitives, SceneMemory::Shared, Reserve::kPerBlock, Materials, 1, true>;
+    using GridStride = BenchConfig<Pool, Primitives, SceneMemory::Shared, Reserve::kPerBlock,
+                                   Materials, 1, false, false>;
     const std::string n = Pool::kName;
     if (choose_scene_memory(s.layout) == SceneMemory::Shared) {
         configs.push_back(wavefront<Shared>(s, n, "the lab's reference", kDefaultWavePaths));
@@ -160,6 +173,11 @@ static void add_pool_configs(const Setup& s, std::vector<Config>& configs) {
                                                    "shading compiled for every material kind",
                                                    kDefaultWavePaths));
         }
+        if (!std::is_same_v<Primitives, AnyGeometry>) {
+            configs.push_back(wavefront<SharedAnyGeometry>(
+                s, n + "-all-primitives", "kernels compiled for every primitive kind",
+                kDefaultWavePaths));
+        }
         configs.push_back(wavefront<Occupancy50>(s, n + "-occupancy-50",
                                                  "8 blocks a multiprocessor (at most 64 registers)",
                                                  kDefaultWavePaths));
@@ -178,12 +196,21 @@ static void add_pool_configs(const Setup& s, std::vector<Config>& configs) {
     }
 }
 
+// The configurations for the scene's material and primitive kinds, as the labs' references
+// choose them (wavefront_renderer.cuh).
 template <class... Pools>
 static void add_all_pools(const Setup& s, std::vector<Config>& configs) {
-    if (has_specular_material(s.scene->view().materials, s.scene->view().num_materials)) {
-        (add_pool_configs<Pools, AnyMaterial>(s, configs), ...);
+    const SceneView scene = s.scene->view();
+    const bool specular = has_specular_material(scene.materials, scene.num_materials);
+    const bool box = geometry_kinds(scene).fits<BoxGeometry>();
+    if (specular && box) {
+        (add_pool_configs<Pools, AnyMaterial, BoxGeometry>(s, configs), ...);
+    } else if (specular) {
+        (add_pool_configs<Pools, AnyMaterial, AnyGeometry>(s, configs), ...);
+    } else if (box) {
+        (add_pool_configs<Pools, DiffuseOnly, BoxGeometry>(s, configs), ...);
     } else {
-        (add_pool_configs<Pools, DiffuseOnly>(s, configs), ...);
+        (add_pool_configs<Pools, DiffuseOnly, AnyGeometry>(s, configs), ...);
     }
 }
 

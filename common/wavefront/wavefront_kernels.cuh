@@ -29,7 +29,7 @@
 
 template <class LayoutT, SceneMemory kMemory, Reserve kHow = Reserve::kPerBlock,
           class MaterialsT = AnyMaterial, int kMinBlocks = 1, bool kPrefetchNext = false,
-          bool kGridPerItem = true>
+          bool kGridPerItem = true, class PrimitivesT = AnyGeometry>
 struct WavefrontConfig {
     using Layout = LayoutT;  // AosPathPool (lab 06) or SoaPathPool (lab 07)
     using Pool = PathPool<Layout>;
@@ -37,6 +37,9 @@ struct WavefrontConfig {
     using ShadowRays = Queue<typename Layout::ShadowRays>;
     using Radiance = typename Layout::Radiance;
     using Materials = MaterialsT;  // what shade_hits compiles in: the scene's kinds, or all
+    // The primitive kinds the closest-hit, shading and shadow kernels compile in
+    // (geometry_set.h): BoxGeometry for a scene of spheres and rectangles, or all of them.
+    using Primitives = PrimitivesT;
     static constexpr SceneMemory kSceneMemory = kMemory;
     static constexpr Reserve kReserve = kHow;  // how pushes reserve their places
     // for_each_queued loads each thread's next item ahead (find_closest_hits and
@@ -104,7 +107,9 @@ __global__ void __launch_bounds__(kStageThreads, min_blocks_per_sm(C::kMinBlocks
     const SceneView scene = scene_in<C::kSceneMemory>(args.layout, args.scene_pool, shared_scene);
     for_each_queued<C::kPrefetch>(
         paths, [&](int k) { return paths.items.load_ray(k); },
-        [&](int k, const Ray& ray) { paths.items.store_hit(k, closest_hit(scene, ray)); });
+        [&](int k, const Ray& ray) {
+            paths.items.store_hit(k, closest_hit<typename C::Primitives>(scene, ray));
+        });
 }
 
 // PROCESS: the core's bounce step at each queued path's hit; every path on `paths` is about
@@ -130,7 +135,7 @@ __global__ void __launch_bounds__(kStageThreads, min_blocks_per_sm(C::kMinBlocks
             const QueuedPath queued = paths.items.load(k);
             slot = queued.slot;
             path = {queued.ray, queued.throughput, Vec3(0.0f), bounce, true};
-            wants_shadow_ray = bounce_step<typename C::Materials>(
+            wants_shadow_ray = bounce_step<typename C::Materials, typename C::Primitives>(
                 scene, paths.items.load_hit(k), stream_of(args, wave, slot), args.settings.bounces,
                 path, shadow);
             if (path.radiance.x != 0.0f || path.radiance.y != 0.0f || path.radiance.z != 0.0f) {
@@ -155,7 +160,8 @@ __global__ void __launch_bounds__(kStageThreads, min_blocks_per_sm(C::kMinBlocks
         shadows, [&](int k) { return shadows.items.load(k); },
         [&](int, const QueuedShadowRay& queued) {
             const ShadowRay& s = queued.shadow;
-            if (!occluded(scene, s.ray, s.t_max)) radiance.add(queued.slot, s.radiance);
+            if (!occluded<typename C::Primitives>(scene, s.ray, s.t_max))
+                radiance.add(queued.slot, s.radiance);
         });
 }
 

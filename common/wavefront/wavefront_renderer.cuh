@@ -297,7 +297,9 @@ double render_waves(const RenderJob& job, const cudaDeviceProp& prop, const Scen
 
 // The whole render() of a wavefront lab, for path-pool layout Layout: the scene in each
 // block's shared memory when it is small, else in global memory (lab 05's rule,
-// choose_scene_memory), and a shading kernel for the scene's material kinds.
+// choose_scene_memory), a shading kernel for the scene's material kinds, and kernels for its
+// primitive kinds: BoxGeometry (spheres and axis-aligned rectangles, the Cornell box) when
+// that holds the scene, else every kind.
 template <class Layout>
 RenderStats render_wavefront(const RenderJob& job, Image& image, WavefrontStats* stats = nullptr) {
     const cudaDeviceProp prop = open_device();
@@ -309,15 +311,19 @@ RenderStats render_wavefront(const RenderJob& job, Image& image, WavefrontStats*
         "copying the scene to the GPU");
     const bool shared = choose_scene_memory(layout) == SceneMemory::Shared;
     const bool specular = has_specular_material(job.scene.materials, job.scene.num_materials);
+    const bool box = geometry_kinds(job.scene).fits<BoxGeometry>();
     using S = std::integral_constant<SceneMemory, SceneMemory::Shared>;
     using G = std::integral_constant<SceneMemory, SceneMemory::Global>;
-    const auto render = [&](auto memory, auto materials) {
+    const auto render = [&](auto memory, auto materials, auto primitives) {
         using C = WavefrontConfig<Layout, decltype(memory)::value, Reserve::kPerBlock,
-                                  decltype(materials)>;
+                                  decltype(materials), 1, false, true, decltype(primitives)>;
         return render_waves<C>(job, prop, layout, scene_pool.data(), image, stats);
     };
-    const double seconds =
-        shared ? (specular ? render(S{}, AnyMaterial{}) : render(S{}, DiffuseOnly{}))
-               : (specular ? render(G{}, AnyMaterial{}) : render(G{}, DiffuseOnly{}));
+    const auto in = [&](auto memory, auto materials) {
+        return box ? render(memory, materials, BoxGeometry{})
+                   : render(memory, materials, AnyGeometry{});
+    };
+    const double seconds = shared ? (specular ? in(S{}, AnyMaterial{}) : in(S{}, DiffuseOnly{}))
+                                  : (specular ? in(G{}, AnyMaterial{}) : in(G{}, DiffuseOnly{}));
     return {seconds, describe(prop), kKernelTimeOnly, describe_layout<Layout>()};
 }

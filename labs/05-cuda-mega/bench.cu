@@ -7,15 +7,15 @@
 //                 [--repeat N] [--only NAME[,NAME...]] [--list]
 //
 // "reference" is what lab05-ref runs on the Cornell baseline: 32 threads per pixel, blocks of
-// 64, whole paths, no register cap, the scene in the constant bank, a kernel compiled for
+// 64, whole paths, at most 56 registers, the scene in the constant bank, a kernel compiled for
 // the scene's kinds of material (DiffuseOnly) and primitive (spheres and axis-aligned
 // rectangles: BoxGeometry). Every other shape changes one thing: the scene's primitives
 // (its rectangles as convex quads, or every quad as two triangles, general_geometry.h, each
 // with a kernel for those kinds; "general" is what lab05-ref runs with
-// RT_LAB05_GEOMETRY=general), the kinds compiled in, where the scene lives, path
-// regeneration, a register cap, the work split or the block. "plain" is the first kernel
-// anyone writes (one thread per pixel calling the core's render_pixel, 16x16 blocks, the
-// scene in global memory). A shape compiled for kinds the scene does not fit (DiffuseOnly on
+// RT_LAB05_GEOMETRY=general), the kinds compiled in, where the scene lives, how a thread
+// traces its samples (path regeneration, lanes kept together), the register cap, the work
+// split or the block. "plain" is the first kernel anyone writes (one thread per pixel calling
+// the core's render_pixel, 16x16 blocks, the scene in global memory, no register cap). A shape compiled for kinds the scene does not fit (DiffuseOnly on
 // a scene with mirrors or glass, BoxGeometry on one with triangles) is left out; the first
 // shape run is the image the others are compared with, bit for bit where they render the
 // same primitives. The previous reference (triangles, branching primitive loops, shared
@@ -63,7 +63,7 @@ using SpheresAndQuads = GeometrySet<true, false, true, false>;
 using SpheresAndTriangles = GeometrySet<true, true, false, false>;
 
 struct Variant {
-    const char* name;    // as in the handout's tables
+    const char* name;  // as in the handout's tables
     const char* change;  // what differs from the reference shape
     int threads_per_pixel;
     SceneMemory memory;
@@ -116,48 +116,40 @@ bool fits(const GeometryKinds& kinds) {
 static const std::vector<Variant>& variants() {
     static const std::vector<Variant> all = {
         // The first of these two that the scene fits is the image the others are compared to.
-        SHAPE("reference", "none", 32, Constant, 64, WholePaths, 255),
+        SHAPE("reference", "none", 32, Constant, 64, WholePaths, 56),
         MEGA("all-materials",
              "compiled for every material and primitive kind (lab05-ref on a "
              "scene with mirrors, glass or triangles)",
-             32, Constant, 64, WholePaths, 255, AnyMaterial, AnyGeometry, AsLoaded),
+             32, Constant, 64, WholePaths, 56, AnyMaterial, AnyGeometry, AsLoaded),
         // The primitives: the same walls as other kinds, each with a kernel for its kinds.
         MEGA("general",
              "walls as convex quads, kernel for every kind but rectangles "
              "(lab05-ref with RT_LAB05_GEOMETRY=general)",
-             32, Constant, 64, WholePaths, 255, DiffuseOnly, GeneralGeometry, Quads),
+             32, Constant, 64, WholePaths, 56, DiffuseOnly, GeneralGeometry, Quads),
         MEGA("quads", "walls as convex quads, kernel for spheres and quads", 32, Constant, 64,
-             WholePaths, 255, DiffuseOnly, SpheresAndQuads, Quads),
+             WholePaths, 56, DiffuseOnly, SpheresAndQuads, Quads),
         MEGA("triangles", "walls as two triangles each, kernel for spheres and triangles", 32,
-             Constant, 64, WholePaths, 255, DiffuseOnly, SpheresAndTriangles, Triangles),
-        MEGA("any-geometry", "compiled for every primitive kind", 32, Constant, 64, WholePaths, 255,
+             Constant, 64, WholePaths, 56, DiffuseOnly, SpheresAndTriangles, Triangles),
+        MEGA("any-geometry", "compiled for every primitive kind", 32, Constant, 64, WholePaths, 56,
              DiffuseOnly, AnyGeometry, AsLoaded),
         // Where the scene lives.
-        SHAPE("scene-shared", "scene in shared memory", 32, Shared, 64, WholePaths, 255),
-        SHAPE("scene-global", "scene in global memory", 32, Global, 64, WholePaths, 255),
+        SHAPE("scene-shared", "scene in shared memory", 32, Shared, 64, WholePaths, 56),
+        SHAPE("scene-global", "scene in global memory", 32, Global, 64, WholePaths, 56),
         MEGA("triangles-shared", "walls as two triangles each, scene in shared memory", 32, Shared,
-             64, WholePaths, 255, DiffuseOnly, SpheresAndTriangles, Triangles),
-        // What the previous reference chose and the converged kernel measured again.
+             64, WholePaths, 56, DiffuseOnly, SpheresAndTriangles, Triangles),
+        // How a thread traces its samples, and how many registers it may use.
         SHAPE("regenerate", "path regeneration (trace_samples_regenerating)", 32, Constant, 64,
-              Regenerate, 255),
+              Regenerate, 56),
         SHAPE("together", "the warp's lanes kept together (trace_samples_together)", 32, Constant,
-              64, Together, 255),
+              64, Together, 56),
+        SHAPE("no-register-cap", "registers left to the compiler", 32, Constant, 64, WholePaths,
+              255),
         SHAPE("regs-64", "at most 64 registers", 32, Constant, 64, WholePaths, 64),
-        SHAPE("regs-56", "at most 56 registers", 32, Constant, 64, WholePaths, 56),
         SHAPE("regs-48", "at most 48 registers", 32, Constant, 64, WholePaths, 48),
-        SHAPE("shared-regs-56", "scene in shared memory, at most 56 registers", 32, Shared, 64,
-              WholePaths, 56),
-        SHAPE("together-regs-56", "lanes kept together, at most 56 registers", 32, Constant, 64,
-              Together, 56),
-        SHAPE("together-shared", "lanes kept together, scene in shared memory", 32, Shared, 64,
-              Together, 255),
-        SHAPE("together-shared-regs-56",
-              "lanes kept together, scene in shared memory, at most 56 registers", 32, Shared, 64,
-              Together, 56),
-        SHAPE("split-16", "16 threads per pixel", 16, Constant, 64, WholePaths, 255),
-        SHAPE("split-1", "1 thread per pixel", 1, Constant, 64, WholePaths, 255),
-        SHAPE("block-32", "blocks of 32", 32, Constant, 32, WholePaths, 255),
-        SHAPE("block-128", "blocks of 128", 32, Constant, 128, WholePaths, 255),
+        SHAPE("split-16", "16 threads per pixel", 16, Constant, 64, WholePaths, 56),
+        SHAPE("split-1", "1 thread per pixel", 1, Constant, 64, WholePaths, 56),
+        SHAPE("block-32", "blocks of 32", 32, Constant, 32, WholePaths, 56),
+        SHAPE("block-128", "blocks of 128", 32, Constant, 128, WholePaths, 56),
         {"plain", "render_pixel per pixel, 16x16 blocks, global memory, every kind", 1,
          SceneMemory::Global, 256, PathLoop::WholePaths, 255, false, GeometryForm::AsLoaded,
          "AnyGeometry", fits<AnyGeometry>, reinterpret_cast<const void*>(plain_kernel),

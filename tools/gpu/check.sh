@@ -132,7 +132,7 @@ if ! skipped bench && [ -x lab05-bench ]; then
     say "benchmark: lab05-bench --repeat 5 (the baseline)"
     ./lab05-bench --repeat 5 > "$out/bench.json" 2>> "$log" && step[bench]=ok || step[bench]=failed
     say "benchmark: lab05-bench-fast-math (--use_fast_math), the main shapes"
-    ./lab05-bench-fast-math --repeat 5 --only "${GPU_CHECK_FAST_MATH_VARIANTS:-reference,general,all-materials,scene-shared,regs-64,plain}" \
+    ./lab05-bench-fast-math --repeat 5 --only "${GPU_CHECK_FAST_MATH_VARIANTS:-reference,general,all-materials,scene-shared,no-register-cap,plain}" \
         > "$out/bench-fast-math.json" 2>> "$log" && step[bench_fast_math]=ok || step[bench_fast_math]=failed
 fi
 # The wavefront labs' references and their targets on the baseline (measure.sh, step 8, has
@@ -167,7 +167,7 @@ if ! skipped ncu && [ -n "$ncu_bin" ] && [ -x lab05-bench ]; then
         timeout 180 "$ncu_bin" --clock-control none --metrics "$metrics" --csv --page raw \
             ./lab05-bench --repeat 1 "$@" > "/tmp/gpu-check-ncu-$label.csv" 2>> "$log"
     }
-    ncu_run cornell --spp 64 --only "${GPU_CHECK_NCU_VARIANTS:-plain,reference,triangles,quads,general,regenerate,scene-shared}" &&
+    ncu_run cornell --spp 64 --only "${GPU_CHECK_NCU_VARIANTS:-plain,reference,no-register-cap,triangles,quads,general,regenerate,together,scene-shared}" &&
     ncu_run cornell-1-bounce --spp 64 --bounces 1 --only reference &&
     ncu_run showcase --spp 64 --width 600 --height 600 --scene common/scenes/showcase.json --only reference &&
         step[ncu]=ok || step[ncu]=failed

@@ -30,13 +30,14 @@ const char* const kLabName = "05-cuda-mega";
 // times are in handouts/05-cuda-mega.md): 32 threads share a pixel's samples (a grid of
 // millions of threads, so the last wave of blocks is a small part of the work, while a
 // pixel's threads still fit in one warp for the shuffles; section 3); blocks of 64 threads
-// (section 5); whole paths (section 7: path regeneration did not pay); no register cap
-// (section 7 measures what a cap gives this kernel); only the kinds of material and
-// primitive the scene uses (sections 6 and 7).
+// (section 5); whole paths (section 7: neither path regeneration nor keeping a warp's lanes
+// together paid); at most 56 registers a thread, for half again as many warps to hide the
+// latencies with, at the price of a few spilled bytes (section 7); only the kinds of
+// material and primitive the scene uses (sections 6 and 7).
 constexpr int kThreadsPerPixel = 32;
 constexpr int kBlockThreads = 64;
 constexpr PathLoop kLoop = PathLoop::WholePaths;
-constexpr int kMaxRegisters = 255;
+constexpr int kMaxRegisters = 56;
 
 // One kernel per place for the scene (choose_megakernel_scene_memory, scene_constant.cuh),
 // per set of material kinds (material_set.h) and per set of primitive kinds (geometry_set.h):
