@@ -93,7 +93,13 @@ GEOMETRY_SETS = {
 }
 
 
+# megakernel.cuh's PathLoop, as the demangler writes its values.
+PATH_LOOPS = {"(PathLoop)0": "whole", "(PathLoop)1": "together", "(PathLoop)2": "regenerate"}
+
+
 def short(name: str) -> str:
+    for value, loop in PATH_LOOPS.items():
+        name = name.replace(value, loop)
     name = name.replace("(SceneMemory)0", "global").replace("(SceneMemory)1", "constant")
     name = name.replace("(SceneMemory)2", "shared").replace("SceneMemory::", "")
     name = name.replace("MaterialSet<false, false>", "DiffuseOnly")
