@@ -105,9 +105,9 @@ __device__ inline Ray ray_meeting_nothing() {
 // bounce split: each vote of a primitive test (any_lane) then goes through the slow path of
 // a warp-wide operation in a split warp, and each branch pays for joining the lanes again.
 // Here a lane whose path has ended stays in the loop and traces ray_meeting_nothing() until
-// every lane's path has ended: the warp runs the bounces' primitive loops whole, which costs
-// no more issue slots (the instructions are issued for the live lanes anyway), and only the
-// bounce step, which is branchy by nature, runs on the live lanes alone.
+// every lane's path has ended, so the warp runs each bounce's primitive loops whole and only
+// the bounce step, branchy by nature, runs on the live lanes alone. Keeping count of which
+// lanes still run is not free: handouts/05-cuda-mega.md, section 7, weighs the two.
 template <class Materials, class Primitives>
 __device__ inline SampleSum trace_samples_together(const SceneView& scene, const KernelArgs& args,
                                                    int x, int y, uint64_t pixel, int first,
