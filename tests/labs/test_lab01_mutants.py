@@ -49,8 +49,10 @@ MUTANTS = {
         "path_tracer.h", "hit = {t, PrimitiveKind::Rect, i};", "hit = {t, PrimitiveKind::Rect, 0};",
         ["cornell", "showcase"]),
     "rectangle: inside test of one axis reversed": (
-        "axis_rect.h", "const real sign_u = a < u ? sign_a : -sign_a;",
-        "const real sign_u = a < u ? -sign_a : sign_a;", ["cornell", "showcase"]),
+        "axis_rect.h",
+        "(from_edge(r.lo_u - o_u, d_u) >= 0.0f) & (from_edge(r.hi_u - o_u, d_u) <= 0.0f)",
+        "(from_edge(r.lo_u - o_u, d_u) <= 0.0f) & (from_edge(r.hi_u - o_u, d_u) >= 0.0f)",
+        ["cornell", "showcase"]),
     "no pixel jitter": ("path_tracer.h",
                         "camera.ray_through(x + real(rng.at(kDimPixelX)), "
                         "y + real(rng.at(kDimPixelY)))",
