@@ -25,7 +25,6 @@ import dataclasses
 import functools
 import os
 import pathlib
-import shutil
 import tempfile
 import time
 
@@ -417,11 +416,11 @@ def cores_used(run) -> float:
     return run.cpu_seconds / run.wall_seconds
 
 
-def one_cpu() -> list[str]:
-    """A launcher confining a run to one CPU (lab 02's lesson is SIMD, not threads). A program
-    may widen its own affinity again, so the timed runs' CPU time is checked as well."""
-    cpu = min(os.sched_getaffinity(0))
-    return [shutil.which("taskset") or "taskset", "-c", str(cpu)]
+def one_cpu() -> int:
+    """The CPU lab 02's timed runs are confined to (its lesson is SIMD, not threads). The
+    sandbox refuses widening the affinity again (sandbox.Limits.cpu); the timed runs' CPU time
+    is checked as well, should a way around that be found."""
+    return min(os.sched_getaffinity(0))
 
 
 # Thread by thread (sandbox.TreeClock): in a run of at least THREADS_TELLABLE_SECONDS of CPU
@@ -453,23 +452,23 @@ def check_speedup(binary, baseline, min_speedup: float, *, threads=None, launche
     speed to grade. `scale` renders the golden view that many times larger (checked box-
     filtered down to the golden size); `overhead_reference` (a trusted binary) measures a
     start-up cost, rendering one pixel, that is subtracted from both sides (launch_overhead).
-    `one_core` (lab 02): both sides run confined to one CPU, and a program whose timed runs
-    used more than SERIAL_CORES cores' worth of CPU time earns nothing (threads are not the
-    lesson). Both sides render the timed scene drawn for this grade (timed_scene), whose
-    golden data the trusted lab-01 reference renders first. Points: speed_credit of the
-    speedup."""
+    `one_core` (lab 02): both sides run confined to one CPU, which they cannot widen, and a
+    program whose timed runs used more than SERIAL_CORES cores' worth of CPU time earns
+    nothing (threads are not the lesson). Both sides render the timed scene drawn for this
+    grade (timed_scene), whose golden data the trusted lab-01 reference renders first.
+    Points: speed_credit of the speedup."""
     name = f"speedup >= {min_speedup:g}x"
-    pinned = one_cpu() if one_core else []
+    pinned = one_cpu() if one_core else None
     overhead = launch_overhead(overhead_reference, launcher) if overhead_reference else 0.0
     base, fast, used, base_used, shares = [], [], [], [], []
     with timed_scene() as scene:
         settings = timed_settings(spp, scene, scale)
         reference = timed_golden(scene)
         for _ in range(repeat):
-            base_run = run_lab(baseline, launcher=pinned, **settings)
+            base_run = run_lab(baseline, cpu=pinned, **settings)
             base.append(max(base_run.wall_seconds - overhead, 1e-3))
             base_used.append(cores_used(base_run))
-            run = run_lab(binary, threads=threads, launcher=[*pinned, *launcher], **settings)
+            run = run_lab(binary, threads=threads, launcher=launcher, cpu=pinned, **settings)
             wrong = wrong_timed_image(run.image, spp, scale, reference)
             if wrong:
                 return CheckResult(name, False,

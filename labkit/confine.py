@@ -3,7 +3,8 @@ had): run by the system's Python as the sandbox user, after setpriv and prlimit,
 libseccomp filter (python3-seccomp) and execs the submitted command, which inherits the
 filter and cannot remove it.
 
-    /usr/bin/python3 -I confine.py [--ro PATH]... [--rw PATH]... -- COMMAND...
+    /usr/bin/python3 -I confine.py [--ro PATH]... [--rw PATH]... [--fixed-affinity] -- COMMAND...
+    /usr/bin/python3 -I confine.py --export-affinity-filter > FILTER.bpf
 
 Where the kernel offers Landlock (and the container's seccomp profile lets it through), the
 file system is confined too: read and execute only under the system's folders (/usr, /bin,
@@ -17,6 +18,11 @@ setns, clone with a CLONE_NEW* flag, mount and the new mount API, pivot_root, ch
 perf events, userfaultfd, module and kexec loading, reboot, swap and clock setting. clone3,
 whose flags sit in memory a filter cannot read, answers ENOSYS, so the C library falls back
 to clone, whose flags it can.
+
+A run confined to some CPUs (Limits.cpu: lab 02's timed runs, on one) must not widen its
+affinity again: with --fixed-affinity sched_setaffinity answers EPERM as well. Bubblewrap's
+runs get that one rule alone, as the compiled filter --export-affinity-filter writes (bwrap
+--seccomp FD): its namespaces are their other walls.
 """
 import errno
 import os
@@ -37,9 +43,11 @@ REFUSED = ("ptrace", "process_vm_readv", "process_vm_writev", "kcmp", "add_key",
            "open_by_handle_at", "iopl", "ioperm")
 
 
-def build_filter() -> "seccomp.SyscallFilter":
+def build_filter(fixed_affinity: bool = False) -> "seccomp.SyscallFilter":
     f = seccomp.SyscallFilter(defaction=seccomp.ALLOW)
     deny = seccomp.ERRNO(errno.EPERM)
+    if fixed_affinity:
+        f.add_rule(deny, "sched_setaffinity")
     for name in REFUSED:
         try:
             f.add_rule(deny, name)
@@ -52,6 +60,14 @@ def build_filter() -> "seccomp.SyscallFilter":
         f.add_rule(seccomp.ERRNO(errno.ENOSYS), "clone3")
     except (RuntimeError, ValueError, OSError):
         pass
+    return f
+
+
+def affinity_filter() -> "seccomp.SyscallFilter":
+    """sched_setaffinity refused and nothing else (a call of another architecture's ABI, such
+    as int 0x80, kills the process: libseccomp's default for a foreign architecture)."""
+    f = seccomp.SyscallFilter(defaction=seccomp.ALLOW)
+    f.add_rule(seccomp.ERRNO(errno.EPERM), "sched_setaffinity")
     return f
 
 
@@ -92,7 +108,7 @@ def landlock(read_only, writable) -> bool:
         except OSError:
             return
         rule = PathBeneath(rights, fd)
-        if os.path.isfile(path):
+        if not os.path.isdir(path):  # a directory's rights on a file (or /dev/null) are invalid
             rule.allowed_access &= EXECUTE | WRITE_FILE | READ_FILE
         libc.syscall(LANDLOCK_ADD_RULE, ruleset, 1, ctypes.byref(rule), 0)
         os.close(fd)
@@ -112,14 +128,19 @@ def landlock(read_only, writable) -> bool:
 
 
 def main(argv) -> int:
+    if argv == ["--export-affinity-filter"]:
+        sys.stdout.flush()
+        affinity_filter().export_bpf(sys.stdout)
+        return 0
     if "--" not in argv:
-        print("usage: confine.py [--ro PATH]... [--rw PATH]... -- COMMAND...", file=sys.stderr)
+        print("usage: confine.py [--ro PATH]... [--rw PATH]... [--fixed-affinity] -- COMMAND...",
+              file=sys.stderr)
         return 2
     options, command = argv[:argv.index("--")], argv[argv.index("--") + 1:]
     read_only = [options[i + 1] for i, o in enumerate(options) if o == "--ro"]
     writable = [options[i + 1] for i, o in enumerate(options) if o == "--rw"]
     landlock(read_only, writable)
-    build_filter().load()
+    build_filter(fixed_affinity="--fixed-affinity" in options).load()
     try:
         os.execvp(command[0], command)
     except OSError as e:

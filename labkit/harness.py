@@ -180,18 +180,21 @@ def run_lab(binary: pathlib.Path | str, scene: pathlib.Path | str | None = None,
             width: int | None = None, height: int | None = None, spp: int | None = None,
             bounces: int | None = None, seed: int | None = None, threads: int | None = None,
             extra: Sequence[str] = (), launcher: Sequence[str] = (), timeout: float | None = None,
-            check: bool = True) -> Run:
+            cpu: int | None = None, check: bool = True) -> Run:
     """Render with a lab binary; returns its summary and PFM image.
 
     `launcher` prefixes the command (e.g. mpirun ...). With check=True a run that did not exit
     0 raises RunError naming the symptom (with the binary's stderr), and an image that is
     missing, of the wrong size or not finite raises ImageError. The run goes through
-    labkit/sandbox.py under the current policy(); `timeout` (seconds) lowers its wall limit.
+    labkit/sandbox.py under the current policy(); `timeout` (seconds) lowers its wall limit;
+    `cpu` confines the whole run to that CPU, which it cannot widen (sandbox.Limits.cpu).
     """
     pol = current_policy()
     limits = pol.limits
     if timeout is not None and timeout < limits.wall_seconds:
         limits = dataclasses.replace(limits, wall_seconds=timeout)
+    if cpu is not None:
+        limits = dataclasses.replace(limits, cpu=cpu)
     if scene is None and not pol.trusted:
         scene = DEFAULT_SCENE  # the built-in default path is outside the sandbox's view
     with Runner(trusted=pol.trusted, gpu=pol.gpu) as r:

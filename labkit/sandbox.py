@@ -50,6 +50,9 @@ class Limits:
     processes: int = 256                 # RLIMIT_NPROC: threads count, so MPI and OpenMP fit
     open_files: int = 1024               # RLIMIT_NOFILE
     output_bytes: int = 1 << 20          # kept of stdout and of stderr, each
+    cpu: int | None = None               # the one CPU the whole tree runs on (taskset, by the
+                                         # grader), which it cannot widen: sched_setaffinity
+                                         # is refused in the sandbox (labkit/confine.py)
 
 
 @dataclasses.dataclass
@@ -425,8 +428,10 @@ class Runner:
             return f.read(limit + 1)[:limit + 1]
 
     # ---- running --------------------------------------------------------------------------
-    def command(self, argv: Sequence[str], limits: Limits, env: dict[str, str]) -> list[str]:
-        """The full command line: bubblewrap (unless trusted), then prlimit, then argv."""
+    def command(self, argv: Sequence[str], limits: Limits, env: dict[str, str],
+                seccomp_fd: int | None = None) -> list[str]:
+        """The full command line: taskset (for limits.cpu), bubblewrap (unless trusted; with
+        the filter read from `seccomp_fd`), then prlimit, then argv."""
         nproc = limits.processes
         if not self.drop_to_nobody and os.geteuid() != 0:
             nproc += _threads_of(os.geteuid())
@@ -437,16 +442,20 @@ class Runner:
         if os.geteuid() != 0 or self.drop_to_nobody:  # root ignores RLIMIT_NPROC anyway
             inner.append(f"--nproc={nproc}")
         inner += ["--", *argv]
+        pin = [] if limits.cpu is None else [shutil.which("taskset") or "taskset", "-c",
+                                             str(limits.cpu)]
         if self.trusted:
-            return inner
+            return pin + inner
         if self.user_mode:
             uid, gid = self.owner
             paths = ["--ro", str(pathlib.Path(_confine_script()).parent),
                      "--ro", str(self.root / "inputs"), "--rw", str(self._scratch_dir())]
             for path, writable in self.binds:
                 paths += ["--rw" if writable else "--ro", path]
-            return [shutil.which("setpriv") or "setpriv", f"--reuid={uid}", f"--regid={gid}",
-                    "--clear-groups", "--no-new-privs", "--inh-caps=-all", "--",
+            if limits.cpu is not None:
+                paths.append("--fixed-affinity")
+            return [*pin, shutil.which("setpriv") or "setpriv", f"--reuid={uid}",
+                    f"--regid={gid}", "--clear-groups", "--no-new-privs", "--inh-caps=-all", "--",
                     *inner[:inner.index("--") + 1],
                     SYSTEM_PYTHON, "-I", _confine_script(), *paths, "--", *argv]
         scratch = self._scratch_dir()
@@ -463,10 +472,12 @@ class Runner:
             from labkit.gpu import sandbox_args
             cmd += sandbox_args()
         cmd += ["--remount-ro", "/"]  # bubblewrap's root is a tmpfs: no files may go there
+        if seccomp_fd is not None:
+            cmd += ["--seccomp", str(seccomp_fd)]
         for key, value in {"PATH": "/usr/local/bin:/usr/bin:/bin", "HOME": SCRATCH,
                            "TMPDIR": "/tmp", "LANG": "C.UTF-8", **env}.items():
             cmd += ["--setenv", key, value]
-        return cmd + ["--", *inner]
+        return pin + cmd + ["--", *inner]
 
     def run(self, argv: Sequence[str], limits: Limits = Limits(),
             env: dict[str, str] | None = None) -> Outcome:
@@ -483,12 +494,20 @@ class Runner:
             cwd = scratch
         else:
             full_env, cwd = None, self.root
-        cmd = self.command(argv, limits, env)
+        seccomp_fd = None
+        if limits.cpu is not None and not (self.trusted or self.user_mode):
+            seccomp_fd = _filter_pipe(affinity_filter())
+        cmd = self.command(argv, limits, env, seccomp_fd)
         user = dict(user=NOBODY, group=NOBODY, extra_groups=[]) if self.drop_to_nobody else {}
         start = time.perf_counter()
-        p = subprocess.Popen(cmd, stdin=subprocess.DEVNULL, stdout=subprocess.PIPE,
-                             stderr=subprocess.PIPE, env=full_env, cwd=cwd,
-                             start_new_session=True, **user)
+        try:
+            p = subprocess.Popen(cmd, stdin=subprocess.DEVNULL, stdout=subprocess.PIPE,
+                                 stderr=subprocess.PIPE, env=full_env, cwd=cwd,
+                                 start_new_session=True,
+                                 pass_fds=() if seccomp_fd is None else (seccomp_fd,), **user)
+        finally:
+            if seccomp_fd is not None:
+                os.close(seccomp_fd)
         try:
             outcome = _supervise(p, start, limits)
         finally:
@@ -500,6 +519,33 @@ class Runner:
                 outcome.killed = (f"left {used / 2**20:.0f} MiB in its scratch folder "
                                   f"(allowed {limits.scratch_bytes / 2**20:.0f} MiB)")
         return outcome
+
+
+_affinity_filter: list[bytes] = []
+
+
+def affinity_filter() -> bytes:
+    """The compiled seccomp filter refusing sched_setaffinity (labkit/confine.py), made once by
+    the system's Python, whose python3-seccomp the grader's own environment may lack."""
+    if not _affinity_filter:
+        p = subprocess.run([SYSTEM_PYTHON, "-I", _confine_script(), "--export-affinity-filter"],
+                           capture_output=True)
+        if p.returncode != 0 or not p.stdout:
+            raise OSError("a run confined to one CPU needs python3-seccomp for "
+                          f"{SYSTEM_PYTHON} (its filter refuses widening the affinity): "
+                          "run `make deps`")
+        _affinity_filter.append(p.stdout)
+    return _affinity_filter[0]
+
+
+def _filter_pipe(program: bytes) -> int:
+    """A pipe's read end holding `program` (smaller than a pipe's buffer), for bwrap --seccomp."""
+    read_end, write_end = os.pipe()
+    try:
+        os.write(write_end, program)
+    finally:
+        os.close(write_end)
+    return read_end
 
 
 SAMPLE_SECONDS = 0.05

@@ -207,11 +207,24 @@ FLOAT_LIMIT = "__import__('numpy').where(image == image.max(), 3.3e38, image).as
 
 def threads_on_every_cpu(folder, parallel_reference: pathlib.Path) -> pathlib.Path:
     """Lab 03's scalar OpenMP reference handed in for lab 02, widening its CPU affinity to
-    every CPU of the machine before it starts (undoing a confinement to one)."""
+    every CPU of the machine (undoing a confinement to one), with a thread per CPU, and
+    rendering whether or not the widening was allowed."""
     import os
     cpus = ",".join(str(c) for c in sorted(os.sched_getaffinity(0)))
-    return carrying_reference(folder, f'exec taskset -c {cpus} ./ref "$@"',
-                              reference=parallel_reference)
+    return carrying_reference(
+        folder, f'taskset -a -p -c {cpus} $$ >/dev/null 2>&1\n'
+                f'OMP_NUM_THREADS={len(cpus.split(","))} exec ./ref "$@"',
+        reference=parallel_reference)
+
+
+def widen_affinity_script() -> str:
+    """A shell script that prints its allowed CPUs, tries to take every CPU of the machine
+    (printing "widened" if it could) and prints them again."""
+    import os
+    cpus = ",".join(str(c) for c in sorted(os.sched_getaffinity(0)))
+    return (f"grep Cpus_allowed_list /proc/self/status; "
+            f"taskset -p -c {cpus} $$ >/dev/null 2>&1 && echo widened; "
+            f"grep Cpus_allowed_list /proc/self/status")
 
 
 # Prints, for every render, the published closed-form answer of the analytic scenes as they

@@ -57,6 +57,22 @@ def test_wall_limit_counts_from_outside():
     assert 0.5 <= out.wall_seconds < 3
 
 
+def test_a_run_confined_to_one_cpu_cannot_widen_its_affinity():
+    """Limits.cpu: the whole run is on that CPU and sched_setaffinity is refused (bwrap
+    --seccomp), where an unconfined run may change its affinity."""
+    import os
+
+    from tests.grading.submissions import widen_affinity_script
+    cpus = sorted(os.sched_getaffinity(0))
+    if len(cpus) < 2:
+        pytest.skip("one CPU: nothing to widen to")
+    free = sh(widen_affinity_script())
+    assert "widened" in free.stdout, free
+    confined = sh(widen_affinity_script(), Limits(wall_seconds=10, cpu=cpus[-1]))
+    assert confined.returncode == 0, confined
+    assert confined.stdout.split() == ["Cpus_allowed_list:", str(cpus[-1])] * 2, confined
+
+
 @pytest.mark.parametrize("code, name", [(-11, "segmentation fault (signal 11)"),
                                         (139, "segmentation fault (signal 11)"),
                                         (134, "aborted (signal 6)"), (3, "exited with status 3")])

@@ -107,6 +107,20 @@ echo "SECRET=$GRADING_SECRET"
     assert not left, left
 
 
+def test_a_run_confined_to_one_cpu_cannot_widen_its_affinity(user_sandbox):
+    """Limits.cpu in the user sandbox: confine.py's filter refuses sched_setaffinity there."""
+    cpus = sorted(os.sched_getaffinity(0))
+    if len(cpus) < 2:
+        pytest.skip("one CPU: nothing to widen to")
+    script = ["/bin/sh", "-c", sub.widen_affinity_script()]
+    with sandbox.Runner(trusted=False) as r:
+        free = r.run(script, sandbox.Limits(wall_seconds=10))
+        confined = r.run(script, sandbox.Limits(wall_seconds=10, cpu=cpus[-1]))
+    assert "widened" in free.stdout and not free.stderr, free  # it may write to /dev/null
+    assert confined.returncode == 0, confined
+    assert confined.stdout.split() == ["Cpus_allowed_list:", str(cpus[-1])] * 2, confined
+
+
 def test_a_private_temporary_folder_is_refused_in_one_line(tmp_path):
     """The sandbox user must enter the folder where inputs and builds are staged: a private
     one (mode 700, as a fresh temporary folder is) is one line naming it, marked for regrade."""
