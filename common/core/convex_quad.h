@@ -112,46 +112,39 @@ RT_HD inline Vec3 step_off_edges(const ConvexQuad& quad, Vec3 p, real margin) {
     return step;
 }
 
-// Watertight ray/quad intersection: intersect_triangle's plane cull, then its ray-space edge
-// functions, one per edge v0v1, v1v2, v2v3, v3v0, each computed as the triangle's of the same
-// directed edge (edge_function of the sheared vertices, the same operand order). A triangle or
-// quad across a shared edge (the same float endpoints) computes exactly the negated value, so
-// a ray through the edge hits at least one of the two. The ray passes inside when no two edge
-// functions have opposite signs (the quad is convex); the distance is then the plane's,
-// num / denom of the cull. Returns the distance in (0, t_max), or t_max for a miss; rays
-// parallel to the plane, quads with no area and NaN miss.
+// Watertight ray/quad intersection: the triangle's plane cull (plane_culled), then its ray-space
+// edge functions, one per edge v0v1, v1v2, v2v3, v3v0, each computed as the triangle's of the same
+// directed edge (edge_function of the vertices shear_vertex gives, the same operand order). A
+// triangle or quad across a shared edge (the same float endpoints) computes exactly the negated
+// value, so a ray through the edge hits at least one of the two. The ray passes inside when no two
+// edge functions have opposite signs (the quad is convex); the distance is then the plane's,
+// num / denom of the cull. Returns the distance in (0, t_max), or t_max for a miss; rays parallel
+// to the plane, quads with no area and NaN miss.
 template <bool kConverged = kConvergedTests>  // rt_hd.h
 RT_HD inline real intersect_quad(const Ray& ray, const RayShear& shear, const ConvexQuad& quad,
                                  real t_max) {
     const real denom = dot(quad.normal, ray.direction);
     const real num = quad.plane_offset - dot(quad.normal, ray.origin);
-    const bool behind = !(num * denom > 0.0f);  // NaN is culled too
-    const bool beyond = fabs_real(num) >= t_max * real(1.00001f) * fabs_real(denom);
-    const bool culled = behind | beyond;
+    const bool culled = plane_culled(num, denom, t_max);
     // Converged, the warp skips the rest when every lane's cull rejects the primitive (the
     // same answer, t_max, on every lane), and runs it on all of them otherwise.
     if (kConverged ? !any_lane(!culled) : culled) return t_max;
 
-    const Vec3 a = quad.v0 - ray.origin;
-    const Vec3 b = quad.v1 - ray.origin;
-    const Vec3 c = quad.v2 - ray.origin;
-    const Vec3 d = quad.v3 - ray.origin;
-    const real az = a[shear.kz], bz = b[shear.kz], cz = c[shear.kz], dz = d[shear.kz];
-    const real ax = a[shear.kx] - shear.sx * az, ay = a[shear.ky] - shear.sy * az;
-    const real bx = b[shear.kx] - shear.sx * bz, by = b[shear.ky] - shear.sy * bz;
-    const real cx = c[shear.kx] - shear.sx * cz, cy = c[shear.ky] - shear.sy * cz;
-    const real dx = d[shear.kx] - shear.sx * dz, dy = d[shear.ky] - shear.sy * dz;
+    const ShearedVertex a = shear_vertex(quad.v0, ray, shear);
+    const ShearedVertex b = shear_vertex(quad.v1, ray, shear);
+    const ShearedVertex c = shear_vertex(quad.v2, ray, shear);
+    const ShearedVertex d = shear_vertex(quad.v3, ray, shear);
 
     // Edge p -> q as the triangle computes it: edge_function(q, p) (its w is v0v1's).
-    real e01 = edge_function(bx, by, ax, ay);
-    real e12 = edge_function(cx, cy, bx, by);
-    real e23 = edge_function(dx, dy, cx, cy);
-    real e30 = edge_function(ax, ay, dx, dy);
+    real e01 = edge_function(b.x, b.y, a.x, a.y);
+    real e12 = edge_function(c.x, c.y, b.x, b.y);
+    real e23 = edge_function(d.x, d.y, c.x, c.y);
+    real e30 = edge_function(a.x, a.y, d.x, d.y);
     if (!culled && (e01 == 0.0f || e12 == 0.0f || e23 == 0.0f || e30 == 0.0f)) {  // rare
-        e01 = static_cast<real>(edge_function_exact(bx, by, ax, ay));
-        e12 = static_cast<real>(edge_function_exact(cx, cy, bx, by));
-        e23 = static_cast<real>(edge_function_exact(dx, dy, cx, cy));
-        e30 = static_cast<real>(edge_function_exact(ax, ay, dx, dy));
+        e01 = static_cast<real>(edge_function_exact(b.x, b.y, a.x, a.y));
+        e12 = static_cast<real>(edge_function_exact(c.x, c.y, b.x, b.y));
+        e23 = static_cast<real>(edge_function_exact(d.x, d.y, c.x, c.y));
+        e30 = static_cast<real>(edge_function_exact(a.x, a.y, d.x, d.y));
     }
     const bool any_negative = (e01 < 0.0f) | (e12 < 0.0f) | (e23 < 0.0f) | (e30 < 0.0f);
     const bool any_positive = (e01 > 0.0f) | (e12 > 0.0f) | (e23 > 0.0f) | (e30 > 0.0f);

@@ -98,6 +98,34 @@ struct RayShear {
     }
 };
 
+// A vertex in the ray's sheared space: relative to the origin, its axes permuted by the
+// RayShear and sheared so that the ray runs along +z. z is left unscaled: the tests scale the
+// distance by sz once. Triangles and quads that share a vertex get the same bits for it.
+struct ShearedVertex {
+    real x, y, z;
+};
+RT_HD RT_FORCE_INLINE ShearedVertex shear_vertex(Vec3 vertex, const Ray& ray,
+                                                 const RayShear& shear) {
+    const Vec3 a = vertex - ray.origin;
+    const real z = a[shear.kz];
+    return {a[shear.kx] - shear.sx * z, a[shear.ky] - shear.sy * z, z};
+}
+
+// The cheap cull both sheared tests start with (intersect_triangle, intersect_quad), from the
+// plane's distance along the ray, num / denom (denom = normal . direction): whether the plane lies
+// behind the ray or clearly beyond t_max (ten times fewer flops than the full test; most primitives
+// of a closed room end here). It only rejects, never accepts, so the watertight test still decides
+// every hit; the 1e-5 margin keeps rounding from culling a hit right at t_max. Parallel rays and
+// degenerate primitives (zero normal) have denom == 0 and are culled too, and so is NaN. Bitwise |
+// rather than ||: one well-predicted branch instead of several random ones; on a GPU the lanes that
+// passed the cull still run the test together with those that did not, whose cull joins the final
+// select (kConvergedTests, rt_hd.h).
+RT_HD RT_FORCE_INLINE bool plane_culled(real num, real denom, real t_max) {
+    const bool behind = !(num * denom > 0.0f);
+    const bool beyond = fabs_real(num) >= t_max * real(1.00001f) * fabs_real(denom);
+    return behind | beyond;
+}
+
 // 2D edge function of directed edge p -> q as seen from the ray: twice the signed area of
 // (origin, p, q). Computed as two rounded products and one rounded difference, never fused:
 // then the neighbour that shares the edge gets exactly the negated value, which is what makes
@@ -147,38 +175,24 @@ RT_HD inline double edge_function_exact(double px, double py, double qx, double 
 template <bool kConverged = kConvergedTests>  // rt_hd.h
 RT_HD inline real intersect_triangle(const Ray& ray, const RayShear& shear, const Triangle& tri,
                                      real t_max) {
-    // Cheap cull first: skip the triangle when its plane lies behind the ray or clearly beyond
-    // t_max (ten times fewer flops than the full test; most triangles of a closed room end
-    // here). It only rejects, never accepts, so the watertight test below still decides every
-    // hit; the 1e-5 margin keeps rounding from culling a hit right at t_max. Parallel rays and
-    // degenerate triangles (zero normal) have denom == 0 and are culled too.
     const real denom = dot(tri.normal, ray.direction);
     const real num = tri.plane_offset - dot(tri.normal, ray.origin);  // t_plane = num / denom
-    // Bitwise | rather than ||: one well-predicted branch instead of several random ones. On
-    // a GPU the lanes that passed the cull still run the test together with those that did
-    // not, whose cull joins the final select (kConvergedTests, rt_hd.h).
-    const bool behind = !(num * denom > 0.0f);  // NaN is culled too
-    const bool beyond = fabs_real(num) >= t_max * real(1.00001f) * fabs_real(denom);
-    const bool culled = behind | beyond;
+    const bool culled = plane_culled(num, denom, t_max);
     // Converged, the warp skips the rest when every lane's cull rejects the primitive (the
     // same answer, t_max, on every lane), and runs it on all of them otherwise.
     if (kConverged ? !any_lane(!culled) : culled) return t_max;
 
-    const Vec3 a = tri.v0 - ray.origin;
-    const Vec3 b = tri.v1 - ray.origin;
-    const Vec3 c = tri.v2 - ray.origin;
-    const real az = a[shear.kz], bz = b[shear.kz], cz = c[shear.kz];
-    const real ax = a[shear.kx] - shear.sx * az, ay = a[shear.ky] - shear.sy * az;
-    const real bx = b[shear.kx] - shear.sx * bz, by = b[shear.ky] - shear.sy * bz;
-    const real cx = c[shear.kx] - shear.sx * cz, cy = c[shear.ky] - shear.sy * cz;
+    const ShearedVertex a = shear_vertex(tri.v0, ray, shear);
+    const ShearedVertex b = shear_vertex(tri.v1, ray, shear);
+    const ShearedVertex c = shear_vertex(tri.v2, ray, shear);
 
-    real u = edge_function(cx, cy, bx, by);
-    real v = edge_function(ax, ay, cx, cy);
-    real w = edge_function(bx, by, ax, ay);
+    real u = edge_function(c.x, c.y, b.x, b.y);
+    real v = edge_function(a.x, a.y, c.x, c.y);
+    real w = edge_function(b.x, b.y, a.x, a.y);
     if (!culled && (u == 0.0f || v == 0.0f || w == 0.0f)) {  // rare: on an edge, or rounded
-        u = static_cast<real>(edge_function_exact(cx, cy, bx, by));
-        v = static_cast<real>(edge_function_exact(ax, ay, cx, cy));
-        w = static_cast<real>(edge_function_exact(bx, by, ax, ay));
+        u = static_cast<real>(edge_function_exact(c.x, c.y, b.x, b.y));
+        v = static_cast<real>(edge_function_exact(a.x, a.y, c.x, c.y));
+        w = static_cast<real>(edge_function_exact(b.x, b.y, a.x, a.y));
     }
     const bool any_negative = (u < 0.0f) | (v < 0.0f) | (w < 0.0f);
     const bool any_positive = (u > 0.0f) | (v > 0.0f) | (w > 0.0f);
@@ -186,7 +200,7 @@ RT_HD inline real intersect_triangle(const Ray& ray, const RayShear& shear, cons
     if (!kConverged && outside) return t_max;
 
     const real det = u + v + w;  // 0 for a parallel ray or a degenerate triangle: a miss
-    const real t_scaled = u * (shear.sz * az) + v * (shear.sz * bz) + w * (shear.sz * cz);
+    const real t_scaled = u * (shear.sz * a.z) + v * (shear.sz * b.z) + w * (shear.sz * c.z);
     // t = t_scaled / det must lie in (0, t_max); compare without dividing first.
     const real sign = copysign_real(real(1), det);
     const real t_signed = t_scaled * sign;
