@@ -441,14 +441,26 @@ SERIAL_CORES = 1.1
 ONE_CORE_SHARE = 1.3
 
 
+# The reference runs twice a round, before and after the program, and the speedup is over
+# the best of all its runs: a load that slowed only some of them does not make the program
+# look faster. How far its two series' bests lie apart (at least 1) says how much a ratio
+# measured then may be off; where the credit differs between the speedup divided and
+# multiplied by that, the rounds are measured again, up to `attempts` times, and failing
+# that the lower credit counts and the rest is left to a regrade. Beside a process burning a
+# core, while another build ran, lab01-ref once measured 0.248 s at best in three runs on
+# one CPU against 0.205 s for lab 03's reference on that CPU: 1.21x for a program no faster.
+
+
 @image_checked("speedup")
 def check_speedup(binary, baseline, min_speedup: float, *, threads=None, launcher=(),
-                  repeat: int = 3, spp: int = 256, scale: int = 1,
+                  repeat: int = 3, spp: int = 256, scale: int = 1, attempts: int = 3,
                   overhead_reference=None, one_core: bool = False) -> CheckResult:
     """Wall-clock time against a baseline binary (the lab-01 reference; a GPU lab's own
     reference), measured by the grader around each whole process (never the `seconds` a
-    program reports about itself), interleaved, best of `repeat`: a ratio, so a busy machine
-    slows both sides alike. Every timed image must match the golden image, or there is no
+    program reports about itself), interleaved, best of `repeat` rounds, the reference before
+    and after the program in each: a ratio, so a busy machine slows both sides alike, and a
+    ratio the reference's own two series disagree about is measured again or left to a
+    regrade (see above). Every timed image must match the golden image, or there is no
     speed to grade. `scale` renders the golden view that many times larger (checked box-
     filtered down to the golden size); `overhead_reference` (a trusted binary) measures a
     start-up cost, rendering one pixel, that is subtracted from both sides (launch_overhead).
@@ -460,44 +472,65 @@ def check_speedup(binary, baseline, min_speedup: float, *, threads=None, launche
     name = f"speedup >= {min_speedup:g}x"
     pinned = one_cpu() if one_core else None
     overhead = launch_overhead(overhead_reference, launcher) if overhead_reference else 0.0
-    base, fast, used, base_used, shares = [], [], [], [], []
-    with timed_scene() as scene:
-        settings = timed_settings(spp, scene, scale)
-        reference = timed_golden(scene)
-        for _ in range(repeat):
-            base_run = run_lab(baseline, cpu=pinned, **settings)
-            base.append(max(base_run.wall_seconds - overhead, 1e-3))
-            base_used.append(cores_used(base_run))
-            run = run_lab(binary, threads=threads, launcher=launcher, cpu=pinned, **settings)
-            wrong = wrong_timed_image(run.image, spp, scale, reference)
-            if wrong:
-                return CheckResult(name, False,
-                                   f"{wrong}: speed is graded only for a correct image",
-                                   credit=0.0)
-            fast.append(max(run.wall_seconds - overhead, 1e-3))
-            used.append(cores_used(run))
-            if (run.cpu_seconds or 0) >= THREADS_TELLABLE_SECONDS:
-                shares.append(busiest_thread_share(run))
-    ratios = sorted(y / b for y, b in zip(used, base_used) if b > 0)
-    share = ratios[len(ratios) // 2] if ratios else float("nan")
-    if one_core and not (max(used) <= SERIAL_CORES and share <= ONE_CORE_SHARE
-                         and all(s >= SHARED_WORK for s in shares)):
-        return CheckResult(name, False,
-                           f"the timed runs used up to {max(used):.2f} cores' worth of CPU time, "
-                           f"{share:.2f}x the share of the reference on one CPU, their busiest "
-                           f"thread as little as {min(shares, default=1.0):.0%} of it (measured "
-                           f"by the grader; allowed {SERIAL_CORES:g}, {ONE_CORE_SHARE:g}x and "
-                           f"{SHARED_WORK:.0%}): lab 02 is timed on one core, its speed must come "
-                           f"from SIMD, not threads", credit=0.0)
-    speedup = min(base) / min(fast)
-    credit = speed_credit(speedup, min_speedup)
     note = (f", less {overhead:.3f} s of start-up measured on the reference rendering one pixel"
             if overhead else "")
     where = ", both on one CPU" if one_core else ""
-    return CheckResult(name, credit > 0,
-                       f"{speedup:.2f}x ({min(base):.3f} s -> {min(fast):.3f} s wall clock "
-                       f"measured by the grader{note}{where}, best of {repeat})"
-                       + credit_note(credit, min_speedup), credit=credit)
+    with timed_scene() as scene:
+        settings = timed_settings(spp, scene, scale)
+        reference = timed_golden(scene)
+
+        def reference_run(used: list[float]) -> float:
+            run = run_lab(baseline, cpu=pinned, **settings)
+            used.append(cores_used(run))
+            return max(run.wall_seconds - overhead, 1e-3)
+
+        for attempt in range(1, attempts + 1):
+            before, after, fast, used, base_used, shares = [], [], [], [], [], []
+            for _ in range(repeat):
+                before.append(reference_run(base_used))
+                run = run_lab(binary, threads=threads, launcher=launcher, cpu=pinned,
+                              **settings)
+                wrong = wrong_timed_image(run.image, spp, scale, reference)
+                if wrong:
+                    return CheckResult(name, False,
+                                       f"{wrong}: speed is graded only for a correct image",
+                                       credit=0.0)
+                fast.append(max(run.wall_seconds - overhead, 1e-3))
+                used.append(cores_used(run))
+                if (run.cpu_seconds or 0) >= THREADS_TELLABLE_SECONDS:
+                    shares.append(busiest_thread_share(run))
+                after.append(reference_run([]))
+            ratios = sorted(y / b for y, b in zip(used, base_used) if b > 0)
+            share = ratios[len(ratios) // 2] if ratios else float("nan")
+            if one_core and not (max(used) <= SERIAL_CORES and share <= ONE_CORE_SHARE
+                                 and all(s >= SHARED_WORK for s in shares)):
+                return CheckResult(
+                    name, False,
+                    f"the timed runs used up to {max(used):.2f} cores' worth of CPU time, "
+                    f"{share:.2f}x the share of the reference on one CPU, their busiest "
+                    f"thread as little as {min(shares, default=1.0):.0%} of it (measured by "
+                    f"the grader; allowed {SERIAL_CORES:g}, {ONE_CORE_SHARE:g}x and "
+                    f"{SHARED_WORK:.0%}): lab 02 is timed on one core, its speed must come "
+                    f"from SIMD, not threads", credit=0.0)
+            base = min(before + after)
+            speedup = base / min(fast)
+            unsteady = max(min(before), min(after)) / base
+            low = speed_credit(speedup / unsteady, min_speedup)
+            high = speed_credit(speedup * unsteady, min_speedup)
+            if low == high:
+                break
+            if attempt < attempts:
+                time.sleep(2.0 * attempt)  # let the other load pass
+    detail = (f"{speedup:.2f}x ({base:.3f} s -> {min(fast):.3f} s wall clock measured by the "
+              f"grader{note}{where}, best of {repeat} rounds, the reference twice a round)")
+    if low != high:
+        return CheckResult(name, low > 0,
+                           f"{detail}: the reference's best before and after the program lay "
+                           f"{unsteady - 1:.1%} apart, too unsteady to tell {low:.0%} of the "
+                           f"points from {high:.0%} in {attempts} attempts; {low:.0%} now, the "
+                           f"rest marked for regrade", regrade=True, credit=low,
+                           provisional=1.0 - low)
+    return CheckResult(name, low > 0, detail + credit_note(low, min_speedup), credit=low)
 
 
 def launch_overhead(reference, launcher, rounds: int = 3) -> float:

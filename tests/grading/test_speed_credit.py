@@ -87,3 +87,52 @@ def test_serial_is_final_even_where_nothing_is_timed(monkeypatch, binary, serial
         assert result.detail.startswith("serial: in every timed run one thread did"), result.detail
     else:
         assert result.regrade and result.passed and result.provisional == 1, result
+
+
+def timed_with(monkeypatch, before: float, yours: float, after: float):
+    """check_speedup with every run replaced by one that takes the given wall-clock seconds:
+    the reference's run before the program in each round, the program's, the reference's
+    after it. Returns the result and how many runs of the program it measured."""
+    import numpy as np
+
+    from grading import checks
+    from labkit.harness import Run
+    calls = {"yours": 0, "reference": 0}
+
+    def run_lab(binary, **_):
+        if binary == "yours":
+            calls["yours"] += 1
+            seconds = yours
+        else:
+            seconds = before if calls["reference"] % 2 == 0 else after
+            calls["reference"] += 1
+        return Run(0, "", "", {}, np.zeros((1, 1, 3), np.float32), seconds, seconds, 1.0)
+
+    monkeypatch.setattr(checks, "run_lab", run_lab)
+    monkeypatch.setattr(checks, "timed_golden", lambda scene: None)
+    monkeypatch.setattr(checks, "wrong_timed_image", lambda *args: None)
+    monkeypatch.setattr(checks.time, "sleep", lambda seconds: None)
+    result = checks.check_speedup("yours", "reference", 1.5)
+    return result, calls["yours"]
+
+
+def test_a_speedup_the_references_own_runs_disagree_about_is_left_to_a_regrade(monkeypatch):
+    """The reference slowed before the program but not after it: 1.5x over its runs before
+    (full points, were they the only ones), 1.25x over its best, and its two series 20% apart,
+    which could make that anything from 1.04x to 1.5x. Measured again, then the lower credit
+    counts and the rest waits for a regrade."""
+    result, measured = timed_with(monkeypatch, before=0.30, yours=0.20, after=0.25)
+    assert result.regrade and result.credit == 0 and result.provisional == 1, result
+    assert not result.passed and measured == 9, (result, measured)
+    assert "1.25x (0.250 s -> 0.200 s" in result.detail and "20.0% apart" in result.detail
+
+
+def test_a_steady_reference_gives_final_credit(monkeypatch):
+    result, measured = timed_with(monkeypatch, before=0.25, yours=0.20, after=0.25)
+    assert not result.regrade and result.credit == pytest.approx(1 / 3) and measured == 3, result
+
+
+def test_an_unsteady_reference_that_cannot_change_the_credit_is_final(monkeypatch):
+    """Far above the bar, 10% of unsteadiness changes nothing: full points at once."""
+    result, measured = timed_with(monkeypatch, before=1.0, yours=0.1, after=0.9)
+    assert not result.regrade and result.credit == 1 and measured == 3, result
