@@ -446,9 +446,8 @@ ONE_CORE_SHARE = 1.3
 # look faster. How far its two series' bests lie apart (at least 1) says how much a ratio
 # measured then may be off; where the credit differs between the speedup divided and
 # multiplied by that, the rounds are measured again, up to `attempts` times, and failing
-# that the lower credit counts and the rest is left to a regrade. Beside a process burning a
-# core, while another build ran, lab01-ref once measured 0.248 s at best in three runs on
-# one CPU against 0.205 s for lab 03's reference on that CPU: 1.21x for a program no faster.
+# that the lower credit counts and the rest is left to a regrade (grading/README.md has the
+# measurement that called for it).
 
 
 @image_checked("speedup")
