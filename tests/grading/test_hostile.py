@@ -463,8 +463,8 @@ def speed_test(results, check: str = "parallel-speedup") -> dict:
 @pytest.mark.parametrize("burner", [False, True], ids=["quiet", "beside-a-burner"])
 def test_threads_in_the_simd_lab_earn_no_speed(tmp_path, burner):
     """Scalar code on every core, handed in for lab 02: the timed runs are confined to one
-    CPU that the sandbox refuses to widen, and their CPU time is measured, so the threads earn
-    nothing, on a quiet machine or beside a process burning a core."""
+    CPU that the sandbox refuses to widen, so the threads share it and earn nothing, on a
+    quiet machine or beside a process burning a core."""
     from labkit.harness import build
     lab03_ref, = build("lab03-ref")
     binary = sub.threads_on_every_cpu(tmp_path, lab03_ref)
