@@ -121,11 +121,15 @@ def test_output_replaced_whole(lab01_ref, tmp_path):
 @pytest.mark.parametrize("signal_number", [signal.SIGINT, signal.SIGTERM])
 def test_interrupted_render_leaves_nothing(lab01_ref, tmp_path, signal_number):
     """Ctrl-C (or a grader's kill) during a long render: the process dies of that signal and
-    no '*.partial-*' temporary of --out/--pfm is left; an existing output stays as it was."""
+    no '*.partial-*' temporary of --out/--pfm is left; an existing output stays as it was.
+    The render starts with the signal's default action, as from a terminal: a program keeps
+    a signal ignored that it was started ignoring (a shell does that to commands it starts in
+    the background), and so does this one, which would then render to the end."""
     (tmp_path / "old.ppm").write_bytes(b"keep me")
     p = subprocess.Popen([str(lab01_ref), "--quiet", "--width", "400", "--height", "400",
                           "--spp", "4096", "--out", str(tmp_path / "old.ppm"),
-                          "--pfm", str(tmp_path / "new.pfm")])
+                          "--pfm", str(tmp_path / "new.pfm")],
+                         preexec_fn=lambda: signal.signal(signal_number, signal.SIG_DFL))
     try:
         deadline = time.monotonic() + 30
         while len(list(tmp_path.glob("*.partial-*"))) < 2:  # both opened: rendering has begun
