@@ -142,3 +142,26 @@ def test_interrupted_render_leaves_nothing(lab01_ref, tmp_path, signal_number):
         p.wait()
     assert sorted(f.name for f in tmp_path.iterdir()) == ["old.ppm"]
     assert (tmp_path / "old.ppm").read_bytes() == b"keep me"
+
+
+def test_a_render_started_ignoring_ctrl_c_keeps_ignoring_it(lab01_ref, tmp_path):
+    """nohup and a shell's background jobs start a program with SIGINT ignored, so that Ctrl-C
+    at the terminal leaves it running: the renderer keeps it so, and still removes its
+    temporaries when it is killed with SIGTERM."""
+    p = subprocess.Popen([str(lab01_ref), "--quiet", "--width", "400", "--height", "400",
+                          "--spp", "4096", "--out", str(tmp_path / "out.ppm")],
+                         preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_IGN))
+    try:
+        deadline = time.monotonic() + 30
+        while not list(tmp_path.glob("*.partial-*")):  # rendering has begun
+            assert p.poll() is None and time.monotonic() < deadline, "no temporary appeared"
+            time.sleep(0.01)
+        p.send_signal(signal.SIGINT)
+        time.sleep(0.5)
+        assert p.poll() is None, "an ignored SIGINT ended the render"
+        p.send_signal(signal.SIGTERM)
+        assert p.wait(timeout=30) == -signal.SIGTERM
+    finally:
+        p.kill()
+        p.wait()
+    assert list(tmp_path.iterdir()) == []
