@@ -118,6 +118,21 @@ def test_output_replaced_whole(lab01_ref, tmp_path):
     assert sorted(x.name for x in tmp_path.iterdir()) == ["img.pfm"]
 
 
+def start_long_render(lab01_ref, outputs: list[str], signal_number, action):
+    """A render of minutes writing `outputs`, started with `action` for `signal_number`."""
+    return subprocess.Popen([str(lab01_ref), "--quiet", "--width", "400", "--height", "400",
+                             "--spp", "4096", *outputs],
+                            preexec_fn=lambda: signal.signal(signal_number, action))
+
+
+def wait_for_temporaries(p, folder, count: int) -> None:
+    """Until `count` '*.partial-*' temporaries are open in `folder` (30 s at most)."""
+    deadline = time.monotonic() + 30
+    while len(list(folder.glob("*.partial-*"))) < count:
+        assert p.poll() is None and time.monotonic() < deadline, "no temporaries appeared"
+        time.sleep(0.01)
+
+
 @pytest.mark.parametrize("signal_number", [signal.SIGINT, signal.SIGTERM])
 def test_interrupted_render_leaves_nothing(lab01_ref, tmp_path, signal_number):
     """Ctrl-C (or a grader's kill) during a long render: the process dies of that signal and
@@ -126,15 +141,11 @@ def test_interrupted_render_leaves_nothing(lab01_ref, tmp_path, signal_number):
     a signal ignored that it was started ignoring (a shell does that to commands it starts in
     the background), and so does this one, which would then render to the end."""
     (tmp_path / "old.ppm").write_bytes(b"keep me")
-    p = subprocess.Popen([str(lab01_ref), "--quiet", "--width", "400", "--height", "400",
-                          "--spp", "4096", "--out", str(tmp_path / "old.ppm"),
-                          "--pfm", str(tmp_path / "new.pfm")],
-                         preexec_fn=lambda: signal.signal(signal_number, signal.SIG_DFL))
+    p = start_long_render(lab01_ref, ["--out", str(tmp_path / "old.ppm"),
+                                      "--pfm", str(tmp_path / "new.pfm")],
+                          signal_number, signal.SIG_DFL)
     try:
-        deadline = time.monotonic() + 30
-        while len(list(tmp_path.glob("*.partial-*"))) < 2:  # both opened: rendering has begun
-            assert p.poll() is None and time.monotonic() < deadline, "no temporaries appeared"
-            time.sleep(0.01)
+        wait_for_temporaries(p, tmp_path, 2)  # both opened: rendering has begun
         p.send_signal(signal_number)
         assert p.wait(timeout=30) == -signal_number
     finally:
@@ -148,14 +159,10 @@ def test_a_render_started_ignoring_ctrl_c_keeps_ignoring_it(lab01_ref, tmp_path)
     """nohup and a shell's background jobs start a program with SIGINT ignored, so that Ctrl-C
     at the terminal leaves it running: the renderer keeps it so, and still removes its
     temporaries when it is killed with SIGTERM."""
-    p = subprocess.Popen([str(lab01_ref), "--quiet", "--width", "400", "--height", "400",
-                          "--spp", "4096", "--out", str(tmp_path / "out.ppm")],
-                         preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_IGN))
+    p = start_long_render(lab01_ref, ["--out", str(tmp_path / "out.ppm")],
+                          signal.SIGINT, signal.SIG_IGN)
     try:
-        deadline = time.monotonic() + 30
-        while not list(tmp_path.glob("*.partial-*")):  # rendering has begun
-            assert p.poll() is None and time.monotonic() < deadline, "no temporary appeared"
-            time.sleep(0.01)
+        wait_for_temporaries(p, tmp_path, 1)  # rendering has begun
         p.send_signal(signal.SIGINT)
         time.sleep(0.5)
         assert p.poll() is None, "an ignored SIGINT ended the render"
