@@ -30,6 +30,12 @@
 
 #include <packed_hit.cuh>
 
+// Threads per block of every stage (not tuned: every measurement in the handouts uses 128).
+// Each kernel's grid is as many blocks as fit on the GPU at once (wavefront_renderer.cuh),
+// and its threads stride over their queue. It also sizes the shared memory in which a push
+// stages a block's records (path_pool_aos.cuh).
+constexpr int kStageThreads = 128;
+
 // A path on its way to its next interaction; `slot` says which (pixel, sample) it is.
 struct QueuedPath {
     Ray ray;

@@ -21,8 +21,15 @@
 //   a slot's radiance, 16 bytes
 //     0  radiance x y z, -                        generate w, shade and shadow rays r/w, accumulate r
 //
+// A push writes its records through shared memory (RowRecords::store_together): stored one
+// record per thread, a warp's 16-byte stores land 48 bytes apart and each covers twelve cache
+// lines in part; staged, the block writes its run of records out as consecutive rows, every
+// warp's store four whole lines.
+//
 // The bytes each stage moves per path, AoS against SoA: handouts/07-soa.md.
 #pragma once
+
+#include <climits>
 
 #include <path_pool.cuh>
 
@@ -35,16 +42,64 @@ struct RowRecords {
     Record* records;
 
     void carve(ArrayCarver& c) { records = c.take<Record>(); }
+
+    // The records of one push (path_queue.cuh): every thread of the block calls it together,
+    // with the place its reserve gave it. A reserve like the reference's gives the block's
+    // pushing threads one run of places, first .. first + count - 1, in whatever order; then
+    // each thread puts its record at its offset in the run in shared memory, and the block
+    // copies the run out row by row, consecutive threads on consecutive rows. Places that are
+    // not one run, or not distinct (a reserve with one atomic per thread, or a racy one), are
+    // stored by each thread as they are: only the speed depends on the reserve, never what
+    // lands where.
+    __device__ void store_together(int place, bool wants, const Record& record) const {
+        __shared__ Record staged[kStageThreads];
+        __shared__ int owner[kStageThreads];
+        __shared__ int first, last, count, clash;
+        const int me = static_cast<int>(threadIdx.x);
+        __syncthreads();  // every thread is done with the previous push's shared state
+        if (me == 0) {
+            first = INT_MAX;
+            last = INT_MIN;
+            count = clash = 0;
+        }
+        __syncthreads();
+        if (wants) {
+            atomicMin(&first, place);
+            atomicMax(&last, place);
+            atomicAdd(&count, 1);
+        }
+        __syncthreads();
+        const int run_first = first, run = count;
+        const bool one_run = run > 0 && static_cast<long long>(last) - run_first == run - 1;
+        if (one_run && wants) {
+            staged[place - run_first] = record;
+            owner[place - run_first] = me;
+        }
+        __syncthreads();
+        if (one_run && wants && owner[place - run_first] != me) clash = 1;
+        __syncthreads();
+        if (!one_run || clash) {
+            if (wants) records[place] = record;
+            return;
+        }
+        const float4* from = &staged[0].row[0];
+        float4* to = &records[run_first].row[0];
+        for (int r = me; r < run * kRows; r += static_cast<int>(blockDim.x)) to[r] = from[r];
+    }
 };
 
 struct AosPaths : RowRecords<3> {
     // The whole record: the hit's place gets "nothing hit", find_closest_hits fills it in.
-    __device__ void store(int k, const QueuedPath& p) const {
+    __device__ static Record record_of(const QueuedPath& p) {
         const Ray& r = p.ray;
-        records[k].row[0] = make_float4(r.origin.x, r.origin.y, r.origin.z, r.direction.x);
-        records[k].row[1] = make_float4(r.direction.y, r.direction.z, 0.0f, __int_as_float(-1));
-        records[k].row[2] =
-            make_float4(p.throughput.x, p.throughput.y, p.throughput.z, __int_as_float(p.slot));
+        return {{make_float4(r.origin.x, r.origin.y, r.origin.z, r.direction.x),
+                 make_float4(r.direction.y, r.direction.z, 0.0f, __int_as_float(-1)),
+                 make_float4(p.throughput.x, p.throughput.y, p.throughput.z,
+                             __int_as_float(p.slot))}};
+    }
+    __device__ void store(int k, const QueuedPath& p) const { records[k] = record_of(p); }
+    __device__ void store_together(int k, bool wants, const QueuedPath& p) const {
+        RowRecords::store_together(k, wants, record_of(p));
     }
     __device__ QueuedPath load(int k) const {
         const float4 c = records[k].row[2];
@@ -66,13 +121,16 @@ struct AosPaths : RowRecords<3> {
 };
 
 struct AosShadowRays : RowRecords<3> {
-    __device__ void store(int k, const QueuedShadowRay& q) const {
+    __device__ static Record record_of(const QueuedShadowRay& q) {
         const Ray& r = q.shadow.ray;
         const Vec3& l = q.shadow.radiance;
-        records[k].row[0] = make_float4(r.origin.x, r.origin.y, r.origin.z, r.direction.x);
-        records[k].row[1] =
-            make_float4(r.direction.y, r.direction.z, q.shadow.t_max, __int_as_float(q.slot));
-        records[k].row[2] = make_float4(l.x, l.y, l.z, 0.0f);
+        return {{make_float4(r.origin.x, r.origin.y, r.origin.z, r.direction.x),
+                 make_float4(r.direction.y, r.direction.z, q.shadow.t_max, __int_as_float(q.slot)),
+                 make_float4(l.x, l.y, l.z, 0.0f)}};
+    }
+    __device__ void store(int k, const QueuedShadowRay& q) const { records[k] = record_of(q); }
+    __device__ void store_together(int k, bool wants, const QueuedShadowRay& q) const {
+        RowRecords::store_together(k, wants, record_of(q));
     }
     __device__ QueuedShadowRay load(int k) const {
         const float4 a = records[k].row[0], b = records[k].row[1], c = records[k].row[2];

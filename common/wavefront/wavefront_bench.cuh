@@ -16,8 +16,10 @@
 // The configurations: "megakernel" (lab 05's render_kernel in its reference shape),
 // "<layout>" (the lab reference: pushes reserved once per block, one thread per queue place,
 // scene in shared memory when small, 2^21 paths a wave, shading compiled for the scene's
-// material kinds), "<layout>-atomic-per-warp" and "<layout>-atomic-each" (pushes reserved
-// once per warp, once per thread), "<layout>-prefetch" (each thread loads its next item
+// material kinds), "<layout>-stored-by-thread" (AoS: each pushing thread stores its own
+// record instead of the block's records going out together through shared memory),
+// "<layout>-atomic-per-warp" and "<layout>-atomic-each" (pushes reserved once per warp, once
+// per thread, each thread storing its own item), "<layout>-prefetch" (each thread loads its next item
 // ahead), "<layout>-grid-stride" (grids that fill the GPU once, threads striding over the
 // queue), "<layout>-global-scene", "<layout>-all-materials" (shading compiled for every
 // material kind, on a scene without mirrors or glass), "<layout>-occupancy-N" (registers
@@ -126,9 +128,10 @@ static double megakernel(const Setup& s, Image& image) {
 
 // A configuration of the bench: the reference's choices (wavefront_kernels.cuh) but those given.
 template <class Pool, class Primitives, SceneMemory kMemory, Reserve kHow, class Materials,
-          int kMinBlocks = 1, bool kPrefetch = false, bool kGridPerItem = true>
+          int kMinBlocks = 1, bool kPrefetch = false, bool kGridPerItem = true,
+          bool kTogether = true>
 using BenchConfig = WavefrontConfig<Pool, kMemory, kHow, Materials, kMinBlocks, kPrefetch,
-                                    kGridPerItem, Primitives>;
+                                    kGridPerItem, Primitives, kTogether>;
 
 template <class Pool, class Materials, class Primitives>
 static void add_pool_configs(const Setup& s, std::vector<Config>& configs) {
@@ -154,9 +157,17 @@ static void add_pool_configs(const Setup& s, std::vector<Config>& configs) {
         BenchConfig<Pool, Primitives, SceneMemory::Shared, Reserve::kPerBlock, Materials, 1, true>;
     using GridStride = BenchConfig<Pool, Primitives, SceneMemory::Shared, Reserve::kPerBlock,
                                    Materials, 1, false, false>;
+    using StoredByThread = BenchConfig<Pool, Primitives, SceneMemory::Shared, Reserve::kPerBlock,
+                                       Materials, 1, false, true, false>;
     const std::string n = Pool::kName;
     if (choose_scene_memory(s.layout) == SceneMemory::Shared) {
         configs.push_back(wavefront<Shared>(s, n, "the lab's reference", kDefaultWavePaths));
+        if constexpr (kStoresTogether<typename Pool::Paths, QueuedPath>) {
+            configs.push_back(wavefront<StoredByThread>(
+                s, n + "-stored-by-thread",
+                "each pushing thread stores its own record (not staged in shared memory)",
+                kDefaultWavePaths));
+        }
         configs.push_back(wavefront<SharedWarp>(
             s, n + "-atomic-per-warp", "one atomicAdd per warp's pushes", kDefaultWavePaths));
         configs.push_back(wavefront<SharedEach>(s, n + "-atomic-each", "one atomicAdd per push",

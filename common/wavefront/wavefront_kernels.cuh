@@ -29,7 +29,7 @@
 
 template <class LayoutT, SceneMemory kMemory, Reserve kHow = Reserve::kPerBlock,
           class MaterialsT = AnyMaterial, int kMinBlocks = 1, bool kPrefetchNext = false,
-          bool kGridPerItem = true, class PrimitivesT = AnyGeometry>
+          bool kGridPerItem = true, class PrimitivesT = AnyGeometry, bool kTogether = true>
 struct WavefrontConfig {
     using Layout = LayoutT;  // AosPathPool (lab 06) or SoaPathPool (lab 07)
     using Pool = PathPool<Layout>;
@@ -50,16 +50,14 @@ struct WavefrontConfig {
     // their threads stride over the queue. One thread per place was 4% faster on the H200:
     // no thread is left with one more item than the others at the end of a launch.
     static constexpr bool kOneItemPerThread = kGridPerItem;
+    // A push stores the block's items together where the layout can (lab 06's records, staged
+    // in shared memory: path_pool_aos.cuh), else each thread its own.
+    static constexpr bool kStoreTogether = kTogether;
     // Blocks of kStageThreads each kernel must fit on a multiprocessor (__launch_bounds__):
     // more caps the registers lower, for more warps in flight. 1 leaves the registers to the
     // compiler, which on the H200 was faster than 12 or 16 blocks (handouts/06-cuda-split.md).
     static constexpr int kMinBlocksPerSM = kMinBlocks;
 };
-
-// Threads per block of every stage (not tuned: every measurement in the handouts uses 128).
-// Each kernel's grid is as many blocks as fit on the GPU at once (wavefront_renderer.cuh),
-// and its threads stride over their queue.
-constexpr int kStageThreads = 128;
 
 // The most threads one multiprocessor holds, for the architecture being compiled (CUDA's
 // occupancy tables): 1024 on Turing, 1536 on consumer Ampere and Ada, 2048 on A100 and Hopper.
@@ -95,7 +93,7 @@ __global__ void __launch_bounds__(kStageThreads, min_blocks_per_sm(C::kMinBlocks
             path = start_path(ray, args.settings.bounces);
             radiance.start(slot, path.radiance);
         }
-        push<C::kReserve>(paths, valid && path.alive, QueuedPath{path.ray, path.throughput, slot});
+        push<C::kReserve, C::kStoreTogether>(paths, valid && path.alive, QueuedPath{path.ray, path.throughput, slot});
     });
 }
 
@@ -142,8 +140,8 @@ __global__ void __launch_bounds__(kStageThreads, min_blocks_per_sm(C::kMinBlocks
                 radiance.add(slot, path.radiance);
             }
         }
-        push<C::kReserve>(shadows, wants_shadow_ray, QueuedShadowRay{shadow, slot});
-        push<C::kReserve>(next, valid && path.alive, QueuedPath{path.ray, path.throughput, slot});
+        push<C::kReserve, C::kStoreTogether>(shadows, wants_shadow_ray, QueuedShadowRay{shadow, slot});
+        push<C::kReserve, C::kStoreTogether>(next, valid && path.alive, QueuedPath{path.ray, path.throughput, slot});
     });
 }
 

@@ -264,6 +264,34 @@ def test_waves_and_bands_do_not_change_the_image(gpu, lab06_ref):
     assert waves_do_not_change_the_image(lab06_ref)
 
 
+def reserve_replaced(body: str) -> str:
+    """common/wavefront/path_queue.cuh with the reserve's solution replaced by `body`."""
+    text = (ROOT / "common" / "wavefront" / "path_queue.cuh").read_text()
+    start = text.index("    // BEGIN SOLUTION")
+    end = text.index("    // END SOLUTION") + len("    // END SOLUTION")
+    return text[:start] + body + text[end:]
+
+
+def test_a_reserve_of_one_atomic_per_thread_gives_the_same_image(gpu, lab06_ref, tmp_path):
+    """The reference writes a block's records out together through shared memory when its
+    reserve gave the block one run of places. A student's reserve with one atomic per thread
+    is correct too, but the blocks' places interleave: every record must still land where it
+    was reserved, the same bits as lab06-ref. (The skeleton's racy reserve, which repeats
+    places, is test_skeleton_is_visibly_incomplete's.)"""
+    folder = tmp_path / "src"
+    folder.mkdir()
+    (folder / "render.cu").write_text((ROOT / "labs" / LAB / "solution" / "render.cu").read_text())
+    (folder / "stage_loop.cuh").write_text(
+        (ROOT / "common" / "wavefront" / "stage_loop.cuh").read_text())
+    (folder / "path_queue.cuh").write_text(
+        reserve_replaced("    return wants ? atomicAdd(size, 1) : -1;"))
+    p = make("cuda-variant", f"VARIANT_LAB={LAB}", f"VARIANT={folder}")
+    assert p.returncode == 0, p.stdout + p.stderr
+    settings = dict(width=96, height=64, spp=16, seed=5)
+    mine = run_lab(folder / "lab", **settings).image
+    assert np.array_equal(mine, run_lab(lab06_ref, **settings).image)
+
+
 def test_deep_paths_are_finite(gpu, lab06_ref):
     """64 bounces (the most the command line allows) through the showcase's glass and
     mirrors: every queue drains, every value is finite."""

@@ -148,11 +148,13 @@ done
 # The memory checker on a small render: no out-of-bounds access, no uninitialised read, no
 # race on the shared-memory copy of the scene (lab05-bench's scene-shared shape).
 if ! skipped sanitizer && command -v compute-sanitizer >/dev/null && [ -x lab05-ref ]; then
-    say "compute-sanitizer: memcheck and initcheck on lab05-ref, memcheck on lab06-ref and lab07-ref, racecheck on scene-shared"
+    say "compute-sanitizer: memcheck and initcheck on lab05-ref, memcheck on lab06-ref and lab07-ref, racecheck on scene-shared and on lab06-ref (its pushes stage records in shared memory), synccheck on lab06-ref"
     { compute-sanitizer --tool memcheck --error-exitcode 3 ./lab05-ref --quiet --width 48 --height 40 --spp 4 &&
       compute-sanitizer --tool initcheck --error-exitcode 3 ./lab05-ref --quiet --width 48 --height 40 --spp 4 &&
       compute-sanitizer --tool memcheck --error-exitcode 3 ./lab06-ref --quiet --width 48 --height 40 --spp 4 &&
       compute-sanitizer --tool memcheck --error-exitcode 3 ./lab07-ref --quiet --width 48 --height 40 --spp 4 &&
+      compute-sanitizer --tool racecheck --error-exitcode 3 ./lab06-ref --quiet --width 48 --height 40 --spp 4 &&
+      compute-sanitizer --tool synccheck --error-exitcode 3 ./lab06-ref --quiet --width 48 --height 40 --spp 4 &&
       compute-sanitizer --tool racecheck --error-exitcode 3 ./lab05-bench --width 48 --height 40 --spp 4 --repeat 1 --only scene-shared >/dev/null
     } >> "$log" 2>&1 && step[sanitizer]=ok || step[sanitizer]=failed
     say "compute-sanitizer: ${step[sanitizer]}"

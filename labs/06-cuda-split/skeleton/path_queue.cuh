@@ -13,6 +13,9 @@
 
 #include <cooperative_groups.h>
 
+#include <type_traits>
+#include <utility>
+
 template <class Items>
 struct Queue {
     Items items;  // places 0 .. *size - 1 (a layout's Paths or ShadowRays)
@@ -66,9 +69,19 @@ __device__ inline int reserve_per_thread(int* size, bool wants) {
     return wants ? atomicAdd(size, 1) : -1;
 }
 
+// Whether a layout's items have store_together(place, wants, item), a store that every thread
+// of the block calls at once for the places of one reserve (lab 06's records: through shared
+// memory, path_pool_aos.cuh); otherwise each pushing thread stores its own item.
+template <class Items, class Item, class = void>
+constexpr bool kStoresTogether = false;
+template <class Items, class Item>
+constexpr bool kStoresTogether<Items, Item,
+                               std::void_t<decltype(std::declval<const Items&>().store_together(
+                                   0, true, std::declval<const Item&>()))>> = true;
+
 // Pushes `item` (a QueuedPath or a QueuedShadowRay) for each thread that `wants` to; every
 // thread of the block calls it together (see reserve).
-template <Reserve kHow = Reserve::kPerBlock, class Items, class Item>
+template <Reserve kHow = Reserve::kPerBlock, bool kTogether = true, class Items, class Item>
 __device__ inline void push(const Queue<Items>& queue, bool wants, const Item& item) {
     int place;
     if constexpr (kHow == Reserve::kPerBlock) {
@@ -78,7 +91,11 @@ __device__ inline void push(const Queue<Items>& queue, bool wants, const Item& i
     } else {
         place = reserve_per_thread(queue.size, wants);
     }
-    if (wants) queue.items.store(place, item);
+    if constexpr (kHow == Reserve::kPerBlock && kTogether && kStoresTogether<Items, Item>) {
+        queue.items.store_together(place, wants, item);
+    } else if (wants) {
+        queue.items.store(place, item);
+    }
 }
 
 // Calls work(k, valid) for the places of a queue of `size` places, block by block: block b
