@@ -32,6 +32,10 @@ BOUNCES = 4
 RENDERS = 32       # K
 SPP_PER_RENDER = 64  # n
 TEST_SPP = 64
+# 4x4 blocks as well: the panel and the triangle cover a few pixels each, which 8x8 blocks
+# dilute; pooled variance keeps small blocks over 32 renders' golden data honest
+# (labkit/compare.py, "Small blocks and pooled variance").
+BLOCK_SIZES = (4, 8, 16)
 
 
 def new_secret() -> str:
@@ -126,7 +130,8 @@ def check_hidden(binary, reference, secret: str, *, launcher=(), threads=None,
             image = run_lab(binary, path, width=SIZE, height=SIZE, bounces=BOUNCES, spp=TEST_SPP,
                             seed=7, launcher=launcher, threads=threads).image
         heatmap = heatmap_dir / "hidden-diff.png" if heatmap_dir else None
-        report = compare(image, TEST_SPP, g.mean, g.variance, g.golden_spp, heatmap_path=heatmap)
+        report = compare(image, TEST_SPP, g.mean, g.variance, g.golden_spp, heatmap_path=heatmap,
+                         block_sizes=BLOCK_SIZES, pooled_variance=True)
         hint = "" if report.passed else symptoms.named(image, g.mean)
         return CheckResult("hidden scene", report.passed, report.summary() + hint)
     return run()

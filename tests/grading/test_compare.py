@@ -491,6 +491,32 @@ def test_a_few_underestimated_variances_do_not_make_a_correct_render_noisy():
             assert "too noisy" in r.summary(), r.summary()
 
 
+def test_pooled_variance_borrows_what_the_neighbours_saw():
+    """Around a glass ball every pixel's paths are heavy-tailed; golden data from few renders
+    caught the rare paths in some pixels and in none of one 4x4 block, whose estimated
+    variance is then a hundredth of the truth: a correct render fails there. Pooled, each
+    pixel of the block takes the larger variance its neighbours outside it saw, and the
+    render passes; a 4x4 patch of pixels at half their brightness elsewhere still fails."""
+    rng = np.random.default_rng(26)
+    truth, var = scene(rng, 32, 32)
+    var[11:17, 11:17] *= 100.0  # the ball's pixels, the block and a ring around it
+    golden = draw(rng, truth, var, 16384)
+    estimated = var.copy()
+    estimated[12:16, 12:16] *= 0.01  # the block whose renders saw no rare path
+    image = draw(rng, truth, var, 64)
+    image[12, 13] += 3.0 * np.sqrt(var[12, 13] / 64)  # the render saw a rare path there
+    blocks = (4, 8, 16)
+    raw = compare(image, 64, golden, estimated, 16384, block_sizes=blocks)
+    pooled = compare(image, 64, golden, estimated, 16384, block_sizes=blocks,
+                     pooled_variance=True)
+    assert not raw.passed and raw.worst_block.block_size == 4, raw.summary()
+    assert pooled.passed, pooled.summary()
+    dark = image.copy()
+    dark[20:24, 4:8] *= 0.5
+    r = compare(dark, 64, golden, estimated, 16384, block_sizes=blocks, pooled_variance=True)
+    assert not r.passed and r.n_failed > 0, r.summary()
+
+
 def test_a_denoised_image_is_too_smooth():
     """The truth plus a tenth of the noise (a denoiser's output): every block passes, the
     median d^2/s2 is far too small."""

@@ -135,12 +135,12 @@ if ! skipped bench && [ -x lab05-bench ]; then
     ./lab05-bench-fast-math --repeat 5 --only "${GPU_CHECK_FAST_MATH_VARIANTS:-reference,general,all-materials,scene-shared,no-register-cap,plain}" \
         > "$out/bench-fast-math.json" 2>> "$log" && step[bench_fast_math]=ok || step[bench_fast_math]=failed
 fi
-# The wavefront labs' references and their targets on the baseline (measure.sh, step 8, has
-# every configuration on four scenes).
+# The wavefront labs' references (and AoS with each thread storing its own record) and their
+# targets on the baseline (measure.sh, step 8, has every configuration on four scenes).
 for lab in lab06 lab07; do
     if [[ " ${GPU_CHECK_SKIP:-} " != *" bench "* ]] && [ -x $lab-bench ]; then
         say "benchmark: $lab-bench --repeat 5 (the baseline: the pools and the megakernel)"
-        ./$lab-bench --repeat 5 --only AoS,SoA,megakernel > "$out/bench-$lab.json" 2>> "$log" \
+        ./$lab-bench --repeat 5 --only AoS,AoS-stored-by-thread,SoA,megakernel > "$out/bench-$lab.json" 2>> "$log" \
             && step[bench_$lab]=ok || step[bench_$lab]=failed
     fi
 done
