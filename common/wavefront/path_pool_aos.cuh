@@ -92,10 +92,10 @@ struct AosPaths : RowRecords<3> {
     // The whole record: the hit's place gets "nothing hit", find_closest_hits fills it in.
     __device__ static Record record_of(const QueuedPath& p) {
         const Ray& r = p.ray;
-        return {{make_float4(r.origin.x, r.origin.y, r.origin.z, r.direction.x),
-                 make_float4(r.direction.y, r.direction.z, 0.0f, __int_as_float(-1)),
-                 make_float4(p.throughput.x, p.throughput.y, p.throughput.z,
-                             __int_as_float(p.slot))}};
+        return {
+            {make_float4(r.origin.x, r.origin.y, r.origin.z, r.direction.x),
+             make_float4(r.direction.y, r.direction.z, 0.0f, __int_as_float(-1)),
+             make_float4(p.throughput.x, p.throughput.y, p.throughput.z, __int_as_float(p.slot))}};
     }
     __device__ void store(int k, const QueuedPath& p) const { records[k] = record_of(p); }
     __device__ void store_together(int k, bool wants, const QueuedPath& p) const {

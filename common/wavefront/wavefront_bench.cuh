@@ -52,11 +52,11 @@
 #include <wavefront_renderer.cuh>
 
 struct Measured {
-    std::vector<double> ms;      // every timed run
-    Image image;                 // of the first timed run
-    WavefrontStats stats;        // of the extra run (wavefront only)
+    std::vector<double> ms;  // every timed run
+    Image image;  // of the first timed run
+    WavefrontStats stats;  // of the extra run (wavefront only)
     bool has_stats = false;
-    std::string json_extra;      // kernel resources of the megakernel
+    std::string json_extra;  // kernel resources of the megakernel
 };
 
 struct Config {

@@ -93,7 +93,8 @@ __global__ void __launch_bounds__(kStageThreads, min_blocks_per_sm(C::kMinBlocks
             path = start_path(ray, args.settings.bounces);
             radiance.start(slot, path.radiance);
         }
-        push<C::kReserve, C::kStoreTogether>(paths, valid && path.alive, QueuedPath{path.ray, path.throughput, slot});
+        push<C::kReserve, C::kStoreTogether>(paths, valid && path.alive,
+                                             QueuedPath{path.ray, path.throughput, slot});
     });
 }
 
@@ -140,8 +141,10 @@ __global__ void __launch_bounds__(kStageThreads, min_blocks_per_sm(C::kMinBlocks
                 radiance.add(slot, path.radiance);
             }
         }
-        push<C::kReserve, C::kStoreTogether>(shadows, wants_shadow_ray, QueuedShadowRay{shadow, slot});
-        push<C::kReserve, C::kStoreTogether>(next, valid && path.alive, QueuedPath{path.ray, path.throughput, slot});
+        push<C::kReserve, C::kStoreTogether>(shadows, wants_shadow_ray,
+                                             QueuedShadowRay{shadow, slot});
+        push<C::kReserve, C::kStoreTogether>(next, valid && path.alive,
+                                             QueuedPath{path.ray, path.throughput, slot});
     });
 }
 
