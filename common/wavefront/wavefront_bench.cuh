@@ -19,11 +19,11 @@
 // material kinds), "<layout>-stored-by-thread" (AoS: each pushing thread stores its own
 // record instead of the block's records going out together through shared memory),
 // "<layout>-atomic-per-warp" and "<layout>-atomic-each" (pushes reserved once per warp, once
-// per thread, each thread storing its own item), "<layout>-prefetch" (each thread loads its next item
-// ahead), "<layout>-grid-stride" (grids that fill the GPU once, threads striding over the
-// queue), "<layout>-global-scene", "<layout>-all-materials" (shading compiled for every
-// material kind, on a scene without mirrors or glass), "<layout>-occupancy-N" (registers
-// capped for N% occupancy) and "<layout>-wave-N" (N paths a wave).
+// per thread, each thread storing its own item), "<layout>-prefetch" (each thread loads its
+// next item ahead), "<layout>-grid-stride" (grids that fill the GPU once, threads striding
+// over the queue), "<layout>-global-scene", "<layout>-all-materials" (shading compiled for
+// every material kind, on a scene without mirrors or glass), "<layout>-occupancy-N"
+// (registers capped for N% occupancy) and "<layout>-wave-N" (N paths a wave).
 #pragma once
 
 #include <algorithm>
