@@ -75,21 +75,25 @@ def hidden_scene(secret: str) -> dict:
     # A panel turned at a drawn angle to the walls (a convex quad, not a rectangle) and a
     # tilted triangle: every primitive kind is traced here, so a renderer that skips one of
     # them fails (the Cornell box alone holds only a sphere and rectangles).
-    s["materials"]["panel"] = {"type": "diffuse",
-                               "albedo": [float(rng.uniform(0.3, 0.85)) for _ in range(3)]}
+    # Much darker than the walls behind them (0.15 to 0.45 of the white walls' albedo,
+    # channel by channel): a renderer that misses the panel or the triangle shows the bright
+    # back wall there. Drawn freely, the panel's colour could match the wall's, and a missing
+    # panel then changed too little to see.
+    s["materials"]["panel"] = {"type": "diffuse", "albedo": [
+        float(a * rng.uniform(0.15, 0.45)) for a in s["materials"]["white"]["albedo"]]}
     angle = float(rng.uniform(np.radians(25), np.radians(65)))
     # Above the box's ball, left of the triangle, in front of the back wall: in view.
     cx, cz, half, height = float(rng.uniform(0.3, 0.4)), float(rng.uniform(-0.9, -0.85)), \
-        0.1, float(rng.uniform(0.2, 0.3))
+        0.1, float(rng.uniform(0.28, 0.38))
     dx, dz = half * np.cos(angle), half * np.sin(angle)
     s["quads"] = s.get("quads", []) + [{"vertices": [
         [cx - dx, 0.45, cz - dz], [cx + dx, 0.45, cz + dz],
         [cx + dx, 0.45 + height, cz + dz], [cx - dx, 0.45 + height, cz - dz]],
         "material": "panel"}]
     s["triangles"] = s.get("triangles", []) + [{"vertices": [
-        [0.55 + float(rng.uniform(-0.03, 0.03)), 0.45, -0.6],
-        [0.7, 0.55 + float(rng.uniform(-0.03, 0.03)), -0.65],
-        [0.6, 0.7, -0.55 + float(rng.uniform(-0.03, 0.03))]], "material": "panel"}]
+        [0.52 + float(rng.uniform(-0.03, 0.03)), 0.38, -0.6],
+        [0.75, 0.53 + float(rng.uniform(-0.03, 0.03)), -0.67],
+        [0.6, 0.75, -0.52 + float(rng.uniform(-0.03, 0.03))]], "material": "panel"}]
     return s
 
 
