@@ -32,7 +32,7 @@ import numpy as np
 
 from grading import draws, hidden, report_html, symptoms
 from labkit import scenes
-from labkit.compare import compare
+from labkit.compare import GRADING_ALPHA, compare
 from labkit.harness import GOLDEN, ROOT, ImageError, golden, run_lab
 
 # The trusted renderer that makes golden data on the spot (the timed scene drawn for a grade).
@@ -100,7 +100,7 @@ def check_golden(binary, scene: str, *, seed: int | None = None, spp: int = GOLD
                            f"bit: a copy, not a render (a render at {spp} spp is noisy)")
     heatmap = heatmap_dir / f"{scene}-diff.png" if heatmap_dir else None
     report = compare(run.image, spp, g.mean, g.variance, g.meta["golden_spp"],
-                     heatmap_path=heatmap)
+                     heatmap_path=heatmap, alpha=GRADING_ALPHA, pooled_variance=True)
     if heatmap_dir and run.image is not None:  # for the page (grading/report_html.py)
         report_html.write_images(heatmap_dir, scene, run.image, g.mean)
     hint = "" if report.passed else symptoms.named(run.image, g.mean)

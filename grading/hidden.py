@@ -24,7 +24,7 @@ import numpy as np
 
 from grading import symptoms
 from labkit import scenes
-from labkit.compare import compare
+from labkit.compare import GRADING_ALPHA, compare
 from labkit.harness import RunPolicy, available_cores, policy, run_lab
 
 SIZE = 32          # pixels a side
@@ -135,7 +135,7 @@ def check_hidden(binary, reference, secret: str, *, launcher=(), threads=None,
                             seed=7, launcher=launcher, threads=threads).image
         heatmap = heatmap_dir / "hidden-diff.png" if heatmap_dir else None
         report = compare(image, TEST_SPP, g.mean, g.variance, g.golden_spp, heatmap_path=heatmap,
-                         block_sizes=BLOCK_SIZES, pooled_variance=True)
+                         block_sizes=BLOCK_SIZES, pooled_variance=True, alpha=GRADING_ALPHA)
         hint = "" if report.passed else symptoms.named(image, g.mean)
         return CheckResult("hidden scene", report.passed, report.summary() + hint)
     return run()

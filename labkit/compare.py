@@ -97,9 +97,9 @@ that is larger: a rare-path pixel borrows the variance its neighbours saw, which
 makes z smaller (the false-failure bound still holds) and costs a defect spanning several
 pixels about a tenth of its z (over 167 secrets, the reference's max |z| was 4.53 raw, 4.05
 pooled).  Measured on the hidden scene as it is (lab 01's reference, Intel Xeon; 4x4, 8x8 and
-16x16 blocks, pooled, limit 5.1): the reference's max |z| over 200 secrets 4.41, all passing;
-over 61 secrets, a renderer without convex quads at least 8.85 and one without triangles at
-least 11.3.
+16x16 blocks, pooled, limit 5.1 at alpha 1e-4): the reference's max |z| over 200 secrets
+4.41, all passing; over 61 secrets, a renderer without convex quads at least 8.85 and one
+without triangles at least 11.3.  The grader compares at ``GRADING_ALPHA`` (limit about 5.5).
 
 Noise and structure: the per-pixel test
 ---------------------------------------
@@ -168,6 +168,13 @@ __all__ = [
 ]
 
 CHANNEL_NAMES = ("R", "G", "B")
+# The grader's family-wise false-failure bound.  Its renders use seeds drawn afresh each grade,
+# so a tail the normal model underestimates is met sooner or later: the showcase's glass makes
+# block sums skewed (assumption 1), and lab 01's reference at 64 spp failed its golden test
+# (8x8 and 16x16 blocks, alpha 1e-4: limit 5.06) at 4 of 2,500 seeds (worst z +5.36; pooled
+# variance, +5.13).  With alpha 1e-5 (limit 5.49 there) and pooled variance none of the 2,500
+# came within 0.36 of the limit.
+GRADING_ALPHA = 1e-5
 # The per-pixel test (module docstring): a correct render gives a mean d^2/s2 of about 1 and
 # a median of about 0.455.
 CHI_MEAN_MAX = 1.5

@@ -89,3 +89,14 @@ def test_a_renderer_that_skips_a_primitive_kind_fails_the_hidden_scene(lab01_ref
         binary = build_variant("01-serial", tmp_path / name, skipping(loop))
         result = hidden.check_hidden(binary, lab01_ref, "kinds")
         assert not result.passed, f"a renderer without {name} passed: {result.detail}"
+
+
+def test_the_reference_passes_the_showcase_at_seeds_where_its_glass_strays(lab01_ref):
+    """Lab 01's reference at the showcase's four worst of 2,500 seeds (block z +5.07 to +5.36:
+    glass makes block sums skewed, a tail the normal model underestimates). At alpha 1e-4
+    over the raw variance each of them failed its golden test; the grader draws a new seed
+    every grade, so it compares at GRADING_ALPHA over pooled variance, and they pass."""
+    from grading.checks import check_golden
+    for seed in (227, 564, 1311, 1500):
+        result = check_golden(lab01_ref, "showcase", seed=seed)
+        assert result.passed, f"seed {seed}: {result.detail}"
