@@ -58,15 +58,20 @@ def no_gpu_is_one_line(binary, tmp_path):
     assert p.stdout == "" and not out.exists()
 
 
-def pristine_skeleton(lab, tmp_path_factory):
-    """The skeleton as generated from the solution, built as `make labNN` builds it."""
-    from labkit.variants import pristine_skeleton_sources
-    folder = tmp_path_factory.mktemp(lab + "-skeleton")
-    for name, text in pristine_skeleton_sources(lab).items():
+def cuda_variant(lab, folder, files: dict[str, str]):
+    """`files` (name -> text) written into `folder` and built as `make labNN` builds a lab."""
+    for name, text in files.items():
         (folder / name).write_text(text)
     p = make("cuda-variant", f"VARIANT_LAB={lab}", f"VARIANT={folder}")
     assert p.returncode == 0, p.stdout + p.stderr
     return folder / "lab"
+
+
+def pristine_skeleton(lab, tmp_path_factory):
+    """The skeleton as generated from the solution, built as `make labNN` builds it."""
+    from labkit.variants import pristine_skeleton_sources
+    return cuda_variant(lab, tmp_path_factory.mktemp(lab + "-skeleton"),
+                        pristine_skeleton_sources(lab))
 
 
 def same_paths_as(binary, other, seed=22):
@@ -278,17 +283,12 @@ def test_a_reserve_of_one_atomic_per_thread_gives_the_same_image(gpu, lab06_ref,
     is correct too, but the blocks' places interleave: every record must still land where it
     was reserved, the same bits as lab06-ref. (The skeleton's racy reserve, which repeats
     places, is test_skeleton_is_visibly_incomplete's.)"""
-    folder = tmp_path / "src"
-    folder.mkdir()
-    (folder / "render.cu").write_text((ROOT / "labs" / LAB / "solution" / "render.cu").read_text())
-    (folder / "stage_loop.cuh").write_text(
-        (ROOT / "common" / "wavefront" / "stage_loop.cuh").read_text())
-    (folder / "path_queue.cuh").write_text(
-        reserve_replaced("    return wants ? atomicAdd(size, 1) : -1;"))
-    p = make("cuda-variant", f"VARIANT_LAB={LAB}", f"VARIANT={folder}")
-    assert p.returncode == 0, p.stdout + p.stderr
+    binary = cuda_variant(LAB, tmp_path, {
+        "render.cu": (ROOT / "labs" / LAB / "solution" / "render.cu").read_text(),
+        "stage_loop.cuh": (ROOT / "common" / "wavefront" / "stage_loop.cuh").read_text(),
+        "path_queue.cuh": reserve_replaced("    return wants ? atomicAdd(size, 1) : -1;")})
     settings = dict(width=96, height=64, spp=16, seed=5)
-    mine = run_lab(folder / "lab", **settings).image
+    mine = run_lab(binary, **settings).image
     assert np.array_equal(mine, run_lab(lab06_ref, **settings).image)
 
 
