@@ -86,9 +86,9 @@ Small blocks and pooled variance
 --------------------------------
 A small image with small features (grading/hidden.py's 32x32 scene, whose turned panel and
 triangle cover a few pixels each) needs 4x4 blocks: a renderer that misses one of them moves
-a few pixels far, which 8x8 blocks dilute (over 26 secrets of an earlier version of that
-scene, lab 01's closest hit without convex quads reached the 8x8/16x16 limit in 20, with 4x4
-blocks in 25).  But 16 pixels is where assumptions 1 and 3 weaken together: a glass ball's
+a few pixels far, which 8x8 blocks dilute (over 26 secrets with a lighter panel and a smaller
+triangle, lab 01's closest hit without convex quads reached the 8x8/16x16 limit in 20, with
+4x4 blocks in 25).  But 16 pixels is where assumptions 1 and 3 weaken together: a glass ball's
 rare bright paths give skewed pixel means, and golden data from K = 32 renders miss them in
 some pixels, so the estimated variance there is far too small (the reference's 4x4 max |z|
 reached 5.07 over 200 secrets, against the limit 5.1).  ``pooled_variance=True`` raises each
@@ -127,13 +127,13 @@ Measured on lab 01's reference at 64 spp against the stored golden data (6 seeds
 1.00-1.07 (cornell) and 0.95-1.10 (showcase), median 0.45-0.49; at 16 spp mean 4.0-4.2; blurred
 over 3x3 pixels median 0.10-0.18; flattened into 8x8 blocks mean 36-149 (uncapped).  On the
 hidden scene (grading/hidden.py, with its glass and mirror balls, turned panel and triangle;
-lab 01's reference on an Intel Xeon): capped mean 0.96-1.22, median 0.32-0.55 (200 secrets).
-On its previous version (a lighter panel, a smaller triangle; 150 secrets) capped mean
-0.97-1.23, median 0.31-0.55; uncapped, the mean reached 1.42 there (up to 38 pixel channels
-above the cap) and 1.51 in one grade, which failed the reference; at 16 spp (30 secrets)
-capped mean 2.5-4.0, blurred over 3x3 pixels 2.9-7.1: both failed every time.  Glass makes
-a pixel's mean of 64 paths skewed, which lowers the median of a correct render: hence the
-lower bound's margin.  For
+lab 01's reference on an Intel Xeon): capped mean 0.96-1.22, median 0.32-0.55 (200 secrets);
+at 16 spp capped mean 2.5-4.0, blurred over 3x3 pixels 3.8-7.7, both failing in 20 of 20.
+With a lighter panel and a smaller triangle (150 secrets) the uncapped mean reached 1.42 (up
+to 38 pixel channels above the cap), and 1.51 in one grade, which failed the reference: a
+few pixels beside the glass ball whose variance the golden renders underestimated.  Glass
+makes a pixel's mean of 64 paths skewed, which lowers the median of a correct render: hence
+the lower bound's margin.  For
 chi-square(1) values the standard error of the mean over P values is sqrt(2/P) and of the
 median ~0.5/(0.47 sqrt(P)), i.e. 0.02 and 0.01 for a 64x64 image and 0.03 and 0.02 for 32x32:
 both bounds are more than 10 standard errors from 1 and 0.455, and a variance estimated from K
