@@ -22,6 +22,8 @@ MAX_OUTPUT_CHARS = 4000
 
 @dataclasses.dataclass
 class Test:
+    __test__ = False  # a graded check, not a pytest test class (the grader's tests import it)
+
     id: str
     label: str
     max_score: int
