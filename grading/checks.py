@@ -162,22 +162,23 @@ def check_sphere_interior(binary, bounces=(1, 2, 4)) -> CheckResult:
     images = render_interior(binary, {b: dict(width=16, height=16, spp=4, bounces=b,
                                               seed=draws.seed("interior"))
                                       for b in bounces}, interior)
-    causes: dict[str, list[int]] = {}  # what each failing render is identified as
+    failing: list[int] = []  # the bounce counts rendered wrong
+    common: list[str] = []  # the causes that every one of those renders matches
     for b, image in images.items():
         want = scenes.sphere_interior_radiance(**interior, bounces=b)
         error = np.max(np.abs(image.astype(np.float64) / want - 1.0))
         worst = worst_of(worst, error)
         symptom = symptom or black_pixels(image)
         if not (error <= 3e-4):
-            cause = symptoms.identified(
+            causes = symptoms.matching_causes(
                 image, lambda k: scenes.sphere_interior_radiance(**interior, bounces=k), b)
-            causes.setdefault(cause, []).append(b)
+            common = causes if not failing else [c for c in common if c in causes]
+            failing.append(b)
     ok = worst <= 3e-4
-    if len(causes) == 1 and "" not in causes:
+    if len(common) == 1:
         # One cause explains every failing render: identified, it outranks the black pixels.
-        cause, found = next(iter(causes.items()))
-        symptoms.record(cause)
-        symptom = f"; {cause} (identified at bounces {found})"
+        symptoms.record(common[0])
+        symptom = f"; {common[0]} (identified at bounces {failing})"
     return CheckResult("analytic sphere interior", ok,
                        f"largest relative error {worst:.2e} over bounces {list(bounces)}"
                        f" (allowed 3e-4)" + ("" if ok else symptom))

@@ -78,11 +78,13 @@ def _matches(image: np.ndarray, want: np.ndarray) -> bool:
     return bool(np.all(np.abs(image - want) <= EXACT * scale))
 
 
-def identified(image: np.ndarray, want_at, bounces: int) -> str:
-    """What a render of a zero-variance closed form is, exactly, when it is not right:
+def matching_causes(image: np.ndarray, want_at, bounces: int) -> list[str]:
+    """Every mistake that a render of a zero-variance closed form is, to float rounding:
     `want_at(b)` is the closed form's radiance with b interactions (`bounces` was asked for).
-    Names B+1 or B-1 bounces, a missing or extra 1/pi, a gamma-encoded PFM; "" when none fits
-    to float rounding. Each is identified, not guessed: the estimator has no noise here."""
+    Candidates are B+1 or B-1 bounces, a missing or extra 1/pi, a gamma-encoded PFM, in that
+    order. One render can match two by coincidence (for some albedos the right value raised
+    to 1/2.2 is also, to 1e-3, the value of one bounce more), so a check that renders several
+    bounce counts keeps the cause they all match (check_sphere_interior)."""
     gray = np.asarray(_gray(image), dtype=np.float64)
     want = want_at(bounces)
     candidates = [
@@ -95,10 +97,16 @@ def identified(image: np.ndarray, want_at, bounces: int) -> str:
         (want / math.pi, PI_EXTRA),
         (want ** (1 / GAMMA) if want > 0 else None, GAMMA_ENCODED),
     ]
-    for value, cause in candidates:
-        if value is not None and _matches(gray, np.full_like(gray, value)):
-            return cause
-    return ""
+    return [cause for value, cause in candidates
+            if value is not None and _matches(gray, np.full_like(gray, value))]
+
+
+def identified(image: np.ndarray, want_at, bounces: int) -> str:
+    """What one render of a zero-variance closed form is, exactly, when it is not right: the
+    first of matching_causes, "" when none fits. Each is identified, not guessed: the
+    estimator has no noise here."""
+    causes = matching_causes(image, want_at, bounces)
+    return causes[0] if causes else ""
 
 
 PI_MISSING = "pi times too bright: the diffuse BRDF's 1/pi is missing"
