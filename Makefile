@@ -38,7 +38,8 @@ $(BUILD)/common/simd/packets_avx512.o: CXXFLAGS += $(SIMD_AVX512_FLAGS)
 # The library part of common/host (what unit tests link) and the driver every lab binary adds.
 LIB_SRC    := common/host/scene_loader.cpp common/host/json_with_positions.cpp common/host/image.cpp common/host/cli.cpp \
               common/host/progress.cpp common/host/interrupt_cleanup.cpp \
-              common/host/scene_centring.cpp common/host/scene_report.cpp
+              common/host/scene_centring.cpp common/host/scene_report.cpp \
+              common/host/scene_limits.cpp common/host/double_twin.cpp
 LIB_OBJ    := $(LIB_SRC:%.cpp=$(BUILD)/%.o)
 DRIVER_OBJ := $(BUILD)/common/host/lab_main.o $(BUILD)/common/host/main.o
 COMMON_OBJ := $(LIB_OBJ) $(DRIVER_OBJ)
@@ -146,13 +147,20 @@ include $(foreach n,$(LABS),labs/$(LAB_FOLDER_$(n))/lab.mk)
 include grading/grading.mk
 
 # Lab 01's reference in double, with the same scene files and command line (--json says
-# "precision": "double").
+# "precision": "double"). A real file, not phony: lab01-ref carries it (below).
 $(DOUBLE_BUILD)/labs/01-serial/solution/%.o: LAB_INCLUDES = -Ilabs/01-serial/solution
 lab01-ref-double: $(patsubst %.cpp,$(DOUBLE_BUILD)/%.o,$(wildcard labs/01-serial/solution/*.cpp)) \
                   $(DOUBLE_COMMON_OBJ)
 	$(CXX) $(CXXFLAGS) $^ -o $@
-.PHONY: lab01-ref-double
 LAB_BINARIES += lab01-ref-double
+
+# A reference renders in double what float cannot place (common/host/double_twin.h): it links
+# build/twins/X.o, which carries the double binary X as data. Each lab's lab.mk names its
+# references' twins (lab01-ref here, lab03-ref and lab03-simd-ref, lab05-ref).
+$(BUILD)/twins/%.o: % common/host/double_twin.S
+	@mkdir -p $(dir $@)
+	$(CXX) -c -x assembler-with-cpp -DTWIN_PATH='"$<"' common/host/double_twin.S -o $@
+lab01-ref: $(BUILD)/twins/lab01-ref-double.o
 
 labs: $(LAB_BINARIES)
 
@@ -163,8 +171,10 @@ UNIT_OBJ := $(UNIT_SRC:%.cpp=$(BUILD)/%.o)
 $(BUILD)/unit_tests: $(UNIT_OBJ) $(LIB_OBJ)
 	$(CXX) $(CXXFLAGS) $^ -o $@ -lgtest -lgtest_main -pthread
 
-# The unit tests that show the double build computes in double (tests/precision/).
-$(BUILD)/precision_tests_double: $(DOUBLE_BUILD)/tests/precision/test_double.o $(DOUBLE_LIB_OBJ)
+# The unit tests that show the double build computes in double (tests/precision/), and the
+# placement tests, which hold in both builds.
+$(BUILD)/precision_tests_double: $(DOUBLE_BUILD)/tests/precision/test_double.o \
+                                 $(DOUBLE_BUILD)/tests/unit/test_scene_placement.o $(DOUBLE_LIB_OBJ)
 	$(CXX) $(CXXFLAGS) $^ -o $@ -lgtest -lgtest_main -pthread
 
 test-unit: $(BUILD)/unit_tests

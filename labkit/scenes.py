@@ -302,3 +302,18 @@ def floor_view_expected(scene: dict, width: int, height: int, subsamples: int = 
     radiance = np.where(hit, albedo / math.pi * intensity * np.maximum(cos, 0.0) / d2, 0.0)
     shape = (height, subsamples, width, subsamples)
     return radiance.reshape(shape).mean(axis=(1, 3)), hit.reshape(shape).all(axis=(1, 3))
+
+
+def mixed_scale(half: float, radius: float = 1e-4) -> dict:
+    """A diffuse sphere of `radius` resting on a floor of half-size `half`, seen from a few
+    radii away, lit from the side so its shadow falls across the view. At half 1e4 float
+    cannot place the sphere (it is below 2^-20 of the scene's extent): the references render
+    it in double. At half 1, float renders the same view: the floor beyond the view adds
+    nothing at one bounce, so the two images differ by rounding only."""
+    r = radius
+    return {"camera": {"position": [0, 4 * r, 8 * r], "look_at": [0, r, 0], "vfov": 40},
+            "light": {"position": [0.5, 1, 0], "intensity": [1, 1, 1]},
+            "materials": {"w": {"type": "diffuse", "albedo": [0.5, 0.5, 0.5]}},
+            "spheres": [{"center": [0, r, 0], "radius": r, "material": "w"}],
+            "quads": [{"vertices": [[-half, 0, -half], [-half, 0, half], [half, 0, half],
+                                    [half, 0, -half]], "material": "w"}]}

@@ -51,7 +51,12 @@ RT_HD inline Vec3 sample_cosine_hemisphere(Vec3 n, real u1, real u2) {
     const real z = sqrt_real(max_float(0.0f, 1.0f - u1));
     Vec3 t, b;
     orthonormal_basis(n, t, b);
-    return t * x + b * y + n * z;
+    const Vec3 d = t * x + b * y + n * z;
+    // The single-precision polynomials leave |d| off 1 by up to ~1e-7. Float's ray offsets
+    // (2^-20, ray.h) cover that; double's (2^-49) do not, and the sphere test, which assumes
+    // a unit direction, then put hit points below the surface by ~1e-7 of the distance.
+    if constexpr (sizeof(real) > sizeof(float)) return normalize(d);
+    return d;
 }
 
 // Unpolarised Fresnel reflectance of a smooth dielectric (exact, not Schlick's fit).

@@ -13,6 +13,13 @@ struct InputError : std::runtime_error {
 
 constexpr int kExitBadInput = 2;
 
+// Bad input for float only: a scene the double build places (scene_limits.h). A reference
+// that carries its double build hands such a scene to it (double_twin.h); any other binary
+// prints the message like any InputError.
+struct PrecisionError : InputError {
+    using InputError::InputError;
+};
+
 // The machine cannot do the render: no GPU, a GPU fault, device memory exhausted. Not the
 // input's fault, so it has a status of its own; the shared main prints its message as one
 // line, removes any half-written output and exits with status 3.

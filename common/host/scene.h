@@ -60,6 +60,7 @@ struct WrittenCoordinates {
     bool present = false;
     WrittenPoint light_position;
     std::vector<WrittenPoint> sphere_centres;     // parallel to Scene::spheres
+    std::vector<double> sphere_radii;             // parallel to Scene::spheres
     std::vector<WrittenPoint> triangle_vertices;  // 3 per entry of Scene::triangles
     std::vector<WrittenPoint> quad_vertices;      // 4 per entry of Scene::quads
     std::vector<WrittenPoint> rect_vertices;      // 4 per entry of Scene::rects, as written
@@ -81,6 +82,10 @@ struct Scene {
     std::vector<AxisRect> rects;    // axis-aligned rectangles
     RenderSettings render;            // the file's settings, or the defaults
     WrittenCoordinates written;       // the file's points in double, for centre_scene
+    // Why float cannot place this scene (scene_limits.h), "/pointer: what"; empty when it can
+    // or when the scene was not loaded from a file. Set in both builds: the double build says
+    // why it was needed (lab_main.cpp).
+    std::string float_refusal;
 
     SceneView view() const {
         return {spheres.data(),

@@ -1,6 +1,7 @@
 #include <scene_centring.h>
 
 #include <algorithm>
+#include <cmath>
 #include <limits>
 
 namespace {
@@ -48,6 +49,14 @@ struct ExactPoints {
         return pick(sized(), sized() ? scene.written.sphere_centres[i] : WrittenPoint{},
                     scene.spheres[i].center);
     }
+    // The radius as rendered (which keeps every centre as it was), unless `real` cannot hold
+    // it: a radius past float's range is placed by the file's number (scene_limits.h then
+    // says float cannot render it).
+    double sphere_radius(size_t i) const {
+        const bool have = sized() && scene.written.sphere_radii.size() == scene.spheres.size();
+        const real own = scene.spheres[i].radius;
+        return have && !std::isfinite(own) ? scene.written.sphere_radii[i] : double(own);
+    }
     WrittenPoint vertex(size_t i, int k) const {
         const Triangle& t = scene.triangles[i];
         return pick(sized(), sized() ? scene.written.triangle_vertices[3 * i + k] : WrittenPoint{},
@@ -59,19 +68,26 @@ struct ExactPoints {
         return pick(sized(), sized() ? scene.written.quad_vertices[4 * i + k] : WrittenPoint{},
                     own[k]);
     }
-    // A rectangle keeps its bounds, not its corners: its written corners stand while each
-    // rounds to one of the rectangle's own corners, else its own (rect_corners) are used.
+    // A rectangle keeps its bounds, not its corners: its written corners stand while the
+    // rectangle is the one the loader built from them (each rounded where it is written),
+    // else its own corners (rect_corners) are used. Not "each written corner rounds to a
+    // corner": a floor whose corners wobble by 1e-10 about 1e6 + 2^-5, a tie in float, rounds
+    // them apart, and was then placed from those corners, off by up to 0.04.
     WrittenPoint rect_vertex(size_t i, int k) const {
-        Vec3 own[4];
-        rect_corners(scene.rects[i], own);
+        const AxisRect& r = scene.rects[i];
         bool written_stand = sized();
-        for (int j = 0; written_stand && j < 4; ++j) {
-            const WrittenPoint& w = scene.written.rect_vertices[4 * i + j];
-            bool on_corner = false;
-            for (const Vec3& c : own) on_corner = on_corner || w.rounds_to(c);
-            written_stand = on_corner;
+        if (written_stand) {
+            const WrittenPoint* w = &scene.written.rect_vertices[4 * i];
+            const Vec3 loaded[4] = {rounded(w[0]), rounded(w[1]), rounded(w[2]), rounded(w[3])};
+            const AxisRect built = make_axis_rect(loaded, rect_axis(r), r.material);
+            written_stand = built.plane == r.plane && built.lo_u == r.lo_u &&
+                            built.lo_v == r.lo_v && built.hi_u == r.hi_u && built.hi_v == r.hi_v &&
+                            built.axis_side == r.axis_side;
         }
-        return written_stand ? scene.written.rect_vertices[4 * i + k] : exact(own[k]);
+        if (written_stand) return scene.written.rect_vertices[4 * i + k];
+        Vec3 own[4];
+        rect_corners(r, own);
+        return exact(own[k]);
     }
     WrittenPoint camera_position() const {
         return pick(scene.camera.written, scene.camera.written_position, scene.camera.position);
@@ -88,7 +104,7 @@ void centre_of_bounds(const Scene& scene, double centre[3]) {
     const ExactPoints points{scene};
     BoundsD box;
     for (size_t i = 0; i < scene.spheres.size(); ++i)
-        box.add(points.sphere(i), scene.spheres[i].radius);
+        box.add(points.sphere(i), points.sphere_radius(i));
     for (size_t i = 0; i < scene.triangles.size(); ++i) {
         for (int k = 0; k < 3; ++k) box.add(points.vertex(i, k));
     }
@@ -134,6 +150,7 @@ Scene centre_scene(Scene scene) {
     const ExactPoints points{scene};
     WrittenCoordinates moved;
     moved.present = true;
+    moved.sphere_radii = scene.written.sphere_radii;
     for (size_t i = 0; i < scene.spheres.size(); ++i)
         moved.sphere_centres.push_back(minus(points.sphere(i), centre));
     for (size_t i = 0; i < scene.triangles.size(); ++i) {

@@ -50,6 +50,15 @@ public:
         }
     }
 
+    // The same, for what only the float build cannot place: a PrecisionError.
+    [[noreturn]] void fail_precision(const std::string& pointer, const std::string& what) const {
+        try {
+            fail(pointer, what);
+        } catch (const InputError& e) {
+            throw PrecisionError(e.what());
+        }
+    }
+
     [[noreturn]] void fail_key(const std::string& pointer, const std::string& what) const {
         auto it = offsets_.find(pointer + "#key");
         throw InputError(name_ + ":" + line_column(text_, it == offsets_.end() ? 0 : it->second) +
@@ -61,11 +70,13 @@ public:
         return obj.at(key);
     }
 
-    // The number as the file writes it (a double), within the range `real` holds.
-    double written_number(const json& v, const std::string& pointer) const {
+    // The number as the file writes it (a double), within the range `real` holds; a
+    // coordinate, any finite double (scene_limits.h judges it once the scene is centred).
+    double written_number(const json& v, const std::string& pointer,
+                          bool coordinate = false) const {
         if (!v.is_number()) fail(pointer, "expected a number, found " + type_of(v));
         const double d = v.get<double>();
-        if (!std::isfinite(d) || std::fabs(d) > kMaxNumber)
+        if (!std::isfinite(d) || (!coordinate && std::fabs(d) > kRealMax))
             fail(pointer,
                  std::string("expected a finite number within ") + kPrecisionName + " range");
         return d;
@@ -121,37 +132,31 @@ private:
     const std::map<std::string, size_t>& offsets_;
 };
 
-// A point of the scene, within what the renderer's arithmetic handles (scene_limits.h), and
-// the same point as the file writes it, in double.
+// A point of the scene: rounded to `real`, and as the file writes it, in double. What the
+// renderer can place is judged once every point is read and the scene centred
+// (scene_limits.h), not here, where the point may lie far from the scene's centre.
 Vec3 read_position(const SceneReader& r, const json& v, const std::string& pointer,
                    WrittenPoint& written) {
-    const Vec3 p = r.vec3(v, pointer);
+    if (!v.is_array() || v.size() != 3)
+        r.fail(pointer, "expected an array of 3 numbers, found " + SceneReader::type_of(v));
     double c[3];
-    for (int axis = 0; axis < 3; ++axis) {
-        c[axis] = r.written_number(v[axis], pointer + "/" + std::to_string(axis));
-        const std::string problem = coordinate_problem(c[axis]);
-        if (!problem.empty()) r.fail(pointer + "/" + std::to_string(axis), problem);
-    }
+    for (int axis = 0; axis < 3; ++axis)
+        c[axis] = r.written_number(v[axis], pointer + "/" + std::to_string(axis), true);
     written = {c[0], c[1], c[2]};
-    return p;
+    return {static_cast<real>(c[0]), static_cast<real>(c[1]), static_cast<real>(c[2])};
 }
 
-// The triangle of vertices a, b, c of a primitive's "vertices", refused if it would not
-// render (scene_limits.h).
-Triangle read_triangle(const SceneReader& r, const json& obj, const std::string& p,
-                       const std::vector<Vec3>& v, int a, int b, int c, int material,
-                       Scene& scene) {
-    const Triangle tri = make_triangle(v[a], v[b], v[c], material);
-    double written[3][3];
+// The triangle of vertices a, b, c of a primitive's "vertices"; its written points go to
+// scene.written.
+Triangle read_triangle(const json& obj, const std::vector<Vec3>& v, int a, int b, int c,
+                       int material, Scene& scene) {
     const int corners[3] = {a, b, c};
     for (int k = 0; k < 3; ++k) {
-        for (int axis = 0; axis < 3; ++axis)
-            written[k][axis] = obj["vertices"][corners[k]][axis].get<double>();
-        scene.written.triangle_vertices.push_back({written[k][0], written[k][1], written[k][2]});
+        const json& point = obj["vertices"][corners[k]];
+        scene.written.triangle_vertices.push_back(
+            {point[0].get<double>(), point[1].get<double>(), point[2].get<double>()});
     }
-    const std::string problem = triangle_problem(written, tri);
-    if (!problem.empty()) r.fail(p + "/vertices", problem);
-    return tri;
+    return make_triangle(v[a], v[b], v[c], material);
 }
 
 // The parts of a scene file, one reader each, in the order of the format's description.
@@ -297,13 +302,14 @@ void read_spheres(const SceneReader& r, const PrimitiveReader& prims, Scene& sce
         Sphere s{};
         WrittenPoint centre;
         s.center = read_position(r, r.require(spheres[i], p, "center"), p + "/center", centre);
-        s.radius = r.number(r.require(spheres[i], p, "radius"), p + "/radius");
-        if (!(s.radius > 0.0f)) r.fail(p + "/radius", "expected a radius > 0");
-        const std::string problem = sphere_problem(s);
-        if (!problem.empty()) r.fail(p + "/radius", problem);
+        const double radius =
+            r.written_number(r.require(spheres[i], p, "radius"), p + "/radius", true);
+        if (!(radius > 0.0)) r.fail(p + "/radius", "expected a radius > 0");
+        s.radius = static_cast<real>(radius);
         s.material = prims.material(spheres[i], p);
         scene.spheres.push_back(s);
         scene.written.sphere_centres.push_back(centre);
+        scene.written.sphere_radii.push_back(radius);
     }
 }
 
@@ -316,7 +322,7 @@ void read_triangles(const SceneReader& r, const PrimitiveReader& prims, Scene& s
         r.check_keys(triangles[i], p, {"vertices", "material"});
         const auto v = prims.vertices(triangles[i], p, 3);
         scene.triangles.push_back(
-            read_triangle(r, triangles[i], p, v, 0, 1, 2, prims.material(triangles[i], p), scene));
+            read_triangle(triangles[i], v, 0, 1, 2, prims.material(triangles[i], p), scene));
     }
     const json& quads = prims.list("quads");
     for (size_t i = 0; i < quads.size(); ++i) {
@@ -324,8 +330,8 @@ void read_triangles(const SceneReader& r, const PrimitiveReader& prims, Scene& s
         r.check_keys(quads[i], p, {"vertices", "material"});
         const auto v = prims.vertices(quads[i], p, 4);
         const int m = prims.material(quads[i], p);
-        scene.triangles.push_back(read_triangle(r, quads[i], p, v, 0, 1, 2, m, scene));
-        scene.triangles.push_back(read_triangle(r, quads[i], p, v, 0, 2, 3, m, scene));
+        scene.triangles.push_back(read_triangle(quads[i], v, 0, 1, 2, m, scene));
+        scene.triangles.push_back(read_triangle(quads[i], v, 0, 2, 3, m, scene));
     }
 }
 
@@ -343,46 +349,23 @@ void read_render_settings(const SceneReader& r, const json& root, RenderSettings
     if (rs.contains("seed")) s.seed = static_cast<uint64_t>(read("seed", 0, kMaxSeed));
 }
 
-// The float build's limit on mixed scales (scene_limits.h): each primitive's size against the
-// largest |coordinate| of the scene once centred, both from the file's numbers.
-void check_scene_scale(const SceneReader& r, const json& root, const Scene& scene) {
-    const Vec3 offset = centring_offset(scene);
-    const double centre[3] = {-double(offset.x), -double(offset.y), -double(offset.z)};
-    const auto from_centre = [&](const WrittenPoint& p) {
-        return std::fmax(std::fabs(p.x - centre[0]),
-                         std::fmax(std::fabs(p.y - centre[1]), std::fabs(p.z - centre[2])));
-    };
-    double extent = 0.0;
-    for (size_t i = 0; i < scene.spheres.size(); ++i)
-        extent = std::fmax(extent,
-                           from_centre(scene.written.sphere_centres[i]) + scene.spheres[i].radius);
-    for (const WrittenPoint& v : scene.written.triangle_vertices)
-        extent = std::fmax(extent, from_centre(v));
-    for (size_t i = 0; i < scene.spheres.size(); ++i) {
-        const std::string problem =
-            scene_scale_problem("a radius", scene.spheres[i].radius, extent);
-        if (!problem.empty()) r.fail("/spheres/" + std::to_string(i) + "/radius", problem);
-    }
-    const size_t listed = root.contains("triangles") ? root["triangles"].size() : 0;
-    for (size_t i = 0; i < scene.triangles.size(); ++i) {
-        const WrittenPoint* v = &scene.written.triangle_vertices[3 * i];
-        const auto edge = [&](int a, int b) {
-            return std::hypot(v[a].x - v[b].x, v[a].y - v[b].y, v[a].z - v[b].z);
-        };
-        const double e1[3] = {v[1].x - v[0].x, v[1].y - v[0].y, v[1].z - v[0].z};
-        const double e2[3] = {v[2].x - v[0].x, v[2].y - v[0].y, v[2].z - v[0].z};
-        if (e1[1] * e2[2] == e1[2] * e2[1] && e1[2] * e2[0] == e1[0] * e2[2] &&
-            e1[0] * e2[1] == e1[1] * e2[0])
-            continue;  // no area as written: nothing to show (triangle_problem)
-        const double longest = std::fmax(edge(0, 1), std::fmax(edge(1, 2), edge(2, 0)));
-        const std::string problem =
-            scene_scale_problem("a triangle with a longest edge", longest, extent);
-        if (!problem.empty()) {
-            r.fail(i < listed ? "/triangles/" + std::to_string(i) + "/vertices"
-                              : "/quads/" + std::to_string((i - listed) / 2) + "/vertices",
-                   problem);
-        }
-    }
+// What this build's precision cannot place (scene_limits.h) is refused; in the float build, a
+// scene the double build places is refused as a PrecisionError, which a reference hands to
+// its double build (double_twin.h). Why float cannot place a scene is kept for the double
+// build's report.
+void check_placement(const SceneReader& r, Scene& scene, size_t file_triangles) {
+    const PlacementProblem in_float = placement_problem(scene, file_triangles, kFloatLimits);
+    if (!in_float.empty()) scene.float_refusal = in_float.pointer + ": " + in_float.message;
+    const PlacementProblem own = build_limits().is_double
+                                     ? placement_problem(scene, file_triangles, kDoubleLimits)
+                                     : in_float;
+    if (own.empty()) return;
+    if (!build_limits().is_double &&
+        placement_problem(scene, file_triangles, kDoubleLimits).empty())
+        r.fail_precision(own.pointer, own.message +
+                                          "; double places it: the references switch to it by "
+                                          "themselves (./lab01-ref), or make lab01-ref-double");
+    r.fail(own.pointer, own.message);
 }
 
 // An edge as two points, the lesser first: the same key from either side.
@@ -496,8 +479,9 @@ Scene parse_scene(const std::string& text, const std::string& name) {
     read_spheres(r, prims, scene);
     read_triangles(r, prims, scene);
     read_render_settings(r, root, scene.render);
-    check_scene_scale(r, root, scene);
-    classify_quads(scene, root.contains("triangles") ? root["triangles"].size() : 0);
+    const size_t file_triangles = root.contains("triangles") ? root["triangles"].size() : 0;
+    check_placement(r, scene, file_triangles);
+    classify_quads(scene, file_triangles);
     return scene;
 }
 

@@ -10,6 +10,7 @@
 
 #include <string>
 
+#include <ray.h>
 #include <scene.h>
 
 struct SceneUse {
@@ -21,10 +22,10 @@ struct SceneUse {
     double extent = 0;  // the largest |coordinate| of any primitive, after centring
 };
 
-// A detail is resolved while it spans at least this many ray offsets of a ray that crossed
-// the scene (offsets are 2^-20 of the distance scale, ray.h; a crossing ray's is about 4
-// extents): smallest >= extent * 2^-14.
-constexpr double kResolvedDetail = 1.0 / (1 << 14);
+// A detail is resolved while it spans at least 16 ray offsets of a ray that crossed the scene
+// (offsets are kRelativeOffset of the distance scale, ray.h: 2^-20 in float, 2^-49 in
+// double; a crossing ray's is about 4 extents): smallest >= extent * 2^-14 in float.
+constexpr double kResolvedDetail = 64.0 * kRelativeOffset;
 
 SceneUse scene_use(const Scene& scene);
 std::string describe(const SceneUse& use);  // one line

@@ -57,3 +57,13 @@ lab03-simd-ref:
 	@echo "lab03-simd-ref: needs an x86-64 CPU and compiler (AVX2)" >&2
 	@exit 1
 endif
+
+# The reference in double (OpenMP over lab 01's scalar renderer), which lab03-ref and
+# lab03-simd-ref carry and hand a scene float cannot place (common/host/double_twin.h).
+$(DOUBLE_BUILD)/$(LAB03)/%.o: CXXFLAGS += -fopenmp
+$(DOUBLE_BUILD)/$(LAB03)/solution/%.o: LAB_INCLUDES = -I$(LAB03)/solution
+lab03-ref-double: $(patsubst %.cpp,$(DOUBLE_BUILD)/%.o,$(wildcard $(LAB03)/solution/*.cpp)) \
+                  $(DOUBLE_COMMON_OBJ)
+	$(CXX) $(CXXFLAGS) $^ -o $@ -fopenmp
+lab03-ref lab03-simd-ref: $(BUILD)/twins/lab03-ref-double.o
+LAB_BINARIES += lab03-ref-double

@@ -38,6 +38,8 @@ lab05-ref-no-fma: $(LAB05_BUILD)/no-fma/render.o $(COMMON_OBJ)
 # The reference in double: linked with the double build's host objects (Makefile).
 lab05-ref-double: $(LAB05_BUILD)/double/render.o $(DOUBLE_COMMON_OBJ)
 	$(NVCC) $(CUDA_ARCH) $^ -o $@
+# lab05-ref carries it and hands it a scene float cannot place (common/host/double_twin.h).
+lab05-ref: $(BUILD)/twins/lab05-ref-double.o
 
 # The benchmark has its own main; it links the library part of common/host only. It runs the
 # reference kernel (common/cuda/megakernel.cuh) in every shape it measures.

@@ -3,7 +3,8 @@ lab05-ref-double` build the same renderer with `real` = double, from the same sc
 command line. The double build passes every correctness check lab 01's reference passes, says
 "double" in --json, and really computes in double (tests/precision/test_double.cpp); the
 float build says "float". The double build accepts the wider scenes double can hold
-(common/host/scene_limits.h) which the float build refuses in one line."""
+(common/host/scene_limits.h); the students' float build refuses them in one line, and the
+references render them in double by themselves (common/host/double_twin.h)."""
 import os
 import subprocess
 
@@ -56,22 +57,51 @@ def test_computes_in_double():
     assert p.returncode == 0, p.stdout + p.stderr
 
 
-def test_double_build_accepts_wider_scales(lab01_ref, lab01_ref_double, tmp_path):
-    """The sphere interior scaled to radius 1e12: past float's bounds (1e9, one error line),
-    within double's (1e30): the double build renders it like the unit-size scene."""
+def test_the_reference_renders_wider_scales_in_double(lab01_ref, lab01_ref_double, tmp_path):
+    """The sphere interior scaled to radius 1e12: past float's bounds (1e9), within double's
+    (1e30). The students' float build refuses it in one line; the reference renders it in
+    double by itself, as the double build does, like the unit-size scene, and says why."""
     def interior(scale):
         scene = scenes.sphere_interior(**checks.INTERIOR)
         return scenes.write_scene(tmp_path / f"scaled-{scale:g}.json",
                                   scenes.scaled(scene, scale))
     big = interior(1e12)
-    p = subprocess.run([str(lab01_ref), "--quiet", "--scene", str(big), "--width", "4",
+    student = build("lab01")[0]
+    p = subprocess.run([str(student), "--quiet", "--scene", str(big), "--width", "4",
                         "--height", "4", "--spp", "1"], capture_output=True, text=True)
     lines = p.stderr.strip().splitlines()
-    assert p.returncode != 0 and len(lines) == 1 and "1e9" in lines[0], p.stderr
+    assert p.returncode == 2 and len(lines) == 1 and "1e9" in lines[0], p.stderr
+    assert "double places it" in lines[0] and "lab01-ref" in lines[0], lines[0]
     settings = dict(width=8, height=8, spp=4, bounces=2)
     want = scenes.sphere_interior_radiance(**checks.INTERIOR, bounces=2)
-    image = run_lab(lab01_ref_double, big, **settings).image
-    assert abs(image / want - 1).max() < 3e-4
+    for binary in (lab01_ref, lab01_ref_double):
+        run = run_lab(binary, big, **settings)
+        assert abs(run.image / want - 1).max() < 3e-4, binary.name
+        assert run.json["precision"] == "double"
+    assert "1e9" in run_lab(lab01_ref, big, **settings).json["precision_reason"]
+
+
+def test_a_mixed_scale_scene_is_rendered_right_by_the_reference(lab01_ref, tmp_path):
+    """A sphere of radius 1e-4 on a floor of half-size 1e4, lit from the side: float cannot
+    place the sphere, so lab01-ref renders it in double, and its image is the float image of
+    the same view on a floor of half-size 1 (one bounce: the floor out of view adds nothing)
+    to rounding: the same mean, every shadow pixel dark. With ray offsets of 2^-20 of the
+    scene's size in double too, the shadow rays started above the sphere and 97 of the 192
+    shadow pixels were lit."""
+    settings = dict(width=64, height=64, spp=64, bounces=1, seed=5)
+    far = scenes.write_scene(tmp_path / "mixed.json", scenes.mixed_scale(1e4))
+    near = scenes.write_scene(tmp_path / "near.json", scenes.mixed_scale(1.0))
+    mixed = run_lab(lab01_ref, far, **settings)
+    plain = run_lab(lab01_ref, near, **settings)
+    assert mixed.json["precision"] == "double" and plain.json["precision"] == "float"
+    assert "/spheres/0/radius" in mixed.json["precision_reason"]
+    assert abs(mixed.image.mean() / plain.image.mean() - 1) < 1e-3
+    luminance, want = mixed.image.mean(axis=2), plain.image.mean(axis=2)
+    shadow = want < 0.02 * want.mean()
+    assert shadow.sum() > 100, "the scene lost its shadow"
+    assert (luminance[shadow] < 0.1 * want.mean()).all(), \
+        f"{(luminance[shadow] >= 0.1 * want.mean()).sum()} of {shadow.sum()} shadow pixels lit"
+    assert float(abs(luminance - want).mean()) < 2e-3 * float(want.mean())
 
 
 def test_lab05_double_builds(nvcc):

@@ -1,7 +1,8 @@
-// The scene loader accepts exactly what the renderer's float arithmetic can show
-// (common/host/scene_limits.h): coordinates up to 1e9, sizes from 1e-9 and from 2^-18 of their
-// distance from the origin, triangles that keep their area in float. Everything else is one
-// InputError line that names the place and says what to do.
+// The scene loader accepts exactly what the renderer's float arithmetic can show once the
+// scene is centred (common/host/scene_limits.h): coordinates up to 1e9 of the scene's centre,
+// sizes from 1e-9 and from 2^-18 of their distance from it, triangles that keep their area in
+// float. Everything else is one InputError line that names the place and says what to do;
+// where the scene sits does not matter.
 #include <gtest/gtest.h>
 
 #include <string>
@@ -12,9 +13,10 @@
 namespace {
 
 // A scene with a camera and one material around `primitives` (top-level members).
-std::string scene(const std::string& primitives, const std::string& camera_position = "[0, 0, 5]") {
-    return "{\n  \"camera\": { \"position\": " + camera_position +
-           ", \"look_at\": [0, 0, 0] },\n"
+std::string scene(const std::string& primitives, const std::string& camera_position = "[0, 0, 5]",
+                  const std::string& look_at = "[0, 0, 0]") {
+    return "{\n  \"camera\": { \"position\": " + camera_position + ", \"look_at\": " + look_at +
+           " },\n"
            "  \"materials\": { \"m\": { \"type\": \"diffuse\", \"albedo\": [0.5, 0.5, 0.5] } },\n" +
            primitives + "\n}\n";
 }
@@ -60,11 +62,13 @@ TEST(SceneLimits, AcceptsTheRangeTheRendererHandles) {
     EXPECT_EQ(refusal(scene(triangle("[0, 0, 0]", "[0, 0, 0]", "[0, 0, 0]"))), "");
 }
 
-TEST(SceneLimits, RefusesCoordinatesPast1e9) {
+TEST(SceneLimits, RefusesCoordinatesPast1e9OfTheScenesCentre) {
     expect_refused(scene(sphere("[0, 2e9, 0]", "1")),
-                   {"/spheres/0/center/1", "1e9", "scale the scene down"});
+                   {"/camera/position/1", "1e9", "scale the scene down"});
+    // The same sphere with its camera beside it: the scene is small, wherever it is.
+    EXPECT_EQ(refusal(scene(sphere("[0, 2e9, 0]", "1"), "[0, 2e9, 5]", "[0, 2e9, 0]")), "");
     expect_refused(scene(triangle("[0, 0, 0]", "[1, 0, 0]", "[0, 0, -3e9]")),
-                   {"/triangles/0/vertices/2/2", "1e9"});
+                   {"/triangles/0/vertices/0/2", "1e9"});
     expect_refused(scene(sphere("[0, 0, 0]", "1"), "[0, 0, 1e10]"), {"/camera/position/2", "1e9"});
     expect_refused(scene(sphere("[0, 0, 0]", "2e9")), {"/spheres/0/radius", "above 1e9"});
     expect_refused(scene("  \"light\": { \"position\": [5e9, 0, 0], \"intensity\": [1, 1, 1] },\n" +
@@ -83,17 +87,25 @@ TEST(SceneLimits, RefusesPrimitivesTooSmallForFloat) {
         {"/quads/0/vertices", "below 1e-9"});
 }
 
-// Float spacing near 1e5 is ~0.008: a sphere of radius 0.2 there is a few ray offsets across.
-TEST(SceneLimits, RefusesPrimitivesTooSmallForTheirPosition) {
-    expect_refused(scene(sphere("[1e5, 0, 0]", "0.2")),
-                   {"/spheres/0/radius", "too small for float precision", "nearer the origin"});
-    expect_refused(scene(triangle("[1e6, 0, 0]", "[1e6, 1, 0]", "[1e6, 0, 1]")),
+// Float spacing near 5e4 is ~0.004: a sphere of radius 0.1 there, 5e4 from the scene's
+// centre, is under 4 ray offsets across. Alone, at the same place, it is the whole scene.
+TEST(SceneLimits, RefusesPrimitivesTooSmallForTheirPlaceInTheScene) {
+    const std::string far_and_near =
+        "  \"spheres\": [ { \"center\": [1e5, 0, 0], \"radius\": "
+        "0.1, \"material\": \"m\" }, { \"center\": [0, 0, 0], "
+        "\"radius\": 1, \"material\": \"m\" } ]";
+    expect_refused(scene(far_and_near),
+                   {"/spheres/0/radius", "too small for float precision", "scene's centre"});
+    EXPECT_EQ(refusal(scene(sphere("[1e5, 0, 0]", "0.1"), "[1e5, 0, 5]", "[1e5, 0, 0]")), "");
+    expect_refused(scene(triangle("[1e6, 0, 0]", "[1e6, 1, 0]", "[1e6, 0, 1]") + ",\n" +
+                         sphere("[0, 0, 0]", "3")),
                    {"/triangles/0/vertices", "too small for float precision"});
 }
 
-// 5e6 + 0.1 rounds to 5e6 in float (spacing 0.5): the third vertex lands on the line of the
-// others and the triangle, which has an area as written, would never be hit.
+// Centred, the third vertex is (4e6, 4000000.1), which rounds to (4e6, 4e6) in float (spacing
+// 0.25): it lands on the line of the others, and the triangle, which has an area as written,
+// would never be hit.
 TEST(SceneLimits, RefusesTrianglesThatCollapseInFloat) {
-    expect_refused(scene(triangle("[0, 0, 0]", "[1e7, 1e7, 0]", "[5e6, 5000000.1, 0]")),
+    expect_refused(scene(triangle("[0, 0, 0]", "[1e7, 1e7, 0]", "[9e6, 9000000.1, 0]")),
                    {"/triangles/0/vertices", "collapses", "rounded to float"});
 }

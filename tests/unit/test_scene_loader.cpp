@@ -606,8 +606,12 @@ TEST(SceneLoaderErrors, ArrayOfFourWhereThreeExpected) {
         {"expected an array of 3 numbers", "an array of 4"});
 }
 
+// A coordinate is judged once the scene is centred (test_scene_limits.cpp); any other number
+// must be within the type's range as written.
 TEST(SceneLoaderErrors, NumberTooLargeForFloat) {
-    expect_error(scene_with("\"center\": [0, 0, @1e39], \"radius\": 1, \"material\": \"white\""),
+    expect_error(scene_with(kGoodSphere,
+                            "  \"light\": { \"position\": [0, 1, 0], "
+                            "\"intensity\": [1, @1e39, 1] },\n"),
                  {"float range"});
 }
 

@@ -1,0 +1,171 @@
+#include <scene_limits.h>
+
+#include <cfloat>
+#include <cmath>
+#include <cstdio>
+
+#include <scene_centring.h>
+
+const PrecisionLimits kFloatLimits{"float", 1e9,   "1e9",   1e-9, "1e-9", 8.0 * FLT_EPSILON,
+                                   "2^-20", false};
+const PrecisionLimits kDoubleLimits{"double", 1e30,  "1e30",  1e-30, "1e-30", 8.0 * DBL_EPSILON,
+                                    "2^-49",  true};
+
+const PrecisionLimits& build_limits() {
+#if defined(RT_DOUBLE)
+    return kDoubleLimits;
+#else
+    return kFloatLimits;
+#endif
+}
+
+namespace {
+
+std::string format_number(double x) {
+    char text[32];
+    std::snprintf(text, sizeof text, "%.3g", x);
+    return text;
+}
+
+// A size, against the type's range and the extent of the primitive it belongs to.
+std::string size_problem(const char* what, double size, double extent,
+                         const PrecisionLimits& limits) {
+    if (size < limits.min_size)
+        return std::string(what) + " of " + format_number(size) + " is below " +
+               limits.min_size_text + ", too small for the renderer's " + limits.name +
+               " arithmetic: scale the scene up";
+    if (size < limits.min_relative_size() * extent)
+        return std::string(what) + " of " + format_number(size) + " is too small for " +
+               limits.name + " precision that far from the scene's centre (coordinates up to " +
+               format_number(extent) + "): make it larger, or the scene smaller";
+    return "";
+}
+
+std::string scene_scale_problem(const char* what, double size, double scene_extent,
+                                const PrecisionLimits& limits) {
+    if (!(size < limits.min_scene_relative_size() * scene_extent)) return "";
+    return std::string(what) + " of " + format_number(size) + " is below " +
+           limits.relative_offset_text + " of the scene's extent (" + format_number(scene_extent) +
+           " from its centre), finer than " + limits.name + " arithmetic places it there";
+}
+
+// Whether a triangle with an area as written loses it when its points are rounded to T: the
+// normal make_triangle (triangle.h) computes from the rounded points is then zero.
+template <class T>
+bool collapses(const WrittenPoint (&v)[3]) {
+    const auto r = [](double x) { return double(static_cast<T>(x)); };
+    const double e1[3] = {r(v[1].x) - r(v[0].x), r(v[1].y) - r(v[0].y), r(v[1].z) - r(v[0].z)};
+    const double e2[3] = {r(v[2].x) - r(v[0].x), r(v[2].y) - r(v[0].y), r(v[2].z) - r(v[0].z)};
+    return e1[1] * e2[2] - e1[2] * e2[1] == 0.0 && e1[2] * e2[0] - e1[0] * e2[2] == 0.0 &&
+           e1[0] * e2[1] - e1[1] * e2[0] == 0.0;
+}
+
+double largest(const WrittenPoint& p) {
+    return std::fmax(std::fabs(p.x), std::fmax(std::fabs(p.y), std::fabs(p.z)));
+}
+
+}  // namespace
+
+PlacementProblem placement_problem(const Scene& scene, size_t file_triangles,
+                                   const PrecisionLimits& limits) {
+    const WrittenPoint c = centring_centre(scene);
+    const auto centred = [&](const WrittenPoint& p) {
+        return WrittenPoint{p.x - c.x, p.y - c.y, p.z - c.z};
+    };
+    const WrittenCoordinates& w = scene.written;
+    // Where the i-th triangle of the scene is written: a triangle, or one half of a quad.
+    const auto triangle_pointer = [&](size_t i) {
+        return i < file_triangles ? "/triangles/" + std::to_string(i)
+                                  : "/quads/" + std::to_string((i - file_triangles) / 2);
+    };
+    // A triangle's k-th point in the file: a quad's second half is its v0 v2 v3.
+    const auto vertex_pointer = [&](size_t i, int k) {
+        const bool second_half = i >= file_triangles && (i - file_triangles) % 2 == 1;
+        const int index = second_half && k > 0 ? k + 1 : k;
+        return triangle_pointer(i) + "/vertices/" + std::to_string(index);
+    };
+
+    // Every point once centred, within the type's range: the primitives', then the light's
+    // and the camera's.
+    const auto coordinate = [&](const WrittenPoint& p, const std::string& pointer) {
+        const WrittenPoint q = centred(p);
+        const double axes[3] = {q.x, q.y, q.z};
+        for (int axis = 0; axis < 3; ++axis) {
+            if (std::fabs(axes[axis]) <= limits.max_coordinate) continue;
+            return PlacementProblem{
+                pointer + "/" + std::to_string(axis),
+                std::string("expected a coordinate within +-") + limits.max_coordinate_text +
+                    " of the scene's centre (beyond it the renderer's " + limits.name +
+                    " arithmetic overflows): scale the scene down or bring it nearer its "
+                    "camera and light"};
+        }
+        return PlacementProblem{};
+    };
+    for (size_t i = 0; i < w.sphere_centres.size(); ++i) {
+        const PlacementProblem problem =
+            coordinate(w.sphere_centres[i], "/spheres/" + std::to_string(i) + "/center");
+        if (!problem.empty()) return problem;
+    }
+    for (size_t i = 0; i < w.triangle_vertices.size(); ++i) {
+        const PlacementProblem problem =
+            coordinate(w.triangle_vertices[i], vertex_pointer(i / 3, static_cast<int>(i % 3)));
+        if (!problem.empty()) return problem;
+    }
+
+    if (scene.camera.written) {
+        for (const auto& [p, pointer] : {std::pair{scene.camera.written_position, "/camera/position"},
+                                         std::pair{scene.camera.written_look_at, "/camera/look_at"}}) {
+            const PlacementProblem problem = coordinate(p, pointer);
+            if (!problem.empty()) return problem;
+        }
+    }
+    if (scene.has_light) {
+        const PlacementProblem problem = coordinate(w.light_position, "/light/position");
+        if (!problem.empty()) return problem;
+    }
+    // The scene's extent once centred: its largest |coordinate|.
+    double extent = 0.0;
+    for (size_t i = 0; i < w.sphere_centres.size(); ++i)
+        extent = std::fmax(extent, largest(centred(w.sphere_centres[i])) + w.sphere_radii[i]);
+    for (const WrittenPoint& v : w.triangle_vertices) extent = std::fmax(extent, largest(centred(v)));
+
+    for (size_t i = 0; i < w.sphere_centres.size(); ++i) {
+        const std::string pointer = "/spheres/" + std::to_string(i) + "/radius";
+        const double radius = w.sphere_radii[i];
+        if (radius > limits.max_coordinate)
+            return {pointer, "a radius of " + format_number(radius) + " is above " +
+                                 limits.max_coordinate_text + ", too large for the renderer's " +
+                                 limits.name + " arithmetic: scale the scene down"};
+        std::string problem = size_problem("a radius", radius,
+                                           largest(centred(w.sphere_centres[i])) + radius, limits);
+        if (problem.empty()) problem = scene_scale_problem("a radius", radius, extent, limits);
+        if (!problem.empty()) return {pointer, problem};
+    }
+    for (size_t i = 0; 3 * i < w.triangle_vertices.size(); ++i) {
+        const WrittenPoint v[3] = {centred(w.triangle_vertices[3 * i]),
+                                   centred(w.triangle_vertices[3 * i + 1]),
+                                   centred(w.triangle_vertices[3 * i + 2])};
+        // The differences of the written points, which centring leaves as they were.
+        const WrittenPoint* raw = &w.triangle_vertices[3 * i];
+        const double r1[3] = {raw[1].x - raw[0].x, raw[1].y - raw[0].y, raw[1].z - raw[0].z};
+        const double r2[3] = {raw[2].x - raw[0].x, raw[2].y - raw[0].y, raw[2].z - raw[0].z};
+        if (r1[1] * r2[2] == r1[2] * r2[1] && r1[2] * r2[0] == r1[0] * r2[2] &&
+            r1[0] * r2[1] == r1[1] * r2[0])
+            continue;  // no area as written: nothing to show, kept and never hit
+        const auto edge = [&](int a, int b) {
+            return std::hypot(raw[a].x - raw[b].x, raw[a].y - raw[b].y, raw[a].z - raw[b].z);
+        };
+        const double longest = std::fmax(edge(0, 1), std::fmax(edge(1, 2), edge(2, 0)));
+        const double own_extent = std::fmax(largest(v[0]), std::fmax(largest(v[1]), largest(v[2])));
+        const char* what = "a triangle with a longest edge";
+        std::string problem = size_problem(what, longest, own_extent, limits);
+        if (problem.empty()) problem = scene_scale_problem(what, longest, extent, limits);
+        if (problem.empty() &&
+            (limits.is_double ? collapses<double>(v) : collapses<float>(v)))
+            problem = std::string("the triangle collapses to a line when its vertices are "
+                                  "rounded to ") +
+                      limits.name + ": make it larger, or the scene smaller";
+        if (!problem.empty()) return {triangle_pointer(i) + "/vertices", problem};
+    }
+    return {};
+}
