@@ -17,6 +17,7 @@ from cuda_env import gpu_name, missing_gpu
 
 from grading import checks
 from grading.renderer_checks import CHECKS
+from labkit import scenes
 from labkit.compare import compare
 from labkit.harness import ROOT, build, golden, run_lab
 
@@ -315,6 +316,22 @@ def test_double_build_passes(gpu, check):
     assert run_lab(binary, width=4, height=4, spp=1).json["precision"] == "double"
     result = check(binary)
     assert result.passed, str(result)
+
+
+def test_the_reference_renders_a_mixed_scale_scene_in_double(gpu, lab05_ref, lab01_ref, tmp_path):
+    """A sphere of radius 1e-4 on a floor of half-size 1e4 (test_precision.py's scene): the
+    GPU reference hands it to its double build by itself, says so, and draws what lab 01's
+    reference draws (which hands it to double too): the same mean, every shadow pixel dark."""
+    settings = dict(width=64, height=64, spp=64, bounces=1, seed=5)
+    far = scenes.write_scene(tmp_path / "mixed.json", scenes.mixed_scale(1e4))
+    gpu_run = run_lab(lab05_ref, far, **settings)
+    cpu = run_lab(lab01_ref, far, **settings).image
+    assert gpu_run.json["precision"] == "double", gpu_run.json
+    assert "/spheres/0/radius" in gpu_run.json["precision_reason"]
+    assert abs(gpu_run.image.mean() / cpu.mean() - 1) < 1e-3
+    want = cpu.mean(axis=2)
+    shadow = want < 0.02 * want.mean()
+    assert shadow.sum() > 100 and (gpu_run.image.mean(axis=2)[shadow] < 0.1 * want.mean()).all()
 
 
 def test_baseline_is_finite_and_summarised(gpu, lab05_ref):
