@@ -38,7 +38,8 @@ $(BUILD)/common/simd/packets_avx512.o: CXXFLAGS += $(SIMD_AVX512_FLAGS)
 # The library part of common/host (what unit tests link) and the driver every lab binary adds.
 LIB_SRC    := common/host/scene_loader.cpp common/host/json_with_positions.cpp common/host/image.cpp common/host/cli.cpp \
               common/host/progress.cpp common/host/interrupt_cleanup.cpp \
-              common/host/scene_centring.cpp common/host/scene_report.cpp
+              common/host/scene_centring.cpp common/host/scene_report.cpp \
+              common/host/t_junctions.cpp
 LIB_OBJ    := $(LIB_SRC:%.cpp=$(BUILD)/%.o)
 DRIVER_OBJ := $(BUILD)/common/host/lab_main.o $(BUILD)/common/host/main.o
 COMMON_OBJ := $(LIB_OBJ) $(DRIVER_OBJ)
@@ -163,8 +164,10 @@ UNIT_OBJ := $(UNIT_SRC:%.cpp=$(BUILD)/%.o)
 $(BUILD)/unit_tests: $(UNIT_OBJ) $(LIB_OBJ)
 	$(CXX) $(CXXFLAGS) $^ -o $@ -lgtest -lgtest_main -pthread
 
-# The unit tests that show the double build computes in double (tests/precision/).
-$(BUILD)/precision_tests_double: $(DOUBLE_BUILD)/tests/precision/test_double.o $(DOUBLE_LIB_OBJ)
+# The unit tests that show the double build computes in double (tests/precision/), and the
+# unit tests written in `real` that the double build must pass too.
+$(BUILD)/precision_tests_double: $(DOUBLE_BUILD)/tests/precision/test_double.o \
+                                 $(DOUBLE_BUILD)/tests/unit/test_t_junctions.o $(DOUBLE_LIB_OBJ)
 	$(CXX) $(CXXFLAGS) $^ -o $@ -lgtest -lgtest_main -pthread
 
 test-unit: $(BUILD)/unit_tests

@@ -81,6 +81,7 @@ struct Scene {
     std::vector<AxisRect> rects;    // axis-aligned rectangles
     RenderSettings render;            // the file's settings, or the defaults
     WrittenCoordinates written;       // the file's points in double, for centre_scene
+    int t_junction_pieces = 0;  // primitives added by splitting at T-junctions (t_junctions.h)
 
     SceneView view() const {
         return {spheres.data(),

@@ -14,6 +14,7 @@
 #include <json_with_positions.h>
 #include <scene_centring.h>
 #include <scene_limits.h>
+#include <t_junctions.h>
 
 using nlohmann::json;
 
@@ -498,6 +499,7 @@ Scene parse_scene(const std::string& text, const std::string& name) {
     read_render_settings(r, root, scene.render);
     check_scene_scale(r, root, scene);
     classify_quads(scene, root.contains("triangles") ? root["triangles"].size() : 0);
+    scene.t_junction_pieces = split_t_junctions(scene);
     return scene;
 }
 
