@@ -55,8 +55,9 @@ bool flat(const Piece& p) {
 }
 
 // Rounding moves each centred coordinate by half an ulp, so a point written on an edge lies
-// within about 2 ulps of the rendered edge's line; computing the distance adds a few more in
-// the double build. 8 ulps of the largest coordinate covers both.
+// within about 2 ulps of the rendered edge's line; computing the distance in long double adds
+// a few more in the double build where long double is double. 8 ulps of the largest
+// coordinate covers both.
 constexpr long double kCollinearUlps = 8;
 
 // Where p lies on the edge a-b, strictly between its ends and collinear within rounding: its
@@ -83,8 +84,8 @@ long double along_edge(Vec3 a, Vec3 b, Vec3 p) {
 }
 
 // The scene's vertices in a uniform grid over their bounds (2 cbrt(n) cells a side), so an edge
-// looks only at those in the cells its bounding box covers (a mesh of 10^5 triangles loads in
-// well under a second; a list sorted on one axis was quadratic for a mesh in a plane x = c).
+// looks only at those in the cells its bounding box covers, whatever the mesh's orientation
+// (a list sorted on one axis would be quadratic for a mesh in a plane x = c).
 class PointIndex {
 public:
     explicit PointIndex(const std::vector<Piece>& pieces) {
