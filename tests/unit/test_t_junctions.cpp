@@ -35,6 +35,7 @@ struct Room {
     std::vector<std::vector<Point>> triangles, quads;
     std::vector<std::array<Point, 2>> junctions;
     bool rotated = false;
+    double scale = 1;  // applied with the rotation, before the move (times scale)
 
     Point placed(Point p) const {
         if (!rotated) return p;
@@ -46,7 +47,8 @@ struct Room {
                              a[0] * p[1] - a[1] * p[0]};
         const double offset[3] = {12.37, -6.21, 3.11};
         Point out;
-        for (int i = 0; i < 3; ++i) out[i] = p[i] * c + x[i] * s + a[i] * d * (1 - c) + offset[i];
+        for (int i = 0; i < 3; ++i)
+            out[i] = (p[i] * c + x[i] * s + a[i] * d * (1 - c) + offset[i]) * scale;
         return out;
     }
 
@@ -171,6 +173,15 @@ TEST(TJunctions, RectangleFloorAndConvexQuadWallsLetNoRayOut) {
 
 TEST(TJunctions, TrianglesOverlappingAlongAnEdgeLetNoRayOut) {
     EXPECT_EQ(escaping_rays(two_triangles_overlapping_along_an_edge(), 4000), 0);
+}
+
+// The tolerance is relative: the same room tiny, or large and far from the origin.
+TEST(TJunctions, TrianglesOverlappingAlongAnEdgeLetNoRayOutAtAnyScale) {
+    for (double scale : {1e-3, 1e4}) {
+        Room room = two_triangles_overlapping_along_an_edge();
+        room.scale = scale;
+        EXPECT_EQ(escaping_rays(room, 2000), 0) << "scale " << scale;
+    }
 }
 
 // Splitting again finds nothing: a loaded room has no T-junction left, and a scene without
