@@ -39,7 +39,8 @@ $(BUILD)/common/simd/packets_avx512.o: CXXFLAGS += $(SIMD_AVX512_FLAGS)
 LIB_SRC    := common/host/scene_loader.cpp common/host/json_with_positions.cpp common/host/image.cpp common/host/cli.cpp \
               common/host/progress.cpp common/host/interrupt_cleanup.cpp \
               common/host/scene_centring.cpp common/host/scene_report.cpp \
-              common/host/scene_limits.cpp common/host/double_twin.cpp
+              common/host/scene_limits.cpp common/host/double_twin.cpp \
+              common/host/t_junctions.cpp
 LIB_OBJ    := $(LIB_SRC:%.cpp=$(BUILD)/%.o)
 DRIVER_OBJ := $(BUILD)/common/host/lab_main.o $(BUILD)/common/host/main.o
 COMMON_OBJ := $(LIB_OBJ) $(DRIVER_OBJ)
@@ -172,9 +173,10 @@ $(BUILD)/unit_tests: $(UNIT_OBJ) $(LIB_OBJ)
 	$(CXX) $(CXXFLAGS) $^ -o $@ -lgtest -lgtest_main -pthread
 
 # The unit tests that show the double build computes in double (tests/precision/), and the
-# placement tests, which hold in both builds.
+# unit tests written in `real` that the double build must pass too (placement, T-junctions).
 $(BUILD)/precision_tests_double: $(DOUBLE_BUILD)/tests/precision/test_double.o \
-                                 $(DOUBLE_BUILD)/tests/unit/test_scene_placement.o $(DOUBLE_LIB_OBJ)
+                                 $(DOUBLE_BUILD)/tests/unit/test_scene_placement.o \
+                                 $(DOUBLE_BUILD)/tests/unit/test_t_junctions.o $(DOUBLE_LIB_OBJ)
 	$(CXX) $(CXXFLAGS) $^ -o $@ -lgtest -lgtest_main -pthread
 
 test-unit: $(BUILD)/unit_tests

@@ -86,6 +86,7 @@ struct Scene {
     // or when the scene was not loaded from a file. Set in both builds: the double build says
     // why it was needed (lab_main.cpp).
     std::string float_refusal;
+    int t_junction_pieces = 0;  // primitives added by splitting at T-junctions (t_junctions.h)
 
     SceneView view() const {
         return {spheres.data(),

@@ -14,6 +14,7 @@
 #include <json_with_positions.h>
 #include <scene_centring.h>
 #include <scene_limits.h>
+#include <t_junctions.h>
 
 using nlohmann::json;
 
@@ -482,6 +483,7 @@ Scene parse_scene(const std::string& text, const std::string& name) {
     const size_t file_triangles = root.contains("triangles") ? root["triangles"].size() : 0;
     check_placement(r, scene, file_triangles);
     classify_quads(scene, file_triangles);
+    scene.t_junction_pieces = split_t_junctions(scene);
     return scene;
 }
 

@@ -40,6 +40,7 @@ SceneUse scene_use(const Scene& scene) {
     use.triangles = static_cast<int>(scene.triangles.size());
     use.quads = static_cast<int>(scene.quads.size());
     use.rects = static_cast<int>(scene.rects.size());
+    use.split_pieces = scene.t_junction_pieces;
     for (const Material& m : scene.materials) {
         use.diffuse += m.type == MaterialType::Diffuse;
         use.mirrors += m.type == MaterialType::Mirror;
@@ -86,6 +87,8 @@ std::string describe(const SceneUse& use) {
     count(use.triangles, "triangle", "triangles");
     count(use.quads, "convex quad", "convex quads");
     count(use.rects, "rectangle", "rectangles");
+    if (use.split_pieces > 0)
+        primitives += " (splitting at T-junctions added " + std::to_string(use.split_pieces) + ")";
     std::string line =
         "scene: " + (primitives.empty() ? std::string("no primitives") : primitives) +
         "; materials: " + (materials.empty() ? "none" : materials) + "; " +

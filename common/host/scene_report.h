@@ -15,6 +15,7 @@
 
 struct SceneUse {
     int spheres = 0, triangles = 0, quads = 0, rects = 0;  // geometry_kinds(scene), counted
+    int split_pieces = 0;  // of those, how many more the splitting at T-junctions made
     int diffuse = 0, mirrors = 0, glass = 0;  // the material table's entries by kind
     bool light = false;
     bool background = false;  // a background that is not black

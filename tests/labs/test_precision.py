@@ -51,7 +51,9 @@ def test_double_build_differs_from_float_by_rounding_only(lab01_ref, lab01_ref_d
 
 def test_computes_in_double():
     """tests/precision/test_double.cpp, built with -DRT_DOUBLE: quantities float cannot
-    resolve (a sphere 1e8 from the origin, an edge function below double rounding)."""
+    resolve (a sphere 1e8 from the origin, an edge function below double rounding); and
+    tests/unit/test_t_junctions.cpp, written in `real`, in double (rooms watertight where
+    walls meet part-way along an edge)."""
     binary = build("build/precision_tests_double")[0]
     p = subprocess.run([str(binary), "--gtest_brief=1"], capture_output=True, text=True)
     assert p.returncode == 0, p.stdout + p.stderr

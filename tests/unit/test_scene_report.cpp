@@ -69,6 +69,18 @@ TEST(SceneReport, CountsQuadsAndRectanglesByKind) {
     EXPECT_NE(describe(scene_use(Scene())).find("scene: no primitives;"), std::string::npos);
 }
 
+// The primitives that splitting at T-junctions added are said after the counts, which include
+// them; a scene that needed none says nothing of it.
+TEST(SceneReport, SaysHowManyPrimitivesSplittingAdded) {
+    Scene s = scene_with(0.25, 2.0);
+    EXPECT_EQ(describe(scene_use(s)).find("T-junctions"), std::string::npos);
+    s.t_junction_pieces = 3;
+    const std::string line = describe(scene_use(s));
+    EXPECT_NE(line.find("scene: 1 sphere, 1 triangle (splitting at T-junctions added 3);"),
+              std::string::npos)
+        << line;
+}
+
 // The warning starts where a detail spans fewer than 2^14 of the scene's extent.
 TEST(SceneReport, WarnsOfADetailBelowTheResolvedSize) {
     const double wall = 1000.0;

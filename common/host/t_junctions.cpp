@@ -1,0 +1,428 @@
+#include <t_junctions.h>
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <map>
+#include <utility>
+#include <vector>
+
+#include <scene_centring.h>
+
+namespace {
+
+enum class Kind { kTriangle, kQuad, kRect };
+
+// A flat primitive while splitting: its corners as written (doubles) and as rendered (moved to
+// the scene's centre and rounded once).
+struct Piece {
+    Kind kind = Kind::kTriangle;
+    int corners = 3;
+    WrittenPoint written[4];
+    Vec3 rendered[4];
+    int material = 0;
+    int axis = -1;  // a rectangle's plane axis
+};
+
+// A vertex of some piece: the point that may lie on another piece's edge.
+struct Point {
+    Vec3 rendered;
+    WrittenPoint written;
+    bool of_rect;
+};
+
+double coordinate(const WrittenPoint& p, int axis) {
+    return axis == 0 ? p.x : (axis == 1 ? p.y : p.z);
+}
+void set_coordinate(WrittenPoint& p, int axis, double value) {
+    (axis == 0 ? p.x : (axis == 1 ? p.y : p.z)) = value;
+}
+Vec3 rounded(const WrittenPoint& p) {
+    return {static_cast<real>(p.x), static_cast<real>(p.y), static_cast<real>(p.z)};
+}
+bool same(Vec3 a, Vec3 b) { return a.x == b.x && a.y == b.y && a.z == b.z; }
+
+// Whether a triangle has no area as rendered: it is never hit, so nothing meets it.
+bool flat(const Piece& p) {
+    if (p.kind != Kind::kTriangle) return false;
+    long double e1[3], e2[3];
+    for (int i = 0; i < 3; ++i) {
+        e1[i] = static_cast<long double>(p.rendered[1][i]) - p.rendered[0][i];
+        e2[i] = static_cast<long double>(p.rendered[2][i]) - p.rendered[0][i];
+    }
+    return e1[1] * e2[2] == e1[2] * e2[1] && e1[2] * e2[0] == e1[0] * e2[2] &&
+           e1[0] * e2[1] == e1[1] * e2[0];
+}
+
+// Rounding moves each centred coordinate by half an ulp, so a point written on an edge lies
+// within about 2 ulps of the rendered edge's line; computing the distance in long double adds
+// a few more in the double build where long double is double. 8 ulps of the largest
+// coordinate covers both.
+constexpr long double kCollinearUlps = 8;
+
+// Where p lies on the edge a-b, strictly between its ends and collinear within rounding: its
+// position along the edge in (0, 1), else -1. In long double on the rendered points.
+long double along_edge(Vec3 a, Vec3 b, Vec3 p) {
+    if (same(p, a) || same(p, b)) return -1;
+    long double d[3], e[3], dd = 0, ed = 0, extent = 0;
+    for (int i = 0; i < 3; ++i) {
+        d[i] = static_cast<long double>(b[i]) - a[i];
+        e[i] = static_cast<long double>(p[i]) - a[i];
+        dd += d[i] * d[i];
+        ed += e[i] * d[i];
+        extent = std::max({extent, std::fabs(static_cast<long double>(a[i])),
+                           std::fabs(static_cast<long double>(b[i])),
+                           std::fabs(static_cast<long double>(p[i]))});
+    }
+    const long double t = ed / dd;
+    if (!(t > 0 && t < 1)) return -1;
+    const long double c[3] = {e[1] * d[2] - e[2] * d[1], e[2] * d[0] - e[0] * d[2],
+                              e[0] * d[1] - e[1] * d[0]};
+    const long double tolerance = kCollinearUlps * kRealEpsilon * extent;
+    const long double distance_squared = (c[0] * c[0] + c[1] * c[1] + c[2] * c[2]) / dd;
+    return distance_squared <= tolerance * tolerance ? t : -1;
+}
+
+// The scene's vertices in a uniform grid over their bounds (2 cbrt(n) cells a side), so an edge
+// looks only at those in the cells its bounding box covers, whatever the mesh's orientation
+// (a list sorted on one axis would be quadratic for a mesh in a plane x = c).
+class PointIndex {
+public:
+    explicit PointIndex(const std::vector<Piece>& pieces) {
+        std::vector<Point> points;
+        for (const Piece& piece : pieces) {
+            if (flat(piece)) continue;
+            for (int k = 0; k < piece.corners; ++k)
+                points.push_back({piece.rendered[k], piece.written[k], piece.kind == Kind::kRect});
+        }
+        if (points.empty()) return;
+        // Each rendered point once; it is a rectangle's only if no other kind has it.
+        const auto less = [](const Point& a, const Point& b) {
+            return std::array<real, 3>{a.rendered.x, a.rendered.y, a.rendered.z} <
+                   std::array<real, 3>{b.rendered.x, b.rendered.y, b.rendered.z};
+        };
+        std::sort(points.begin(), points.end(), less);
+        size_t kept = 0;
+        for (size_t i = 0; i < points.size(); ++i) {
+            if (kept > 0 && same(points[kept - 1].rendered, points[i].rendered))
+                points[kept - 1].of_rect = points[kept - 1].of_rect && points[i].of_rect;
+            else points[kept++] = points[i];
+        }
+        points.resize(kept);
+        for (int axis = 0; axis < 3; ++axis) {
+            lo_[axis] = hi_[axis] = points[0].rendered[axis];
+            for (const Point& p : points) {
+                lo_[axis] = std::min(lo_[axis], double(p.rendered[axis]));
+                hi_[axis] = std::max(hi_[axis], double(p.rendered[axis]));
+            }
+        }
+        side_ = std::max(1, std::min(128, static_cast<int>(2 * std::cbrt(double(points.size())))));
+        // Counting sort by cell: start_[c] .. start_[c + 1] are cell c's points.
+        start_.assign(size_t(side_) * side_ * side_ + 1, 0);
+        for (const Point& p : points) ++start_[cell_of(p.rendered) + 1];
+        for (size_t c = 1; c < start_.size(); ++c) start_[c] += start_[c - 1];
+        std::vector<size_t> fill(start_.begin(), start_.end() - 1);
+        points_.resize(points.size());
+        for (const Point& p : points) points_[fill[cell_of(p.rendered)]++] = p;
+    }
+
+    // Calls visit(point) for every vertex (and perhaps a few more) within margin of the box
+    // with corners a and b.
+    template <typename Visit>
+    void near_box(Vec3 a, Vec3 b, double margin, Visit visit) const {
+        if (points_.empty()) return;
+        int from[3], to[3];
+        for (int axis = 0; axis < 3; ++axis) {
+            from[axis] = cell(axis, std::min(double(a[axis]), double(b[axis])) - margin);
+            to[axis] = cell(axis, std::max(double(a[axis]), double(b[axis])) + margin);
+        }
+        for (int i = from[0]; i <= to[0]; ++i) {
+            for (int j = from[1]; j <= to[1]; ++j) {
+                for (int k = from[2]; k <= to[2]; ++k) {
+                    const size_t c = (size_t(i) * side_ + j) * side_ + k;
+                    for (size_t n = start_[c]; n < start_[c + 1]; ++n) visit(points_[n]);
+                }
+            }
+        }
+    }
+
+private:
+    // Monotonic in x, so a point within a range lies in the cells of the range's ends.
+    int cell(int axis, double x) const {
+        const double extent = hi_[axis] - lo_[axis];
+        if (!(extent > 0)) return 0;
+        const double at = (x - lo_[axis]) / extent * side_;
+        return at <= 0 ? 0 : (at >= side_ - 1 ? side_ - 1 : static_cast<int>(at));
+    }
+    size_t cell_of(Vec3 p) const {
+        return (size_t(cell(0, p.x)) * side_ + cell(1, p.y)) * side_ + cell(2, p.z);
+    }
+
+    double lo_[3] = {0, 0, 0}, hi_[3] = {0, 0, 0};
+    int side_ = 1;
+    std::vector<size_t> start_;
+    std::vector<Point> points_;
+};
+
+// A point found on an edge, by its position along the edge.
+struct OnEdge {
+    long double t;
+    Point point;
+};
+
+// The points of `index` on the edge a-b of a triangle or convex quad, in order from a, each
+// rendered point once.
+std::vector<OnEdge> points_on_edge(const PointIndex& index, Vec3 a, Vec3 b) {
+    const double extent = std::max(max_component(abs(a)), max_component(abs(b)));
+    const double margin = 4 * kCollinearUlps * kRealEpsilon * extent;
+    std::vector<OnEdge> found;
+    index.near_box(a, b, margin, [&](const Point& p) {
+        for (int axis = 0; axis < 3; ++axis) {  // the edge's box first: most points are far
+            const double c = p.rendered[axis];
+            if (c < std::min(a[axis], b[axis]) - margin || c > std::max(a[axis], b[axis]) + margin)
+                return;
+        }
+        const long double t = along_edge(a, b, p.rendered);
+        if (t > 0) found.push_back({t, p});
+    });
+    std::sort(found.begin(), found.end(),
+              [](const OnEdge& x, const OnEdge& y) { return x.t < y.t; });
+    found.erase(std::unique(found.begin(), found.end(),
+                            [](const OnEdge& x, const OnEdge& y) {
+                                return same(x.point.rendered, y.point.rendered);
+                            }),
+                found.end());
+    return found;
+}
+
+// The triangle or convex quad as a fan of triangles around its centroid, its boundary passing
+// through every point found on its edges; empty when none is.
+std::vector<Piece> fan(const Piece& piece, const PointIndex& index, const WrittenPoint& centre) {
+    std::vector<Point> boundary;
+    bool split = false;
+    for (int k = 0; k < piece.corners; ++k) {
+        const int next = (k + 1) % piece.corners;
+        boundary.push_back({piece.rendered[k], piece.written[k], false});
+        for (const OnEdge& on : points_on_edge(index, piece.rendered[k], piece.rendered[next])) {
+            boundary.push_back(on.point);
+            split = true;
+        }
+    }
+    if (!split) return {};
+    // The mean of the written corners, kept within their range on each axis (so a piece in
+    // the plane x = c keeps its centroid there exactly).
+    WrittenPoint centroid;
+    for (int axis = 0; axis < 3; ++axis) {
+        double sum = 0, lo = coordinate(piece.written[0], axis), hi = lo;
+        for (int k = 0; k < piece.corners; ++k) {
+            const double c = coordinate(piece.written[k], axis);
+            sum += c;
+            lo = std::min(lo, c);
+            hi = std::max(hi, c);
+        }
+        set_coordinate(centroid, axis, std::clamp(sum / piece.corners, lo, hi));
+    }
+    const Vec3 centroid_rendered = moved_to_centre(centroid, centre);
+    std::vector<Piece> pieces;
+    for (size_t k = 0; k < boundary.size(); ++k) {
+        const Point& from = boundary[k];
+        const Point& to = boundary[(k + 1) % boundary.size()];
+        Piece t;
+        t.kind = Kind::kTriangle;
+        t.corners = 3;
+        t.material = piece.material;
+        t.written[0] = centroid, t.rendered[0] = centroid_rendered;
+        t.written[1] = from.written, t.rendered[1] = from.rendered;
+        t.written[2] = to.written, t.rendered[2] = to.rendered;
+        pieces.push_back(t);  // counter-clockwise as the piece's boundary is
+    }
+    return pieces;
+}
+
+// A cut across a rectangle: the rendered coordinate, and the written one it rounds from.
+struct Cut {
+    real rendered;
+    double written;
+};
+
+// The rectangle cut across at every vertex of a triangle or convex quad that lies exactly on
+// one of its edges, strictly between the ends: a grid of smaller rectangles with the same
+// winding; empty when there is none.
+std::vector<Piece> cut(const Piece& rect, const PointIndex& index) {
+    const int in_plane[2] = {rect_axis_u(rect.axis), rect_axis_v(rect.axis)};
+    std::vector<Cut> cuts[2];
+    for (int k = 0; k < 4; ++k) {
+        const Vec3 a = rect.rendered[k], b = rect.rendered[(k + 1) % 4];
+        const int along = a[in_plane[0]] != b[in_plane[0]] ? 0 : 1;
+        const int axis = in_plane[along], fixed = in_plane[1 - along];
+        const real lo = min_float(a[axis], b[axis]), hi = max_float(a[axis], b[axis]);
+        index.near_box(a, b, 0.0, [&](const Point& p) {
+            const Vec3 q = p.rendered;
+            if (!p.of_rect && q[rect.axis] == a[rect.axis] && q[fixed] == a[fixed] &&
+                q[axis] > lo && q[axis] < hi)
+                cuts[along].push_back({q[axis], coordinate(p.written, axis)});
+        });
+    }
+    if (cuts[0].empty() && cuts[1].empty()) return {};
+    real lo[2], hi[2];
+    for (int d = 0; d < 2; ++d) {
+        std::sort(cuts[d].begin(), cuts[d].end(),
+                  [](const Cut& x, const Cut& y) { return x.rendered < y.rendered; });
+        cuts[d].erase(
+            std::unique(cuts[d].begin(), cuts[d].end(),
+                        [](const Cut& x, const Cut& y) { return x.rendered == y.rendered; }),
+            cuts[d].end());
+        lo[d] = hi[d] = rect.rendered[0][in_plane[d]];
+        for (const Vec3& c : rect.rendered) {
+            lo[d] = min_float(lo[d], c[in_plane[d]]);
+            hi[d] = max_float(hi[d], c[in_plane[d]]);
+        }
+    }
+    // Each corner keeps its own written coordinates, but for the in-plane ones a cut replaces:
+    // the strip [i, i+1] of cuts on each axis, where 0 and cuts.size() + 1 are the
+    // rectangle's own sides. Corners keep their order, so the winding stays.
+    std::vector<Piece> pieces;
+    for (size_t i = 0; i <= cuts[0].size(); ++i) {
+        for (size_t j = 0; j <= cuts[1].size(); ++j) {
+            const size_t strip[2] = {i, j};
+            Piece r = rect;
+            for (int k = 0; k < 4; ++k) {
+                for (int d = 0; d < 2; ++d) {
+                    const bool high = rect.rendered[k][in_plane[d]] == hi[d];
+                    const size_t side = strip[d] + (high ? 1 : 0);  // index into lo, cuts, hi
+                    if (side == 0 || side == cuts[d].size() + 1) continue;  // its own side
+                    set_coordinate(r.written[k], in_plane[d], cuts[d][side - 1].written);
+                }
+            }
+            pieces.push_back(r);
+        }
+    }
+    return pieces;
+}
+
+// An edge as two points, the lesser first: the same key from either side.
+using EdgeKey = std::array<real, 6>;
+EdgeKey edge_key(Vec3 p, Vec3 q) {
+    EdgeKey a{p.x, p.y, p.z, q.x, q.y, q.z}, b{q.x, q.y, q.z, p.x, p.y, p.z};
+    return a < b ? a : b;
+}
+
+// classify_quads's rule on the pieces: a rectangle that shares an edge with a triangle or a
+// convex quad becomes a convex quad, and so in turn does every rectangle sharing an edge with
+// it. Returns how many it changed.
+int demote_rects(std::vector<Piece>& pieces) {
+    std::vector<EdgeKey> shared;
+    std::map<EdgeKey, std::vector<size_t>> rect_edges;
+    const auto edges = [](const Piece& p, int k) {
+        return edge_key(p.rendered[k], p.rendered[(k + 1) % p.corners]);
+    };
+    for (size_t i = 0; i < pieces.size(); ++i) {
+        for (int k = 0; k < pieces[i].corners; ++k) {
+            if (pieces[i].kind == Kind::kRect) rect_edges[edges(pieces[i], k)].push_back(i);
+            else shared.push_back(edges(pieces[i], k));
+        }
+    }
+    int demoted = 0;
+    while (!shared.empty()) {  // a worklist: each rectangle is demoted once
+        const auto found = rect_edges.find(shared.back());
+        shared.pop_back();
+        if (found == rect_edges.end()) continue;
+        for (size_t i : found->second) {
+            if (pieces[i].kind != Kind::kRect) continue;
+            pieces[i].kind = Kind::kQuad;
+            ++demoted;
+            for (int k = 0; k < 4; ++k) shared.push_back(edges(pieces[i], k));
+        }
+    }
+    return demoted;
+}
+
+// One pass: every piece split where the scene's current vertices lie on its edges, then the
+// rectangles that now meet triangles or quads demoted. Returns whether anything changed.
+bool split_once(std::vector<Piece>& pieces, const WrittenPoint& centre) {
+    const PointIndex index(pieces);
+    std::vector<Piece> next;
+    bool changed = false;
+    for (const Piece& piece : pieces) {
+        std::vector<Piece> parts;
+        if (!flat(piece))
+            parts = piece.kind == Kind::kRect ? cut(piece, index) : fan(piece, index, centre);
+        if (parts.empty()) {
+            next.push_back(piece);
+            continue;
+        }
+        for (Piece& part : parts) {
+            for (int k = 0; k < part.corners; ++k)
+                part.rendered[k] = moved_to_centre(part.written[k], centre);
+            next.push_back(part);
+        }
+        changed = true;
+    }
+    pieces = std::move(next);
+    return demote_rects(pieces) > 0 || changed;
+}
+
+// Enough for a chain of rectangles demoted one neighbour per pass; each pass of a scene
+// without T-junctions left changes nothing and ends the search.
+constexpr int kMaxPasses = 32;
+
+}  // namespace
+
+int split_t_junctions(Scene& scene) {
+    const WrittenCoordinates& w = scene.written;
+    if (!w.present || w.triangle_vertices.size() != 3 * scene.triangles.size() ||
+        w.quad_vertices.size() != 4 * scene.quads.size() ||
+        w.rect_vertices.size() != 4 * scene.rects.size())
+        return 0;  // a scene built in code: no written points to split on
+    const WrittenPoint centre = centring_centre(scene);
+    std::vector<Piece> pieces;
+    const auto add = [&](Kind kind, int corners, const WrittenPoint* written, int material,
+                         int axis) {
+        Piece p;
+        p.kind = kind;
+        p.corners = corners;
+        p.material = material;
+        p.axis = axis;
+        for (int k = 0; k < corners; ++k) {
+            p.written[k] = written[k];
+            p.rendered[k] = moved_to_centre(written[k], centre);
+        }
+        pieces.push_back(p);
+    };
+    for (size_t i = 0; i < scene.triangles.size(); ++i)
+        add(Kind::kTriangle, 3, &w.triangle_vertices[3 * i], scene.triangles[i].material, -1);
+    for (size_t i = 0; i < scene.quads.size(); ++i)
+        add(Kind::kQuad, 4, &w.quad_vertices[4 * i], scene.quads[i].material, -1);
+    for (size_t i = 0; i < scene.rects.size(); ++i)
+        add(Kind::kRect, 4, &w.rect_vertices[4 * i], scene.rects[i].material,
+            rect_axis(scene.rects[i]));
+    const size_t before = pieces.size();
+
+    bool changed = false;
+    for (int pass = 0; pass < kMaxPasses && split_once(pieces, centre); ++pass) changed = true;
+    if (!changed) return 0;  // every bit as loaded
+
+    // Rebuilt from the written points, rounded once, as the loader builds the file's own.
+    scene.triangles.clear();
+    scene.quads.clear();
+    scene.rects.clear();
+    WrittenCoordinates& out = scene.written;
+    out.triangle_vertices.clear();
+    out.quad_vertices.clear();
+    out.rect_vertices.clear();
+    for (const Piece& p : pieces) {
+        Vec3 v[4];
+        for (int k = 0; k < p.corners; ++k) v[k] = rounded(p.written[k]);
+        if (p.kind == Kind::kTriangle) {
+            scene.triangles.push_back(make_triangle(v[0], v[1], v[2], p.material));
+            out.triangle_vertices.insert(out.triangle_vertices.end(), p.written, p.written + 3);
+        } else if (p.kind == Kind::kQuad) {
+            scene.quads.push_back(make_convex_quad(v[0], v[1], v[2], v[3], p.material));
+            out.quad_vertices.insert(out.quad_vertices.end(), p.written, p.written + 4);
+        } else {
+            scene.rects.push_back(make_axis_rect(v, p.axis, p.material));
+            out.rect_vertices.insert(out.rect_vertices.end(), p.written, p.written + 4);
+        }
+    }
+    return static_cast<int>(pieces.size() - before);
+}
