@@ -54,7 +54,7 @@ DOUBLE_COMMON_OBJ := $(COMMON_OBJ:$(BUILD)/%=$(DOUBLE_BUILD)/%)
 PHONY_EXTRA := variant
 PHONY_EXTRA += render grade handin check-nvcc bench-micro bench-cpu bench-serial count-work bench-precision
 PHONY_EXTRA += bench-simd bench-openmp bench-mpi extremes-report
-PHONY_EXTRA += lint format
+PHONY_EXTRA += lint format gpu-figures
 .PHONY: all help deps labs $(PHONY_EXTRA) test test-unit test-labs skeletons check-skeletons golden bench tradeoff \
         clean
 .DEFAULT_GOAL := help
@@ -93,6 +93,7 @@ help:
 	@echo "  make bench-precision  float against double: time and error of lab 01's reference"
 	@echo "  make extremes-report  the extreme scenes in float and double (docs/extremes.md's table)"
 	@echo "  make check-nvcc   compile every header of common/core for the GPU (needs nvcc)"
+	@echo "  make gpu-figures  the handouts' GPU tables from reference/gpu/h200/ (CHECK=1: compare)"
 	@echo "  make kernel-report registers, spills, stack and shared memory of every CUDA kernel"
 	@echo "  make gpu-check OUT=DIR  on a GPU machine: build, test and benchmark the CUDA labs"
 	@echo "  make tradeoff-gpu OUT=DIR  on a GPU machine: make tradeoff's GPU rows (no plots)"
@@ -288,6 +289,12 @@ REPORTS ?= $(BUILD)/reports
 tradeoff: lab01-ref
 	$(PYTHON) -m tools.tradeoff --out $(REPORTS) $(if $(filter 1 true yes,$(QUICK)),--quick) \
 	    $(if $(PLAN),--plan $(PLAN)) $(if $(filter 0 false no,$(PLOTS)),--no-plots)
+
+# The GPU record's figures in the handouts and READMEs (tools/gpu/figures.py): the tables
+# regenerated from reference/gpu/h200/ after a new record; CHECK=1 only compares, naming every
+# figure that differs.
+gpu-figures:
+	$(PYTHON) -m tools.gpu.figures $(if $(filter 1 true yes,$(CHECK)),--check)
 
 # Float against double: time and error of lab01-ref and lab01-ref-double (tools/bench/precision.py).
 bench-precision: lab01-ref lab01-ref-double
