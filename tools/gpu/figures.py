@@ -118,7 +118,7 @@ def lab05_divergence(r):
     what = [("plain", "`plain` (`render_pixel` per pixel)", "Cornell, 4"),
             ("reference", "`reference`", "Cornell, 4"),
             ("reference, 1 bounce", "`reference`", "Cornell, **1**"),
-            ("showcase", "`reference`'s shape, every material", "showcase (mirror, glass), 4")]
+            ("showcase", "`reference`'s shape, every material", "showcase (mirror, glass)")]
     body = []
     for shape, label, scene in what:
         n = r["ncu"][shape]
