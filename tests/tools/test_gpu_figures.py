@@ -47,6 +47,9 @@ def edit(path, old, new):
     # a figure no phrase names: an earlier record's time left in the text
     ("handouts/06-cuda-split.md", "its margin grows with depth",
      "its margin (39.91 ms on the baseline) grows with depth"),
+    # or a hand-written table of times holding one
+    ("handouts/07-soa.md", "Reading the table:",
+     "| layout | kernel ms |\n|---|---:|\n| AoS | 74.05 |\n\nReading the table:"),
 ])
 def test_a_figure_edited_away_from_the_record_fails(copy, where, old, new):
     edit(copy / where, old, new)
