@@ -56,8 +56,8 @@ DOUBLE_COMMON_OBJ := $(COMMON_OBJ:$(BUILD)/%=$(DOUBLE_BUILD)/%)
 PHONY_EXTRA := variant
 PHONY_EXTRA += render grade handin check-nvcc bench-micro bench-cpu bench-serial count-work bench-precision
 PHONY_EXTRA += bench-simd bench-openmp bench-mpi extremes-report
-PHONY_EXTRA += lint format
-.PHONY: all help deps labs $(PHONY_EXTRA) test test-unit test-labs skeletons check-skeletons golden bench tradeoff \
+PHONY_EXTRA += lint format gpu-figures
+.PHONY: all help deps labs $(PHONY_EXTRA) test test-quick test-unit test-labs skeletons check-skeletons golden bench tradeoff \
         clean
 .DEFAULT_GOAL := help
 
@@ -70,6 +70,7 @@ help:
 	@echo "  make render       render the default scene to cornell.ppm with the fastest"
 	@echo "                    reference here (GPU, else OpenMP+AVX2)"
 	@echo "  make test         the unit tests of common/ and the lab tests"
+	@echo "  make test-quick   a few minutes' check: lint, the unit tests and the fast pytest files"
 	@echo "  make deps         install what is missing (JSON library, OpenMPI, tools/requirements.txt)"
 	@echo "  make bench-serial time the lab-01 reference on the Cornell baseline (minutes)"
 	@echo "  make bench-cpu    the CPU labs side by side with load and capacity (Table 4 here)"
@@ -95,6 +96,7 @@ help:
 	@echo "  make bench-precision  float against double: time and error of lab 01's reference"
 	@echo "  make extremes-report  the extreme scenes in float and double (docs/extremes.md's table)"
 	@echo "  make check-nvcc   compile every header of common/core for the GPU (needs nvcc)"
+	@echo "  make gpu-figures  the handouts' GPU tables from reference/gpu/h200/ (CHECK=1: compare)"
 	@echo "  make kernel-report registers, spills, stack and shared memory of every CUDA kernel"
 	@echo "  make gpu-check OUT=DIR  on a GPU machine: build, test and benchmark the CUDA labs"
 	@echo "  make tradeoff-gpu OUT=DIR  on a GPU machine: make tradeoff's GPU rows (no plots)"
@@ -184,6 +186,22 @@ test-unit: $(BUILD)/unit_tests
 
 test-labs: labs
 	$(PYTHON) -m pytest -q tests
+
+# The quick tier, beside the full make test: the style, the unit tests and the pytest files
+# that run in seconds and build at most lab 01 (the registry, the layout of the kit, the
+# handouts' tables and GPU figures, the image comparison's statistics, the speed credit, the
+# hand-in, lab 01's own tests); not the image-comparison suites of every lab, the grader's
+# sandbox and hostile submissions, the releases or the benchmarks, which make test runs.
+QUICK_TESTS := tests/tools/test_registry.py tests/tools/test_python_layout.py \
+               tests/tools/test_gpu_report.py tests/tools/test_gpu_figures.py \
+               tests/grading/test_handout_tables.py tests/grading/test_speed_credit.py \
+               tests/grading/test_handin.py tests/grading/test_golden_sums.py \
+               tests/grading/test_compare.py tests/grading/test_symptoms.py \
+               tests/labs/test_lab01.py tests/labs/test_scene_report.py
+test-quick:
+	$(if $(wildcard .clang-format),$(MAKE) --no-print-directory lint)
+	$(MAKE) --no-print-directory test-unit
+	$(PYTHON) -m pytest -q $(QUICK_TESTS)
 
 # Every test: installs what is missing first, so it works on a fresh machine; the style first,
 # where the style is configured (the course repository: a student release ships no style rules,
@@ -300,6 +318,12 @@ REPORTS ?= $(BUILD)/reports
 tradeoff: lab01-ref
 	$(PYTHON) -m tools.tradeoff --out $(REPORTS) $(if $(filter 1 true yes,$(QUICK)),--quick) \
 	    $(if $(PLAN),--plan $(PLAN)) $(if $(filter 0 false no,$(PLOTS)),--no-plots)
+
+# The GPU record's figures in the handouts and READMEs (tools/gpu/figures.py): the tables
+# regenerated from reference/gpu/h200/ after a new record; CHECK=1 only compares, naming every
+# figure that differs.
+gpu-figures:
+	$(PYTHON) -m tools.gpu.figures $(if $(filter 1 true yes,$(CHECK)),--check)
 
 # Float against double: time and error of lab01-ref and lab01-ref-double (tools/bench/precision.py).
 bench-precision: lab01-ref lab01-ref-double

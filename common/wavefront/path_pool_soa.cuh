@@ -18,7 +18,7 @@
 // after another in the pool's allocation; field f of place k is words[f * stride + k]. One
 // pointer and one stride rather than a pointer per array: a kernel keeps the addresses it
 // uses in registers, and a pointer for each of the 38 arrays in shade_hits' arguments took
-// it to 126 registers and a quarter of the GPU's threads (handouts/07-soa.md).
+// it to 126 registers and a quarter of the GPU's threads (docs/gpu-tuning.md).
 template <int kFields>
 struct FieldArrays {
     float* words;

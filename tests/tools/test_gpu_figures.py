@@ -1,0 +1,99 @@
+"""The handouts, the README and the GPU labs' timed renders quote the GPU record
+(reference/gpu/h200/) as it is: every generated table is what tools/gpu/figures.py makes of
+the record, every phrase of PROSE stands in its file as the record renders it, no "N.NN ms"
+is a number the record does not hold, and labs.toml's timed_spp is what the record gives for
+the grader's timed render. A figure edited away from the record, or a record changed without
+the text, fails here. Reads files only: well under a second."""
+import dataclasses
+import re
+import shutil
+
+import pytest
+
+from grading import grade
+from labkit import registry
+from tools.gpu import figures
+from tools.gpu import record as rec
+
+
+def test_every_figure_is_the_records():
+    assert figures.problems() == [], "regenerate with python3 -m tools.gpu.figures"
+
+
+@pytest.fixture
+def copy(tmp_path):
+    """The files that quote the record, copied, for problems(root=...)."""
+    for name in figures.FILES:
+        (tmp_path / name).parent.mkdir(parents=True, exist_ok=True)
+        shutil.copy(figures.ROOT / name, tmp_path / name)
+    return tmp_path
+
+
+def edit(path, old, new):
+    text = path.read_text()
+    assert old in text, old
+    path.write_text(text.replace(old, new, 1))
+
+
+@pytest.mark.parametrize("where, old, new", [
+    # a cell of a generated table
+    ("handouts/06-cuda-split.md", "| generate_camera_paths | 4.34 |",
+     "| generate_camera_paths | 4.43 |"),
+    # a figure in the prose, checked phrase by phrase
+    ("handouts/05-cuda-mega.md", "takes **30.74 ms**", "takes **30.47 ms**"),
+    ("README.md", "ready; 21.7 ms for the baseline", "ready; 21.6 ms for the baseline"),
+    ("handouts/07-soa.md", "is met**: 53.22 against 55.94 ms, 1.05×",
+     "is met**: 53.22 against 55.94 ms, 1.09×"),
+    # a figure no phrase names: an earlier record's time left in the text
+    ("handouts/06-cuda-split.md", "its margin grows with depth",
+     "its margin (39.91 ms on the baseline) grows with depth"),
+    # or a hand-written table of times holding one
+    ("handouts/07-soa.md", "Reading the table:",
+     "| layout | kernel ms |\n|---|---:|\n| AoS | 74.05 |\n\nReading the table:"),
+])
+def test_a_figure_edited_away_from_the_record_fails(copy, where, old, new):
+    edit(copy / where, old, new)
+    found = figures.problems(root=copy)
+    assert found and all(line.startswith(f"{where}:") for line in found), found
+
+
+def test_a_record_changed_without_the_text_fails(copy, tmp_path_factory):
+    record = tmp_path_factory.mktemp("record")
+    for f in rec.RECORD.iterdir():
+        shutil.copy(f, record / f.name)
+    bench = record / "bench-lab05.json"
+    bench.write_text(bench.read_text().replace('"best_ms": 21.688', '"best_ms": 20.688', 1))
+    found = figures.problems(root=copy, record=record)
+    assert any("table 'lab05-targets'" in line for line in found), found
+    assert any("takes **20.69 ms**" in line for line in found), found
+    # and regenerating puts the record's tables back in place of the old ones
+    figures.rewrite(root=copy, record=record)
+    assert "| `reference` | 20.69 |" in (copy / "handouts/05-cuda-mega.md").read_text()
+
+
+def test_the_timed_renders_are_sized_from_the_record():
+    """Each GPU lab's timed render takes the grader's GPU_TIMED_SECONDS of its reference's
+    kernel time at the record's throughput, to within the spp's rounding."""
+    r = rec.read()
+    side = figures.grade_view_side() * grade.GPU_TIMED_SCALE
+    for lab in registry.labs():
+        if not lab.gpu:
+            continue
+        assert lab.timed_spp == figures.derived_spp(r, lab.number), lab.number
+        seconds = rec.timed_seconds(r, lab.number, side * side, lab.timed_spp)
+        step = rec.timed_seconds(r, lab.number, side * side, rec.SPP_STEP)
+        assert abs(seconds - grade.GPU_TIMED_SECONDS) <= step / 2, (lab.number, seconds)
+
+
+def test_a_timed_spp_the_record_does_not_give_fails(monkeypatch):
+    labs = tuple(dataclasses.replace(lab, timed_spp=4096) if lab.number == "05" else lab
+                 for lab in registry.labs())
+    monkeypatch.setattr(registry, "labs", lambda: labs)
+    found = [line for line in figures.problems() if line.startswith("labs/labs.toml")]
+    assert found and re.search(r"lab 05's timed_spp is 4096; the record gives \d+", found[0])
+
+
+def test_the_ncu_rows_name_the_shapes_the_handout_quotes():
+    shapes = rec.read()["ncu"]
+    assert {"reference", "plain", "showcase", "reference, 1 bounce"} <= set(shapes)
+    assert 1 <= shapes["reference"]["active"] <= 32
