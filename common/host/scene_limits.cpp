@@ -6,10 +6,10 @@
 
 #include <scene_centring.h>
 
-const PrecisionLimits kFloatLimits{"float", 1e9,   "1e9",   1e-9, "1e-9", 8.0 * FLT_EPSILON,
-                                   "2^-20", false};
-const PrecisionLimits kDoubleLimits{"double", 1e30,  "1e30",  1e-30, "1e-30", 8.0 * DBL_EPSILON,
-                                    "2^-49",  true};
+const PrecisionLimits kFloatLimits{"float",           1e9,     "1e9", 1e-9, "1e-9",
+                                   8.0 * FLT_EPSILON, "2^-20", false};
+const PrecisionLimits kDoubleLimits{"double",          1e30,    "1e30", 1e-30, "1e-30",
+                                    8.0 * DBL_EPSILON, "2^-49", true};
 
 const PrecisionLimits& build_limits() {
 #if defined(RT_DOUBLE)
@@ -113,8 +113,9 @@ PlacementProblem placement_problem(const Scene& scene, size_t file_triangles,
     }
 
     if (scene.camera.written) {
-        for (const auto& [p, pointer] : {std::pair{scene.camera.written_position, "/camera/position"},
-                                         std::pair{scene.camera.written_look_at, "/camera/look_at"}}) {
+        for (const auto& [p, pointer] :
+             {std::pair{scene.camera.written_position, "/camera/position"},
+              std::pair{scene.camera.written_look_at, "/camera/look_at"}}) {
             const PlacementProblem problem = coordinate(p, pointer);
             if (!problem.empty()) return problem;
         }
@@ -127,7 +128,8 @@ PlacementProblem placement_problem(const Scene& scene, size_t file_triangles,
     double extent = 0.0;
     for (size_t i = 0; i < w.sphere_centres.size(); ++i)
         extent = std::fmax(extent, largest(centred(w.sphere_centres[i])) + w.sphere_radii[i]);
-    for (const WrittenPoint& v : w.triangle_vertices) extent = std::fmax(extent, largest(centred(v)));
+    for (const WrittenPoint& v : w.triangle_vertices)
+        extent = std::fmax(extent, largest(centred(v)));
 
     for (size_t i = 0; i < w.sphere_centres.size(); ++i) {
         const std::string pointer = "/spheres/" + std::to_string(i) + "/radius";
@@ -160,10 +162,10 @@ PlacementProblem placement_problem(const Scene& scene, size_t file_triangles,
         const char* what = "a triangle with a longest edge";
         std::string problem = size_problem(what, longest, own_extent, limits);
         if (problem.empty()) problem = scene_scale_problem(what, longest, extent, limits);
-        if (problem.empty() &&
-            (limits.is_double ? collapses<double>(v) : collapses<float>(v)))
-            problem = std::string("the triangle collapses to a line when its vertices are "
-                                  "rounded to ") +
+        if (problem.empty() && (limits.is_double ? collapses<double>(v) : collapses<float>(v)))
+            problem = std::string(
+                          "the triangle collapses to a line when its vertices are "
+                          "rounded to ") +
                       limits.name + ": make it larger, or the scene smaller";
         if (!problem.empty()) return {triangle_pointer(i) + "/vertices", problem};
     }

@@ -32,12 +32,12 @@ std::string box_at(double x) {
     const double s = 10;
     const auto quad = [&](std::array<std::array<double, 3>, 4> v) {
         std::string text = "{\"vertices\": [";
-        for (int k = 0; k < 4; ++k)
-            text += (k ? ", " : "") + point(x + v[k][0], v[k][1], v[k][2]);
+        for (int k = 0; k < 4; ++k) text += (k ? ", " : "") + point(x + v[k][0], v[k][1], v[k][2]);
         return text + "], \"material\": \"w\"}";
     };
-    return "{\"camera\": {\"position\": " + point(x + 5, 5, 9) + ", \"look_at\": " +
-           point(x + 5, 5, 0) + "},\n\"light\": {\"position\": " + point(x + 5, 9, 5) +
+    return "{\"camera\": {\"position\": " + point(x + 5, 5, 9) +
+           ", \"look_at\": " + point(x + 5, 5, 0) +
+           "},\n\"light\": {\"position\": " + point(x + 5, 9, 5) +
            ", \"intensity\": [1, 1, 1]},\n"
            "\"materials\": {\"w\": {\"type\": \"diffuse\", \"albedo\": [0.5, 0.5, 0.5]}},\n"
            "\"spheres\": [{\"center\": " +
