@@ -449,15 +449,18 @@ def refusal(binary, scene, tmp_path):
 @pytest.mark.parametrize("factor", [1e-25, 1e-15, 1e15])
 def test_a_scene_too_small_or_large_is_refused_for_its_size(lab01_ref, tmp_path, factor,
                                                             spheres):
-    """The Cornell box scaled far beyond float's bounds: refused for a size (as large as it
-    is, not 0) or a coordinate, never as a camera looking at itself."""
+    """The Cornell box scaled far beyond float's bounds: the students' float build refuses it
+    for a size (as large as it is, not 0) or a coordinate, never as a camera looking at
+    itself; the reference, within double's bounds, renders it in double."""
     scene = scenes.scaled(scenes.load("cornell"), factor)
     if not spheres:
         scene.pop("spheres")
-    code, lines = refusal(lab01_ref, scene, tmp_path)
+    code, lines = refusal(build("lab01")[0], scene, tmp_path)
     assert code == 2 and len(lines) == 1, lines
     assert "camera position" not in lines[0] and ("1e-9" in lines[0] or "1e9" in lines[0]), lines
     assert " of 0 " not in lines[0], lines
+    code, lines = refusal(lab01_ref, scene, tmp_path)
+    assert code == 0 and not lines, lines
 
 
 def test_a_look_at_very_close_to_the_camera_is_a_view(tmp_path):
@@ -472,8 +475,9 @@ def test_a_look_at_very_close_to_the_camera_is_a_view(tmp_path):
 
 
 def test_mixed_scales_beyond_float_are_refused_with_what_to_do(lab01_ref, tmp_path):
-    """A sphere of radius 1e-4 on a floor of half-size 1e4: the float build refuses it in one
-    line naming the double build; the double build renders it."""
+    """A sphere of radius 1e-4 on a floor of half-size 1e4: the students' float build refuses
+    it in one line saying double places it; the reference renders it in double by itself
+    (test_precision.py checks its image)."""
     h = 1e4
     scene = {"camera": {"position": [0, 5e-4, 1e-3], "look_at": [0, 1e-4, 0], "up": [0, 1, 0],
                         "vfov": 60},
@@ -482,8 +486,8 @@ def test_mixed_scales_beyond_float_are_refused_with_what_to_do(lab01_ref, tmp_pa
              "spheres": [{"center": [0, 1e-4, 0], "radius": 1e-4, "material": "w"}],
              "quads": [{"vertices": [[-h, 0, -h], [-h, 0, h], [h, 0, h], [h, 0, -h]],
                         "material": "w"}]}
-    code, lines = refusal(lab01_ref, scene, tmp_path)
-    assert code == 2 and len(lines) == 1 and "double build" in lines[0], lines
+    code, lines = refusal(build("lab01")[0], scene, tmp_path)
+    assert code == 2 and len(lines) == 1 and "double places it" in lines[0], lines
     path = scenes.write_scene(tmp_path / "mixed.json", scene)
-    image = run_lab(build("lab01-ref-double")[0], path, width=8, height=8, spp=4).image
-    assert image.mean() > 0
+    run = run_lab(lab01_ref, path, width=8, height=8, spp=4)
+    assert run.json["precision"] == "double" and run.image.mean() > 0
