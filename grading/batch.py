@@ -40,7 +40,7 @@ import threading
 import time
 import zipfile
 
-from grading import hidden, shown
+from grading import class_page, hidden, shown
 from grading.grade import RUBRICS
 from grading.speed_numbers import speed_numbers
 from labkit import gpu
@@ -103,13 +103,21 @@ def flagged(results: dict) -> bool:
                 or not results.get("tests"))
 
 
+def waiting(test: dict) -> bool:
+    """A check whose points wait for a gate and which lost none of its own: not run yet, or
+    run and passed ("not counted until ...; it saw: PASS ..."). The gate's verdict is the
+    cause, never a check that passed."""
+    output = test.get("output", "")
+    return output.startswith("not graded until") or (
+        output.startswith("not counted until") and "it saw: PASS" in output)
+
+
 def failure_cause(results: dict) -> str:
     """Why points were lost, in a few words, with the first failing check's words: the
     compiler's first error, a signal, a timeout, a race, which image check."""
     tests = results.get("tests", [])
     top = results.get("output", "")
-    failing = [t for t in tests if t.get("status") != "passed"
-               and not t.get("output", "").startswith("not graded until")]
+    failing = [t for t in tests if t.get("status") != "passed" and not waiting(t)]
     texts = [top] + [f"{t['name']}: {t.get('output', '')}" for t in failing]
     for cause, pattern in CAUSES:
         for text in texts:
@@ -203,46 +211,6 @@ def summary_row(lab: str, rows: dict[str, dict], labels: list[str]) -> list:
         f"{sum(bool(failure_cause(r)) for r in rows.values())} lost points",
         *passed,
     ]
-
-
-def write_html(path: pathlib.Path, lab: str, rows: dict[str, dict]) -> None:
-    labels = [i.label for i in RUBRICS[lab]]
-    e = shown.html  # names, causes and what the checks saw come from the hand-ins
-    head = "".join(f"<th>{e(label)}</th>" for label in labels)
-    body = []
-    for student, r in rows.items():
-        by_name = {t["name"]: t for t in r.get("tests", [])}
-        cells = []
-        for label in labels:
-            t = by_name.get(label)
-            if t is None:
-                cells.append("<td></td>")
-                continue
-            cls = "regrade" if t.get("extra_data", {}).get("regrade") else t.get("status", "failed")
-            cells.append(f'<td class="{cls}" title="{e(t.get("output", ""))}">'
-                         f'{t["score"]}/{t["max_score"]}</td>')
-        note = e(r.get("output", "").splitlines()[0]) if r.get("output") else ""
-        # Each student's own page (images, heatmaps, what each check saw), where the grader
-        # wrote one: grading/report_html.py.
-        page = path.parent / student / "heatmaps" / "report.html"
-        name = (f'<a href="{e(student)}/heatmaps/report.html">{e(student)}</a>' if page.exists()
-                else e(student))
-        numbers = speed_numbers(r)
-        facts = "".join(f"<td>{e(numbers[k])}</td>" for k in ("yours_s", "speedup", "capacity"))
-        flag = " (flagged)" if flagged(r) else ""
-        body.append(f"<tr><th>{name}{flag}</th><td>{r.get('score', 0)}</td>"
-                    f"<td>{provisional_points(r) or ''}</td>{facts}{''.join(cells)}"
-                    f"<td>{e(failure_cause(r))}</td><td>{note}</td></tr>")
-    path.write_text(f"""<!doctype html><meta charset="utf-8"><title>Lab {lab} grades</title>
-<style>body{{font-family:sans-serif}} td,th{{padding:2px 8px;border:1px solid #ccc}}
-.passed{{background:#cfc}} .failed{{background:#fcc}} .regrade{{background:#ffc}}
-table{{border-collapse:collapse}}</style>
-<h1>Lab {lab}: {len(rows)} submissions, {sum(flagged(r) for r in rows.values())} flagged</h1>
-<p>Hover a cell for what the check saw; yellow: marked for regrade (machine too busy).</p>
-<table><tr><th>student</th><th>score</th><th>provisional</th><th>seconds</th><th>speedup</th>
-<th>capacity</th>{head}<th>cause</th><th>note</th></tr>
-{chr(10).join(body)}</table>
-""")
 
 
 EXPORT_METADATA = "submission_metadata.yml"
@@ -532,7 +500,8 @@ def write_report(out: pathlib.Path, lab: str, rows: dict[str, dict | None],
     rows = {s: r if r is not None else {"score": 0, "output": "not graded", "tests": []}
             for s, r in rows.items()}
     write_csv(out / "grades.csv", lab, rows, submitters)
-    write_html(out / "report.html", lab, rows)
+    class_page.write_html(out / "report.html", lab, rows, [i.label for i in RUBRICS[lab]],
+                          submitters)
     count = sum(flagged(r) for r in rows.values())
     print(f"wrote {out / 'grades.csv'} and {out / 'report.html'}: {len(rows)} students, "
           f"{count} flagged{' (regrade them: make grade-batch ... ONLY=flagged)' if count else ''}")
