@@ -338,6 +338,11 @@ def submissions(folder: pathlib.Path, unpacked: pathlib.Path) -> dict[str, pathl
     the one line saying why, which becomes that student's cause."""
     found: dict[str, pathlib.Path | str] = {}
     for entry in sorted(folder.iterdir()):
+        if entry.is_symlink():  # it would grade whatever it points at: a solution, /
+            if entry.suffix == ".zip" or entry.is_dir():
+                found[entry.stem if entry.suffix == ".zip" else entry.name] = shown.line(
+                    f"{entry.name}: refused, a symbolic link: hand in the folder or zip itself")
+            continue
         if entry.is_dir():
             found[entry.name] = entry
         elif entry.suffix == ".zip" and entry.is_file():

@@ -742,6 +742,28 @@ def test_a_hostile_zip_is_its_rows_cause_and_the_class_is_graded(tmp_path, monke
     assert written < 32 << 20, written
 
 
+def test_a_linked_submission_folder_is_its_rows_cause(tmp_path, monkeypatch):
+    """A student's entry that is a link (an export unzipped with its links) would grade what
+    it points at, the solution here: refused, that row's cause."""
+    import csv
+
+    from grading import batch
+    subs, report = tmp_path / "subs", tmp_path / "report"
+    handin(subs / "ann", {"render.cpp": "int x;\n"})
+    (subs / "eve").symlink_to(ROOT / "labs" / "01-serial" / "solution")
+    graded = []
+
+    def grade_one(lab, folder, out, extra, env):
+        graded.append(folder.name)
+        out.mkdir(parents=True, exist_ok=True)
+        return {"score": 100, "max_score": 100, "output": "", "tests": []}
+    monkeypatch.setattr(batch, "grade_one", grade_one)
+    assert batch.main(["01", str(subs), "--out", str(report)]) == 0
+    rows = {r["student"]: r for r in csv.DictReader((report / "grades.csv").open())}
+    assert graded == ["ann"] and rows["eve"]["score"] == "0", rows
+    assert "symbolic link" in rows["eve"]["cause"], rows["eve"]
+
+
 @pytest.mark.parametrize("metadata", [
     "submission_1: !!python/object/apply:os.system ['echo owned']\n",
     "submission_1:\n  :submitters: [[[\n",
