@@ -263,6 +263,7 @@ def test_the_cause_is_the_failing_gates_verdict_not_a_check_that_passed():
     cause = batch.failure_cause(SERIAL)
     assert "serial: in every timed run one thread did" in cause, cause
     assert "PASS" not in cause, cause
+    assert batch.speed_numbers(SERIAL)["capacity"] == "1.97"  # measured: shown beside it
 
 
 def test_the_class_page_names_links_sorts_plots_and_says_a_shared_note_once(tmp_path,
