@@ -101,7 +101,7 @@ def student_page(report: pathlib.Path, student: str, lab: str, who: str, results
 
 def write_html(path: pathlib.Path, lab: str, rows: dict[str, dict], labels: list[str],
                submitters: dict[str, str] | None = None) -> None:
-    from grading.batch import failure_cause, flagged, provisional_points
+    from grading.batch import failure_cause, flagged, provisional_points, waiting
     e = shown.html
     shared_count = collections.Counter(line for r in rows.values() for line in set(note_lines(r)))
     shared = [line for line, n in shared_count.items() if n > 1]
@@ -129,7 +129,7 @@ def write_html(path: pathlib.Path, lab: str, rows: dict[str, dict], labels: list
                 cells.append('<td data-v=""></td>')
                 continue
             cls = ("regrade" if t.get("extra_data", {}).get("regrade")
-                   else t.get("status", "failed"))
+                   else "waiting" if waiting(t) else t.get("status", "failed"))
             cells.append(f'<td class="{e(cls)}" data-v="{t["score"]}" '
                          f'title="{e(t.get("output", ""))}">{t["score"]}/{t["max_score"]}</td>')
         own = [line for line in note_lines(r) if line not in shared][:MOST_NOTE_LINES]
@@ -145,13 +145,15 @@ def write_html(path: pathlib.Path, lab: str, rows: dict[str, dict], labels: list
     path.write_text(f"""<!doctype html><meta charset="utf-8"><title>Lab {e(lab)} grades</title>
 <style>body{{font-family:sans-serif}} td,th{{padding:2px 8px;border:1px solid #ccc}}
 .passed{{background:#cfc}} .failed{{background:#fcc}} .regrade{{background:#ffc}}
-table{{border-collapse:collapse}} thead th{{cursor:pointer}} .plots svg{{margin-right:2em}}</style>
+.waiting{{background:#eee}} table{{border-collapse:collapse}} thead th{{cursor:pointer}}
+.plots svg{{margin-right:2em}}</style>
 {SORT_SCRIPT}
 <h1>Lab {e(lab)}: {len(rows)} submissions, {flagged_count} flagged</h1>
 {plots(rows)}
 {notes}
 <p>Click a column's title to sort by it; hover a cell for what the check saw; yellow: marked
-for regrade (machine too busy); each name links to that submission's page.</p>
+for regrade (machine too busy); grey: points waiting for a gate that failed; each name links
+to that submission's page.</p>
 <table><thead><tr>{columns_html}{head}<th onclick="sortBy(this)">cause</th>
 <th>notes</th></tr></thead>
 <tbody>
