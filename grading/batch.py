@@ -41,10 +41,21 @@ import time
 import zipfile
 
 from grading import class_page, hidden, shown
-from grading.grade import RUBRICS
+from grading.grade import BUDGET_SECONDS, RUBRICS
 from grading.speed_numbers import speed_numbers
 from labkit import gpu
 from labkit.harness import ROOT
+
+# A grade ends within the grader's budget (grade.BUDGET_SECONDS) plus a compile; a grader
+# still running well past it is stopped (SIGTERM: it writes its results and cleans up, then
+# SIGKILL), so that one hand-in never holds up the class.
+GRADER_SECONDS = BUDGET_SECONDS + 20 * 60
+STOP_GRACE_SECONDS = 60
+
+
+def grader_command(lab: str, folder: pathlib.Path, out: pathlib.Path, extra: list[str]) -> list:
+    return [sys.executable, "-m", "grading.grade", lab, "--sources", str(folder),
+            "--results", str(out / "results.json"), "--heatmaps", str(out / "heatmaps"), *extra]
 
 
 def grade_one(lab: str, folder: pathlib.Path, out: pathlib.Path, extra: list[str],
@@ -53,15 +64,27 @@ def grade_one(lab: str, folder: pathlib.Path, out: pathlib.Path, extra: list[str
     results.json and never run)."""
     out.mkdir(parents=True, exist_ok=True)
     results = out / "results.json"
-    subprocess.run([sys.executable, "-m", "grading.grade", lab, "--sources", str(folder),
-                    "--results", str(results),
-                    "--heatmaps", str(out / "heatmaps"), *extra],
-                   cwd=ROOT, env=env, stdout=(out / "grader.log").open("w"),
-                   stderr=subprocess.STDOUT)
+    stopped = ""
+    with (out / "grader.log").open("w") as log:
+        grader = subprocess.Popen(grader_command(lab, folder, out, extra), cwd=ROOT, env=env,
+                                  stdout=log, stderr=subprocess.STDOUT)
+        try:
+            grader.wait(timeout=GRADER_SECONDS)
+        except subprocess.TimeoutExpired:
+            stopped = f"the grader did not finish in {GRADER_SECONDS:g} s and was stopped"
+            grader.terminate()
+            try:
+                grader.wait(timeout=STOP_GRACE_SECONDS)
+            except subprocess.TimeoutExpired:
+                grader.kill()
+                grader.wait()
     try:
-        return json.loads(results.read_text())
+        graded = json.loads(results.read_text())
     except (OSError, ValueError) as e:  # the grader always writes one; say so if it did not
-        return {"score": 0, "output": f"the grader left no results.json: {e}", "tests": []}
+        graded = {"score": 0, "output": f"the grader left no results.json: {e}", "tests": []}
+    if stopped:
+        graded["output"] = f"{stopped}\n{graded.get('output', '')}".rstrip()
+    return graded
 
 
 def refused_results(lab: str, reason: str) -> dict:
@@ -76,6 +99,7 @@ def refused_results(lab: str, reason: str) -> dict:
 
 # The cause of a failure, from what the failing check or the grader said: first match wins.
 CAUSES = [
+    ("timeout", re.compile(r"the grader did not finish in")),  # stopped by the batch
     ("no results", re.compile(r"left no results\.json")),
     ("compile error", re.compile(r"does not compile")),
     ("no hand-in", re.compile(r"the hand-in holds (none|lab)")),

@@ -287,3 +287,21 @@ def test_the_class_page_names_links_sorts_plots_and_says_a_shared_note_once(tmp_
     assert page.count(HIDDEN_NOTE.split(" (")[0]) == 1, page  # said once, not per row
     assert page.count("<svg") >= 2 and "sort" in page and "<th onclick" in page
     assert "serial: in every timed run" in page and "1.91" in page and "1.97" in page
+
+
+def test_a_grader_that_never_ends_is_stopped_and_the_class_goes_on(tmp_path, monkeypatch):
+    """One hand-in must not hold up the class: a grader still running past its time is
+    stopped, and its row says so."""
+    import sys
+    subs = tmp_path / "subs"
+    for student in ("ann", "bob"):
+        (subs / student).mkdir(parents=True)
+    monkeypatch.setattr(batch, "GRADER_SECONDS", 1)
+    monkeypatch.setattr(batch, "STOP_GRACE_SECONDS", 1)
+    monkeypatch.setattr(batch, "grader_command", lambda lab, folder, out, extra: [
+        sys.executable, "-c", "import signal, time; signal.signal(signal.SIGTERM, "
+        "signal.SIG_IGN); time.sleep(600)"])
+    assert batch.main(["01", str(subs), "--out", str(tmp_path / "r")]) == 0
+    rows = {r["student"]: r for r in rows_of(tmp_path / "r" / "grades.csv")}
+    assert rows["ann"]["cause"].startswith("timeout: the grader did not finish"), rows["ann"]
+    assert rows["bob"]["cause"].startswith("timeout: the grader did not finish"), rows["bob"]
