@@ -82,8 +82,9 @@ def grade_one(lab: str, folder: pathlib.Path, out: pathlib.Path, extra: list[str
         graded = json.loads(results.read_text())
     except (OSError, ValueError) as e:  # the grader always writes one; say so if it did not
         graded = {"score": 0, "output": f"the grader left no results.json: {e}", "tests": []}
-    if stopped:
+    if stopped:  # said in results.json too, where a later merge reads it
         graded["output"] = f"{stopped}\n{graded.get('output', '')}".rstrip()
+        results.write_text(json.dumps(graded, indent=2))
     return graded
 
 
@@ -123,8 +124,8 @@ def provisional_points(results: dict) -> int:
 def flagged(results: dict) -> bool:
     """To be graded again on a quiet machine: provisional points, or refused for the
     machine's sake (no GPU), or no results at all."""
-    return bool(any(t.get("extra_data", {}).get("regrade") for t in results.get("tests", []))
-                or not results.get("tests"))
+    return (any(t.get("extra_data", {}).get("regrade") for t in results.get("tests", []))
+            or not results.get("tests"))
 
 
 def waiting(test: dict) -> bool:
