@@ -147,6 +147,9 @@ def failure_cause(results: dict) -> str:
     for cause, pattern in CAUSES:
         for text in texts:
             if pattern.search(text):
+                if cause == "refused":  # the grader's one line, once
+                    why = text.split("the hand-in was refused: ", 1)[1].splitlines()
+                    return f"refused: {why[0][:200] if why else ''}"
                 if cause == "compile error":  # the compiler's first line after the note
                     lines = top.splitlines()
                     at = next((i for i, line in enumerate(lines) if "does not compile" in line), 0)
@@ -366,7 +369,7 @@ def submissions(folder: pathlib.Path, unpacked: pathlib.Path) -> dict[str, pathl
         if entry.is_symlink():  # it would grade whatever it points at: a solution, /
             if entry.suffix == ".zip" or entry.is_dir():
                 found[entry.stem if entry.suffix == ".zip" else entry.name] = shown.line(
-                    f"{entry.name}: refused, a symbolic link: hand in the folder or zip itself")
+                    f"{entry.name} is a symbolic link: hand in the folder or zip itself")
             continue
         if entry.is_dir():
             found[entry.name] = entry
@@ -434,11 +437,9 @@ def unzip(archive: pathlib.Path, target: pathlib.Path) -> None:
                             raise ZipRefused(f"unpacks to more than {ZIP_MAX_BYTES >> 20} MiB")
                         dst.write(chunk)
             _check_ratio(written, archive.stat().st_size)
-    except ZipRefused as e:
-        raise ZipRefused(f"refused, {e}") from None
     except (zipfile.BadZipFile, zipfile.LargeZipFile, NotImplementedError, EOFError,
             ValueError, OSError, RuntimeError) as e:
-        raise ZipRefused(f"refused, it cannot be read as a zip ({e})") from None
+        raise ZipRefused(f"it cannot be read as a zip ({e})") from None
 
 
 def _check_ratio(unpacked: int, packed: int) -> None:
