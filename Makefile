@@ -300,8 +300,8 @@ bench-precision: lab01-ref lab01-ref-double
 # shared one) and links the lab's driver into DIR/lab. Each lab.mk sets VARIANT_FLAGS_<lab>,
 # VARIANT_DRIVER_<lab> and VARIANT_LIBS_<lab> to what its own binaries are built with.
 # A hand-in's file names reach the shell quoted (the grader also refuses any outside
-# [A-Za-z0-9_.+-]): each word of $(1) in single quotes.
-quoted = $(foreach f,$(1),'$(f)')
+# [A-Za-z0-9_.+-]): each word of $(1) in single quotes, a quote in it as '\''.
+quoted = $(foreach f,$(1),'$(subst ','\'',$(f))')
 
 variant: $(VARIANT_DRIVER_$(VARIANT_LAB))
 	@test -n "$(VARIANT)" -a -n "$(VARIANT_DRIVER_$(VARIANT_LAB))" || \
