@@ -403,6 +403,16 @@ class ZipRefused(Exception):
     """A hand-in zip that is not unpacked: one line."""
 
 
+def by_export(found: dict[str, pathlib.Path | str],
+              submitters: dict[str, str] | None) -> dict[str, pathlib.Path | str]:
+    """For a Gradescope export, the submissions its metadata lists, in name order (the order
+    Slurm's tasks count in); one it lists without a folder or zip is a row saying so."""
+    if submitters is None:
+        return found
+    return {name: found.get(name, "the export holds no folder or zip of this submission")
+            for name in sorted(submitters)}
+
+
 def unzip(archive: pathlib.Path, target: pathlib.Path) -> None:
     """Unpack a hand-in zip into `target`: no absolute paths, no "..", nothing outside, and
     within the limits above, checked on what the zip declares and again on the bytes it
@@ -572,8 +582,7 @@ def main(argv=None) -> int:
     )
     try:
         found = submissions(a.submissions, unpacked)
-        if submitters is not None:  # a Gradescope export: its submissions, by its metadata
-            found = {name: folder for name, folder in found.items() if name in submitters}
+        found = by_export(found, submitters)
         rows = {student: previous(a.out, student) for student in found}
         if a.merge:
             write_report(a.out, a.lab, rows, submitters)

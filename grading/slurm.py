@@ -31,8 +31,7 @@ from labkit.harness import ROOT
 
 def count(submissions: pathlib.Path, out: pathlib.Path) -> int:
     found = batch.submissions(submissions, out / ".unpacked")
-    listed = batch.export_submitters(submissions)
-    return len([s for s in found if listed is None or s in listed])
+    return len(batch.by_export(found, batch.export_submitters(submissions)))
 
 
 def scripts(lab: str, submissions: pathlib.Path, out: pathlib.Path, n: int,

@@ -793,3 +793,19 @@ def test_a_hostile_export_metadata_never_stops_the_class(tmp_path, monkeypatch, 
     rows = list(csv.DictReader((report / "grades.csv").open()))
     assert {r["submission_id"] for r in rows} >= {"1", "2"}
     assert capsys.readouterr().err.count("submission_metadata.yml") == 1
+
+
+def test_a_submission_the_export_lists_without_its_folder_is_a_row(tmp_path, monkeypatch):
+    import csv
+
+    from grading import batch
+    subs = tmp_path / "subs"
+    handin(subs / "submission_1", {"render.cpp": "int x;\n"})
+    (subs / "submission_metadata.yml").write_text(
+        "submission_1:\n  :submitters:\n  - :name: Ada\n"
+        "submission_2:\n  :submitters:\n  - :name: Alan\n")
+    monkeypatch.setattr(batch, "grade_one", lambda lab, folder, out, extra, env: (
+        out.mkdir(parents=True, exist_ok=True), {"score": 100, "tests": []})[1])
+    assert batch.main(["01", str(subs), "--out", str(tmp_path / "r")]) == 0
+    rows = {r["submission_id"]: r for r in csv.DictReader((tmp_path / "r" / "grades.csv").open())}
+    assert rows["2"]["score"] == "0" and "no folder or zip" in rows["2"]["cause"], rows
