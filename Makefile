@@ -335,12 +335,16 @@ bench-precision: lab01-ref lab01-ref-double
 # compiles DIR/*.cpp with DIR first on the include path (a header there stands in for the
 # shared one) and links the lab's driver into DIR/lab. Each lab.mk sets VARIANT_FLAGS_<lab>,
 # VARIANT_DRIVER_<lab> and VARIANT_LIBS_<lab> to what its own binaries are built with.
+# A hand-in's file names reach the shell quoted (the grader also refuses any outside
+# [A-Za-z0-9_.+-]): each word of $(1) in single quotes, a quote in it as '\''.
+quoted = $(foreach f,$(1),'$(subst ','\'',$(f))')
+
 variant: $(VARIANT_DRIVER_$(VARIANT_LAB))
 	@test -n "$(VARIANT)" -a -n "$(VARIANT_DRIVER_$(VARIANT_LAB))" || \
 	    { echo "variant: needs VARIANT=DIR and VARIANT_LAB=<a lab with VARIANT_DRIVER_<lab>>" >&2; exit 2; }
-	$(CXX) $(filter-out -MMD -MP,$(CXXFLAGS)) -w -I$(VARIANT) $(VARIANT_FLAGS_$(VARIANT_LAB)) \
-	    $(INCLUDES) $(sort $(wildcard $(VARIANT)/*.cpp)) $(VARIANT_DRIVER_$(VARIANT_LAB)) \
-	    -o $(VARIANT)/lab $(VARIANT_LIBS_$(VARIANT_LAB))
+	$(CXX) $(filter-out -MMD -MP,$(CXXFLAGS)) -w -I'$(VARIANT)' $(VARIANT_FLAGS_$(VARIANT_LAB)) \
+	    $(INCLUDES) $(call quoted,$(sort $(wildcard $(VARIANT)/*.cpp))) \
+	    $(VARIANT_DRIVER_$(VARIANT_LAB)) -o '$(VARIANT)/lab' $(VARIANT_LIBS_$(VARIANT_LAB))
 
 clean:
 	rm -rf $(BUILD) $(LAB_BINARIES) .pytest_cache

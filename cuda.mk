@@ -86,8 +86,9 @@ cuda-variant: $(COMMON_OBJ)
 	    { echo "cuda-variant: needs VARIANT=DIR and VARIANT_LAB=<a CUDA lab folder: $(CUDA_LAB_FOLDERS)>" >&2; exit 2; }
 	@missing="$(filter-out $(notdir $(wildcard $(VARIANT)/*)),$(CUDA_STUDENT_FILES_$(VARIANT_LAB)))"; \
 	    test -z "$$missing" || { echo "error: $(VARIANT) has no $$missing: lab $(VARIANT_LAB)'s students write it" >&2; exit 2; }
-	$(NVCC) $(NVCCFLAGS) $(CUDA_ARCH) -I$(VARIANT) $(CUDA_SHARED_INCLUDES_$(VARIANT_LAB)) \
-	    $(CUDA_INCLUDES) $(INCLUDES) $(sort $(wildcard $(VARIANT)/*.cu)) $(COMMON_OBJ) -o $(VARIANT)/lab
+	$(NVCC) $(NVCCFLAGS) $(CUDA_ARCH) -I'$(VARIANT)' $(CUDA_SHARED_INCLUDES_$(VARIANT_LAB)) \
+	    $(CUDA_INCLUDES) $(INCLUDES) $(call quoted,$(sort $(wildcard $(VARIANT)/*.cu))) \
+	    $(COMMON_OBJ) -o '$(VARIANT)/lab'
 
 
 # Each shared GPU header compiles alone, for sm_90 with warnings as errors: it includes what

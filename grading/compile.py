@@ -52,8 +52,11 @@ def build_in_sandbox(variant_lab: str, handin: pathlib.Path, target: str = "vari
     try:
         files, missing = students_tree.collect(handin, variant_lab)
     except students_tree.HandInError as e:
-        return None, f"refused: {e}", ""
-    note = (f"not handed in, the skeleton's copy used: {', '.join(missing)}" if missing else "")
+        return None, f"refused: {e}", students_tree.ignored(handin)
+    note = "\n".join(line for line in (
+        students_tree.ignored(handin),  # programs and other files: never run, only named
+        f"not handed in, the skeleton's copy used: {', '.join(missing)}" if missing else "",
+    ) if line)
     work = students_tree.stage(variant_lab, files, missing, target)
     try:
         tree, src = work / "tree", work / "tree" / "submission"

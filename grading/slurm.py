@@ -24,22 +24,25 @@ import subprocess
 import sys
 import tempfile
 
-from grading import batch
+from grading import batch, shown
 from grading.grade import RUBRICS
 from labkit.harness import ROOT
 
 
 def count(submissions: pathlib.Path, out: pathlib.Path) -> int:
     found = batch.submissions(submissions, out / ".unpacked")
-    listed = batch.export_submitters(submissions)
-    return len([s for s in found if listed is None or s in listed])
+    return len(batch.by_export(found, batch.export_submitters(submissions)))
 
 
 def scripts(lab: str, submissions: pathlib.Path, out: pathlib.Path, n: int,
             partition: str | None, run_seconds: float | None) -> tuple[str, str]:
     """(the array job's script, the merge job's script)."""
-    q = shlex.quote
-    part = f"#SBATCH --partition={partition}\n" if partition else ""
+    # Paths on a directive line stay on it (a newline would add a directive of its own):
+    # one cleaner for everything shown or run (grading/shown.py).
+    def q(text: object) -> str:
+        return shlex.quote(shown.line(text))
+    out_line = shown.line(str(out))
+    part = f"#SBATCH --partition={shown.line(partition)}\n" if partition else ""
     extra = f" --run-seconds {run_seconds:g}" if run_seconds else ""
     common = (f"cd {q(str(ROOT))}\n"
               f"{q(sys.executable)} -m grading.batch {lab} {q(str(submissions))} "
@@ -49,14 +52,14 @@ def scripts(lab: str, submissions: pathlib.Path, out: pathlib.Path, n: int,
 #SBATCH --array=0-{n - 1}
 #SBATCH --exclusive
 #SBATCH --nodes=1
-#SBATCH --output={out}/slurm-%A_%a.log
+#SBATCH --output={out_line}/slurm-%A_%a.log
 {part}# One submission per task: the K-th in name order (grading/slurm.py).
 {common} --task "$SLURM_ARRAY_TASK_ID"
 """
     merge = f"""#!/bin/bash
 #SBATCH --job-name=grade-lab{lab}-merge
 #SBATCH --nodes=1
-#SBATCH --output={out}/slurm-merge-%j.log
+#SBATCH --output={out_line}/slurm-merge-%j.log
 {part}# grades.csv and report.html from every task's results.json (grading/slurm.py).
 {common} --merge
 """

@@ -29,8 +29,10 @@ def test_batch_grades_each_student_into_csv_and_html(tmp_path):
     subs = tmp_path / "submissions"
     for student in ("alice", "bob", "carol"):
         (subs / student).mkdir(parents=True)
-    shutil.copy2(sub.REFERENCE, subs / "alice" / "lab")       # correct
-    sub.exec_reference(subs / "bob")                           # the wrapper
+    for name in ("render.cpp", "path_tracer.h"):               # correct sources
+        shutil.copy2(ROOT / "labs/01-serial/solution" / name if name == "render.cpp"
+                     else ROOT / "common/core" / name, subs / "alice" / name)
+    sub.exec_reference(subs / "bob")          # a program only: never run, nothing to build
     (subs / "carol" / "render.cpp").write_text("int broken( {\n")  # does not compile
     report = tmp_path / "report"
     p = subprocess.run([sys.executable, "-m", "grading.batch", "01", str(subs), "--out",
