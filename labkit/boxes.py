@@ -150,7 +150,10 @@ def processes(uid: int) -> list[int]:
     return found
 
 
-KILL = shutil.which("kill") or "/bin/kill"
+# kill(-1, SIGKILL), run as the box's user: procps's kill, or the system's Python where a
+# slim container image has no procps.
+KILL_ALL = ([shutil.which("kill"), "-s", "KILL", "--", "-1"] if shutil.which("kill") else
+            ["/usr/bin/python3", "-I", "-S", "-c", "import os; os.kill(-1, 9)"])
 
 
 def end_processes(uid: int, gid: int, seconds: float = 5.0) -> list[int]:
@@ -160,7 +163,7 @@ def end_processes(uid: int, gid: int, seconds: float = 5.0) -> list[int]:
     deadline = time.monotonic() + seconds
     while True:
         with contextlib.suppress(OSError):
-            subprocess.run([KILL, "-s", "KILL", "--", "-1"], user=uid, group=gid,
+            subprocess.run(KILL_ALL, user=uid, group=gid,
                            extra_groups=[], stdin=subprocess.DEVNULL,
                            stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
         left = processes(uid)

@@ -229,3 +229,17 @@ def test_more_output_than_the_limit_is_cut(mode):
                                                                output_bytes=1 << 20))
     assert out.failure and "wrote more than 1024 KiB on stdout" in out.failure, out
     assert len(out.stdout) == 1 << 20
+
+
+def test_more_open_files_than_the_limit_are_refused(mode):
+    out = py("import os\nfds = []\ntry:\n    while len(fds) < 2000:\n"
+             "        fds.append(os.open('/dev/null', os.O_RDONLY))\n"
+             "except OSError as e:\n    print(len(fds), e.strerror)")
+    assert "Too many open files" in out.stdout, out
+    assert int(out.stdout.split()[0]) < Limits().open_files, out
+
+
+def test_more_left_in_scratch_than_the_limit_is_refused(mode):
+    out = sh("for i in 1 2 3; do head -c 600000 /dev/zero > f$i; done",
+             Limits(wall_seconds=10, scratch_bytes=1 << 20))
+    assert out.failure and "left 2 MiB in its scratch folder" in out.failure, out
