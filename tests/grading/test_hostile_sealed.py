@@ -11,6 +11,7 @@ import pytest
 from labkit import sandbox
 from labkit.harness import ROOT
 from labkit.sandbox import Limits, Runner
+from tests.grading import submissions as sub
 
 QUICK = Limits(wall_seconds=10)
 
@@ -180,6 +181,47 @@ def test_no_two_runs_are_the_same_user(mode):
     seen = [owner_of_what_it_writes() for _ in range(3)]
     assert len(set(seen)) == 3, seen
     assert not {os.geteuid(), sandbox.NOBODY} & set(seen), seen
+
+
+# ---- one student's renders replayed by another's grade, as in a batch (one secret) -------
+
+# The key of a render: every argument but the two paths, and the scene's content.
+RENDER_KEY = """key=$( (prev=""; for a in "$@"; do
+  case "$prev" in --pfm|--scene) ;; *) printf '%s ' "$a" ;; esac; prev="$a"; done
+  [ -n "$scene" ] && cat "$scene") | md5sum | cut -c1-32)
+"""
+
+
+def keeper(folder, kept: str):
+    """Renders honestly (the reference), and keeps each image and summary in /dev/shm."""
+    return sub.carrying_reference(folder, f"""{sub.FIND_ARGS}{RENDER_KEY}./ref "$@" > out
+status=$?
+cat out
+mkdir -p {kept} 2>/dev/null && chmod 777 {kept}
+cp "$pfm" {kept}/$key.pfm 2>/dev/null; cp out {kept}/$key.out 2>/dev/null
+chmod 666 {kept}/* 2>/dev/null
+exit $status""", name="keeper")
+
+
+def replayer(folder, kept: str):
+    """No renderer: prints whatever image another run kept for the same arguments."""
+    return sub.script(folder, f"""{sub.FIND_ARGS}{RENDER_KEY}
+cp {kept}/$key.pfm "$pfm" && cat {kept}/$key.out
+""", name="replayer")
+
+
+def test_a_hand_in_replaying_another_students_renders_scores_nothing(mode, tmp_path):
+    from grading.grade import describe, grade
+    kept = f"/dev/shm/prt-kept-{os.getpid()}"
+    try:
+        honest = grade("01", keeper(tmp_path, kept), tmp_path / "a", secret="one-batch")
+        assert honest["score"] == 100, describe(honest)
+        replayed = grade("01", replayer(tmp_path, kept), tmp_path / "b", secret="one-batch")
+        assert replayed["score"] == 0, describe(replayed)
+    finally:
+        if os.path.isdir(kept):
+            import shutil
+            shutil.rmtree(kept)
 
 
 # ---- the limits grading/README.md promises, each exceeded --------------------------------
