@@ -321,17 +321,17 @@ class Runner:
         self.trusted = trusted
         self.gpu = gpu  # a GPU lab's runs: the sandbox shows the GPU (labkit/gpu.py)
         self.user_mode = not trusted and isolation() == USER
-        self.root = pathlib.Path(tempfile.mkdtemp(prefix="grading-"))
-        os.chmod(self.root, 0o755)  # the unprivileged sandbox user must reach staged inputs
-        self.inputs: dict[str, pathlib.Path] = {}
-        self.binds: list[tuple[str, bool]] = []  # (path, writable), mounted at the same path
-        self._scratch: pathlib.Path | None = None
         # A grader running as root runs each Runner as a user of its own (labkit/boxes.py),
         # whom the submission's files belong to; else as the grader's own user (bubblewrap's
         # namespaces are then the only walls).
         self.box = boxes.new_box() if not trusted and os.geteuid() == 0 else None
         if self.user_mode and self.box is None:
             raise OSError("the user sandbox needs the grader to run as root")
+        self.root = pathlib.Path(tempfile.mkdtemp(prefix="grading-"))
+        os.chmod(self.root, 0o755)  # the unprivileged sandbox user must reach staged inputs
+        self.inputs: dict[str, pathlib.Path] = {}
+        self.binds: list[tuple[str, bool]] = []  # (path, writable), mounted at the same path
+        self._scratch: pathlib.Path | None = None
 
     def __enter__(self):
         return self
