@@ -94,9 +94,10 @@ def _taken(ident: int) -> bool:
         return False
 
 
-def new_box() -> tuple[int, int]:
-    """A uid and gid (the same number) no box had before: the next of the pool's counter,
-    which starts again at the pool's first id only when the pool is spent (after hundreds
+def new_box() -> tuple[tuple[int, int], bool]:
+    """A uid and gid (the same number) no box had before, and whether no box ever had it
+    (False once the counter has come round: that box must be reset before it runs). The
+    counter starts again at the pool's first id only when the pool is spent (after hundreds
     of millions of runs; the fallback's after ten thousand), skipping ids an account holds."""
     ids = pool()
     if ids is None:
@@ -106,14 +107,21 @@ def new_box() -> tuple[int, int]:
     fd = os.open(_state_file(), os.O_RDWR | os.O_CREAT | os.O_NOFOLLOW, 0o600)
     with os.fdopen(fd, "r+") as f:
         fcntl.flock(f, fcntl.LOCK_EX)
-        text = f.read().strip()
-        ident = int(text) if text.isdigit() and int(text) in ids else ids.start
+        fields = f.read().split()  # the next id, and how often the counter came round
+        if len(fields) == 2 and all(x.isdigit() for x in fields) and int(fields[0]) in ids:
+            ident, rounds = int(fields[0]), int(fields[1])
+        else:  # none yet; or unreadable, where no id can be taken for fresh
+            ident, rounds = ids.start, 0 if not fields else 1
+
+        def after(ident: int, rounds: int) -> tuple[int, int]:
+            return (ids.start, rounds + 1) if ident + 1 == ids.stop else (ident + 1, rounds)
+
         while _taken(ident):
-            ident = ids.start if ident + 1 == ids.stop else ident + 1
+            ident, rounds = after(ident, rounds)
         f.seek(0)
         f.truncate()
-        f.write(str(ids.start if ident + 1 == ids.stop else ident + 1))
-    return ident, ident
+        f.write("{} {}\n".format(*after(ident, rounds)))
+    return (ident, ident), rounds == 0
 
 
 # ---- ending a box ------------------------------------------------------------------------

@@ -324,7 +324,10 @@ class Runner:
         # A grader running as root runs each Runner as a user of its own (labkit/boxes.py),
         # whom the submission's files belong to; else as the grader's own user (bubblewrap's
         # namespaces are then the only walls).
-        self.box = boxes.new_box() if not trusted and os.geteuid() == 0 else None
+        self.box, self._reset = None, False
+        if not trusted and os.geteuid() == 0:
+            self.box, fresh = boxes.new_box()
+            self._reset = not fresh  # an id that came round: whatever it left goes first
         if self.user_mode and self.box is None:
             raise OSError("the user sandbox needs the grader to run as root")
         self.root = pathlib.Path(tempfile.mkdtemp(prefix="grading-"))
@@ -470,7 +473,7 @@ class Runner:
         user = {}
         if self.box and not self.user_mode:  # the user sandbox switches users with setpriv
             user = dict(user=self.box[0], group=self.box[1], extra_groups=[])
-        if self.box:  # a box is reset before each run, should its id ever come round again
+        if self._reset:
             boxes.seal(*self.box)
         start = time.perf_counter()
         try:
@@ -486,6 +489,7 @@ class Runner:
         finally:
             if self.box:  # nothing of this run outlives it
                 boxes.seal(*self.box)
+                self._reset = False
         if outcome.killed is None and outcome.returncode == 0:
             used = _tree_size(self._scratch_dir())
             if used > limits.scratch_bytes:

@@ -19,8 +19,18 @@ def state(tmp_path, monkeypatch):
 
 def test_no_id_is_drawn_twice(state):
     drawn = [boxes.new_box() for _ in range(50)]
-    assert len({uid for uid, _ in drawn}) == 50 and all(u == g for u, g in drawn), drawn
-    assert all(uid in boxes.pool() for uid, _ in drawn), drawn
+    assert all(fresh for _, fresh in drawn), drawn
+    ids = [box for box, _ in drawn]
+    assert len({uid for uid, _ in ids}) == 50 and all(u == g for u, g in ids), ids
+    assert all(uid in boxes.pool() for uid, _ in ids), ids
+
+
+def test_an_id_that_came_round_is_not_fresh(state, monkeypatch):
+    """Once the pool is spent the counter starts again, and those boxes are reset first."""
+    monkeypatch.setattr(boxes, "POOL", range(boxes.POOL.start, boxes.POOL.start + 3))
+    drawn = [boxes.new_box() for _ in range(5)]
+    assert [box[0] - boxes.POOL.start for box, _ in drawn] == [0, 1, 2, 0, 1], drawn
+    assert [fresh for _, fresh in drawn] == [True, True, True, False, False], drawn
 
 
 def test_a_namespace_of_65536_ids_draws_from_the_fallback_skipping_accounts(state, monkeypatch):
@@ -30,7 +40,7 @@ def test_a_namespace_of_65536_ids_draws_from_the_fallback_skipping_accounts(stat
     held = {boxes.FALLBACK_POOL.start, boxes.FALLBACK_POOL.start + 1}
     monkeypatch.setattr(boxes, "_taken", lambda ident: ident in held)
     assert boxes.pool() == boxes.FALLBACK_POOL
-    assert boxes.new_box()[0] == boxes.FALLBACK_POOL.start + 2
+    assert boxes.new_box()[0][0] == boxes.FALLBACK_POOL.start + 2
 
 
 def test_no_pool_is_one_line(monkeypatch):
