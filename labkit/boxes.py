@@ -166,18 +166,22 @@ KILL_ALL = ([shutil.which("kill"), "-s", "KILL", "--", "-1"] if shutil.which("ki
 
 def end_processes(uid: int, gid: int, seconds: float = 5.0) -> list[int]:
     """SIGKILL every process of the box until none has a live thread; what is still alive
-    after `seconds` (a task stuck in the kernel), else []. kill(-1) sent as the box's user
-    (POSIX: every process it may signal) leaves no gap a fork could slip through."""
+    after `seconds` (a task stuck in the kernel), else []. Each pass signals, from root,
+    every process a /proc sweep finds, then sends kill(-1) as the box's user (POSIX: every
+    process it may signal at once, so no fork slips through), with a time limit: a process
+    of the box the sweep missed may stop that sender (SIGSTOP to every process of its user),
+    and the next pass's sweep finds it."""
     deadline = time.monotonic() + seconds
     while True:
-        with contextlib.suppress(OSError):
-            subprocess.run(KILL_ALL, user=uid, group=gid,
-                           extra_groups=[], stdin=subprocess.DEVNULL,
-                           stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
         left = processes(uid)
-        for pid in left:  # kill(-1) reached them; a signal from root as well, for certainty
+        for pid in left:
             with contextlib.suppress(OSError):
                 os.kill(pid, signal.SIGKILL)
+        with contextlib.suppress(OSError, subprocess.TimeoutExpired):
+            subprocess.run(KILL_ALL, user=uid, group=gid, extra_groups=[], timeout=0.5,
+                           stdin=subprocess.DEVNULL, stdout=subprocess.DEVNULL,
+                           stderr=subprocess.DEVNULL)
+        left = processes(uid)
         if not left or time.monotonic() > deadline:
             return left
         time.sleep(0.01)
