@@ -530,6 +530,11 @@ BUSY = 1.9
 SERIAL_TELLABLE = 1.25
 QUOTA_TOO_SMALL = 1.5  # cores' worth of CPU (count or cgroup quota) below which nothing is timed
 ONE_THREAD = 0.9
+# A speedup this many times the capacity measured in the same rounds is impossible: a
+# program cannot get more from the cores than n copies of the serial reference do, beyond
+# noise and a faster serial path. One that does read something it had kept (its own first
+# render, another run's image) or slowed the reference: refused, never scored.
+IMPOSSIBLE = 1.5
 
 
 def busiest_thread_share(run) -> float:
@@ -654,6 +659,11 @@ def _parallel_speedup(binary, baseline, settings: dict, *, threads, launcher, fr
         if wrong:
             return CheckResult("parallel speedup", False,
                                f"{wrong[0]}: speed is graded only for a correct image", credit=0.0)
+        if timing.speedup("yours") > IMPOSSIBLE * timing.capacity:
+            return CheckResult("parallel speedup", False,
+                               f"impossible: {timing.describe('yours')}; more than "
+                               f"{IMPOSSIBLE:g} times the capacity no program can get from the "
+                               f"machine, so not a speedup: refused, no points", credit=0.0)
         if one_thread_did_it(shares):
             return serial_by_thread(shares, f"{max(used):.2f} cores' worth at most, on a "
                                             f"machine giving {capacity:.2f}")

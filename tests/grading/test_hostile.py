@@ -496,8 +496,9 @@ def test_serial_lab03_beside_a_cpu_burner_earns_nothing_and_is_final(tmp_path):
 
 def test_the_lab03_reference_beside_a_cpu_burner_is_not_called_serial(tmp_path):
     """The lab 03 reference beside the same burner: its work is shared among its threads, so
-    it is never called serial; its correctness counts (bits and golden images, 60 points)
-    and its speed either earns points or waits for a regrade, never a final 0."""
+    it is never called serial; its speed either earns points or waits for a regrade, never a
+    final 0, and its correctness (bits and golden images, 60 points) counts once a speedup is
+    measured, else waits with the speed, shown apart."""
     from labkit.harness import build
     reference, = build("lab03-ref")
     with burning_one_core():
@@ -505,7 +506,8 @@ def test_the_lab03_reference_beside_a_cpu_burner_is_not_called_serial(tmp_path):
     speed = speed_test(results)
     assert not speed["output"].startswith("serial"), describe(results)
     assert speed["score"] > 0 or speed["extra_data"]["regrade"], describe(results)
-    assert results["score"] >= 60, describe(results)
+    shown_apart = sum(t["extra_data"]["provisional"] for t in results["tests"])
+    assert results["score"] >= 60 or results["score"] + shown_apart >= 100, describe(results)
 
 
 def noisy_golden(spp: int):

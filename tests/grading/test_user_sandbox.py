@@ -53,7 +53,7 @@ def test_reference_scores_100_without_namespaces(tmp_path):
         assert all(t["extra_data"]["regrade"] for t in results["tests"]), results
         return
     assert status == 0, stderr
-    assert "dedicated user" in results["sandbox"], results["sandbox"]
+    assert "a user of its own" in results["sandbox"], results["sandbox"]
     assert results["score"] == 100, json.dumps(results, indent=1)[:3000]
 
 
@@ -99,11 +99,12 @@ echo "SECRET=$GRADING_SECRET"
             with sandbox.Runner(trusted=False) as r:
                 net = r.run([r.input(client), str(server.getsockname()[1])])
                 out = r.run([r.input(spy)])
+                uid = r.box[0]
     finally:
         del os.environ["GRADING_SECRET"]
     assert net.returncode == 3, (net.returncode, net.stderr)
     assert "SPY" not in out.stdout and "leak-me-4713" not in out.stdout, out.stdout
-    left = sandbox.user_processes(sandbox.sandbox_user()[0])
+    left = sandbox.user_processes(uid)
     assert not left, left
 
 
