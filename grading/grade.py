@@ -19,10 +19,10 @@ import sys
 import time
 from typing import Callable
 
-from grading import checks, draws, golden_sums, hidden, report_html, symptoms
+from grading import checks, draws, golden_sums, hidden, references, report_html, symptoms
 from grading.results import Results, Test
 from labkit import gpu, registry, sandbox
-from labkit.harness import ROOT, RunPolicy, available_cores, build, policy
+from labkit.harness import ROOT, RunPolicy, available_cores, policy
 
 LAB01_REFERENCE = ROOT / "lab01-ref"
 LAB04_REFERENCE = ROOT / "lab04-ref"
@@ -246,6 +246,10 @@ def grade(lab: str, binary: pathlib.Path, heatmap_dir: pathlib.Path, *, trusted:
         results.refuse(f"refusing to grade against golden data that is not as recorded: "
                        f"{reason}", regrade=True)
         return results.as_dict()
+    reason = references.problem(lab)
+    if reason:  # no baseline, no golden data for the hidden scene: the machine's fault
+        results.refuse(reason, regrade=True)
+        return results.as_dict()
     on_gpu = gpu.is_gpu_lab(lab)
     # CUDA reserves virtual address space for all of the GPU's memory and the host's (unified
     # addressing), so an address-space limit (RLIMIT_AS) stops every CUDA program at start-up.
@@ -260,17 +264,18 @@ def grade(lab: str, binary: pathlib.Path, heatmap_dir: pathlib.Path, *, trusted:
     start = time.perf_counter()
     with draws.secret(secret), symptoms.grading(lab):
         grade_items(rubric, binary, heatmap_dir, secret, results, run_policy, limits,
-                    budget_seconds, start, progress)
+                    budget_seconds, start, progress, lambda: references.problem(lab))
     results.complete(time.perf_counter() - start)
     return results.as_dict()
 
 
 def grade_items(rubric, binary, heatmap_dir, secret, results, run_policy, limits,
-                budget_seconds, start, progress=None) -> None:
+                budget_seconds, start, progress=None, reference_problem=None) -> None:
     """Each item of the rubric in grading order, results updated after each. A check whose
     requirements failed is not run (untrusted: the grade's time goes to what counts), unless
     the grade is trusted or the check always runs: then it runs and shows what it saw, its
-    points "not counted until" the requirements pass."""
+    points "not counted until" the requirements pass. A check that failed while a reference
+    could not run (`reference_problem()` says why) is marked for regrade, never scored."""
     for item in grading_order(rubric):
         test = results.test(item.id)
         labels = [i.label for i in rubric if i.id in item.requires
@@ -288,6 +293,8 @@ def grade_items(rubric, binary, heatmap_dir, secret, results, run_policy, limits
             t0 = time.perf_counter()
             with policy(dataclasses.replace(run_policy, limits=limits)):
                 result = run_check(item, binary, heatmap_dir, secret)
+            if not result.passed and reference_problem and (why := reference_problem()):
+                result = checks.CheckResult(item.label, False, why, regrade=True)
             credit = result.credit if result.credit is not None else float(result.passed)
             if waiting:  # it ran, and says what it saw; its points wait for the gate
                 mark = "" if result.detail.startswith(("PASS", "FAIL")) else \
@@ -488,6 +495,9 @@ def main(argv=None) -> int:
                    help=f"wall-clock limit of one run (default {RUN_SECONDS:g})")
     p.add_argument("--budget-seconds", type=float, default=BUDGET_SECONDS,
                    help=f"wall-clock budget of the whole grade (default {BUDGET_SECONDS})")
+    p.add_argument("--no-build", action="store_true",
+                   help="run make for nothing: the references are built already (a batch "
+                        "builds them once before its graders start side by side)")
     a = p.parse_args(argv)
     out = pathlib.Path(a.results)
     results = Results(path=out)
@@ -511,11 +521,11 @@ def main(argv=None) -> int:
             print(f"error: {line}", file=sys.stderr)
             results.refuse(line, regrade=True)
             return 2
-        build("lab01-ref")  # the baseline of every speedup, the hidden scene's golden data
-        if registry.lab(a.lab).kind == "mpi":
-            build("lab04-ref")  # measures mpirun's start-up
-        if gpu.is_gpu_lab(a.lab):
-            build(f"lab{a.lab}-ref")  # the baseline of the lab's speed
+        line = None if a.no_build else references.build(a.lab)
+        if line:  # the machine's fault: one line, and a results.json marked for regrade
+            print(f"error: {line}", file=sys.stderr)
+            results.refuse(line, regrade=True)
+            return 2
         if a.binary:
             binary = pathlib.Path(a.binary)
             if not binary.is_file():

@@ -42,7 +42,7 @@ RUN = """#!/usr/bin/env bash
 root="${{AUTOGRADER_ROOT:-/autograder}}"
 cd "$root/source"
 mkdir -p "$root/results"
-python3 -m grading.grade {lab} --sources "$root/submission" \\
+python3 -m grading.grade {lab} --no-build --sources "$root/submission" \\
     --results "$root/results/results.json" --heatmaps "$root/results/heatmaps"
 status=$?
 if [ ! -s "$root/results/results.json" ]; then

@@ -24,7 +24,7 @@ import subprocess
 import sys
 import tempfile
 
-from grading import batch
+from grading import batch, references
 from grading.grade import RUBRICS
 from labkit.harness import ROOT
 
@@ -86,6 +86,10 @@ def main(argv=None) -> int:
     if not a.no_submit and shutil.which("sbatch") is None:
         print("error: grade-slurm: no sbatch here (Slurm's client, Debian's slurm-client); "
               "--no-submit writes the scripts only", file=sys.stderr)
+        return 2
+    line = references.build(a.lab)  # built once: the tasks run with --no-build, side by side
+    if line:
+        print(f"error: grade-slurm: {line}", file=sys.stderr)
         return 2
     batch.batch_secret(out)  # saved before any task starts: all of them read it
     n = count(submissions, out)
