@@ -19,7 +19,7 @@ import sys
 import time
 from typing import Callable
 
-from grading import checks, draws, golden_sums, hidden, references, report_html, symptoms
+from grading import checks, draws, golden_sums, hidden, part_a, references, report_html, symptoms
 from grading.results import Results, Test
 from labkit import gpu, registry, sandbox
 from labkit.harness import ROOT, RunPolicy, available_cores, policy, rerun_as
@@ -42,6 +42,7 @@ class Item:
     # check, whose diagnosis (a race, or the work split) is what a failing speedup needs.
     always_runs: bool = False
     visibility: str = "visible"     # Gradescope's, for its results.json test
+    part: str = ""  # runs on this part's binary (lab 02's "a": ./lab02a), not the lab's
 
     def __post_init__(self):
         if isinstance(self.requires, str):
@@ -164,15 +165,19 @@ RUBRIC_KINDS: dict[str, Callable[[str], list[Item]]] = {
         checked_golden("cornell", 20), checked_golden("showcase", 20), worth(SCALE, 10),
         worth(REPRODUCIBLE, 10),
     ],
+    # Both parts of the handout: Part B (./lab02, the packets) and Part A (./lab02a, lab 01's
+    # renderer on the student's SSE Vec3: lab 01's closed forms and hidden scene on it).
     "simd": lambda lab: [
-        worth(SPHERE_INTERIOR, 10), worth(LIT_PLANE, 10), worth(GLASS_PANE, 10), hidden_scene(),
-        checked_golden("cornell", 15), checked_golden("showcase", 15), worth(SCALE, 10),
+        worth(SPHERE_INTERIOR, 5), worth(LIT_PLANE, 5), worth(GLASS_PANE, 5), hidden_scene(),
+        checked_golden("cornell", 15), checked_golden("showcase", 10), worth(SCALE, 10),
         # The handout's bar is 2.5x on the full baseline; graded here is what holds on a busy
         # two-core machine in a short run, both sides on one CPU (the lesson is SIMD, not
         # threads). Speed counts only for a correct renderer.
         Item("speedup", "speedup >= 1.5x on one core", 30,
              lambda b: checks.check_speedup(b, LAB01_REFERENCE, 1.5, one_core=True),
              requires=GOLDENS),
+        Item("part-a", "Part A: lab 01's checks on ./lab02a", 20,
+             lambda b, secret: part_a.check_part_a(b, secret, LAB01_REFERENCE), part="a"),
     ],
     "openmp": lambda lab: [
         needs(bitwise(30), "parallel-speedup"),
@@ -233,13 +238,15 @@ def grading_order(rubric: list[Item]) -> list[Item]:
 def grade(lab: str, binary: pathlib.Path, heatmap_dir: pathlib.Path, *, trusted: bool = False,
           budget_seconds: float = BUDGET_SECONDS, run_seconds: float = RUN_SECONDS,
           results: Results | None = None, secret: str | None = None,
-          progress: Callable | None = None) -> dict:
+          progress: Callable | None = None,
+          parts: dict[str, pathlib.Path | str] | None = None) -> dict:
     """Grade `binary` on lab `lab`'s rubric; returns results.json's content. `results` (if
     given) is updated after each item, so a caller can write it as it goes. `secret` makes
     the hidden scene (default: $GRADING_SECRET, else a new one for this grade). Trusted (at
     home), every check runs and says what it saw; a requirement decides only whether its
     points count. `progress(item, test)` is called as each check starts (test None) and
-    finishes."""
+    finishes. `parts` holds a part's binary (lab 02's "a": ./lab02a) or why there is none.
+    """
     secret = secret or hidden.secret_from_environment()
     rubric = RUBRICS[lab]
     results = results or Results()
@@ -273,13 +280,14 @@ def grade(lab: str, binary: pathlib.Path, heatmap_dir: pathlib.Path, *, trusted:
     start = time.perf_counter()
     with draws.secret(secret), symptoms.grading(lab), rerun_as(f"./lab{lab}"):
         grade_items(rubric, binary, heatmap_dir, secret, results, run_policy, limits,
-                    budget_seconds, start, progress, lambda: references.problem(lab))
+                    budget_seconds, start, progress, lambda: references.problem(lab), parts)
     results.complete(time.perf_counter() - start)
     return results.as_dict()
 
 
 def grade_items(rubric, binary, heatmap_dir, secret, results, run_policy, limits,
-                budget_seconds, start, progress=None, reference_problem=None) -> None:
+                budget_seconds, start, progress=None, reference_problem=None,
+                parts=None) -> None:
     """Each item of the rubric in grading order, results updated after each. A check whose
     requirements failed is not run (untrusted: the grade's time goes to what counts), unless
     the grade is trusted or the check always runs: then it runs and shows what it saw, its
@@ -291,7 +299,11 @@ def grade_items(rubric, binary, heatmap_dir, secret, results, run_policy, limits
                   and not results.test(i.id).passed]
         waiting = (f"the {' and the '.join(labels)} "
                    f"{'passes' if len(labels) == 1 else 'pass'}") if labels else ""
-        if time.perf_counter() - start > budget_seconds:
+        target = (parts or {}).get(item.part, f"no Part {item.part.upper()} binary was "
+                                              f"given") if item.part else binary
+        if isinstance(target, str):
+            test.finish(0, f"not graded: {target}")
+        elif time.perf_counter() - start > budget_seconds:
             test.finish(0, "not graded: the grading budget of "
                            f"{budget_seconds:g} s was spent on the checks before it")
         elif waiting and not (run_policy.trusted or item.always_runs):
@@ -301,7 +313,7 @@ def grade_items(rubric, binary, heatmap_dir, secret, results, run_policy, limits
                 progress(item, None)
             t0 = time.perf_counter()
             with policy(dataclasses.replace(run_policy, limits=limits)):
-                result = run_check(item, binary, heatmap_dir, secret)
+                result = run_check(item, target, heatmap_dir, secret)
             if not result.passed and reference_problem and (why := reference_problem()):
                 result = checks.CheckResult(item.label, False, why, regrade=True)
             credit = result.credit if result.credit is not None else float(result.passed)
@@ -380,7 +392,7 @@ def gpu_problem(lab: str, run_policy: RunPolicy) -> str | None:
 
 def run_check(item: Item, binary, heatmap_dir, secret: str = "") -> checks.CheckResult:
     kwargs = {"heatmap_dir": heatmap_dir} if item.heatmaps else {}
-    if item.id == "hidden":
+    if item.id in ("hidden", "part-a"):
         kwargs["secret"] = secret
     try:
         return item.run(binary, **kwargs)
@@ -489,6 +501,23 @@ def build_lab(lab: str, sources: pathlib.Path | None = None, trusted: bool = Tru
     return None, first_errors(p.stdout + p.stderr)
 
 
+def part_a_binary(a, results: Results) -> pathlib.Path | str:
+    """Lab 02's Part A binary for this grade (grading/part_a.py), or why there is none."""
+    if a.binary:
+        if a.part_a and pathlib.Path(a.part_a).is_file():
+            return pathlib.Path(a.part_a).resolve()
+        return "no Part A binary was given (--part-a BINARY)"
+    notes: list[str] = []
+    binary, errors = part_a.build(pathlib.Path(a.sources) if a.sources else None, a.trusted,
+                                  notes)
+    results.notes.extend(notes)
+    if binary is None:
+        why = errors.removeprefix("refused: ") if errors.startswith("refused: ") else \
+            f"Part A (part-a/vec3.h) does not compile: {first_errors(errors, 5)}"
+        return why
+    return binary.resolve()
+
+
 def main(argv=None) -> int:
     p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     p.add_argument("lab", choices=sorted(RUBRICS))
@@ -504,6 +533,7 @@ def main(argv=None) -> int:
                    help=f"wall-clock limit of one run (default {RUN_SECONDS:g})")
     p.add_argument("--budget-seconds", type=float, default=BUDGET_SECONDS,
                    help=f"wall-clock budget of the whole grade (default {BUDGET_SECONDS})")
+    p.add_argument("--part-a", help="with --binary: lab 02's Part A binary (./lab02a)")
     p.add_argument("--no-build", action="store_true",
                    help="run make for nothing: the references are built already (a batch "
                         "builds them once before its graders start side by side)")
@@ -558,13 +588,16 @@ def main(argv=None) -> int:
                 results.refuse("the code does not compile", detail=errors)
                 print_table(a.lab, pathlib.Path(f"lab{a.lab}"), results.as_dict())
                 return 1
+        parts = {}
+        if part_a.has_part_a(a.lab):
+            parts["a"] = part_a_binary(a, results)
         heatmaps = pathlib.Path(a.heatmaps)
         clear_report(heatmaps)
         heatmaps.mkdir(parents=True, exist_ok=True)
         print(f"grading lab {a.lab}: {binary}", flush=True)
         grade(a.lab, binary.resolve(), heatmaps, trusted=a.trusted, results=results,
               budget_seconds=a.budget_seconds, run_seconds=a.run_seconds,
-              progress=print_progress)
+              progress=print_progress, parts=parts)
         print_table(a.lab, binary, results.as_dict())
         if not any(heatmaps.iterdir()):
             heatmaps.rmdir()

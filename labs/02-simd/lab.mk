@@ -62,11 +62,13 @@ lab02a: $(patsubst %.cpp,$(BUILD)/vec3-sse/%.o,$(LAB02A_SRC))
 
 LAB_BINARIES += lab02 lab02-ref lab02-ref-avx2 lab02-bench lab02a lab02a-ref lab02-prims
 
-# Variants (make variant): Part B as one AVX2 build; Part A against lab02a-ref's driver
-# objects (the same 16-byte Vec3 layout; only the operators' bodies differ).
+# Variants (make variant): Part B as one AVX2 build; Part A against ./lab02a's driver
+# objects, built with the skeleton's part-a/vec3.h (the same 16-byte Vec3 layout; only the
+# operators' bodies differ), which a students' tree holds too, where the solution's is not.
+# The variant's own objects come first on the link line, so its operators are the ones kept.
 VARIANT_FLAGS_02-simd := -Icommon/simd $(SIMD_AVX2_FLAGS)
 VARIANT_DRIVER_02-simd := $(COMMON_OBJ)
-VARIANT_DRIVER_02-simd-a := $(patsubst %.cpp,$(BUILD)/vec3-sse-ref/%.o,$(LIB_SRC) \
+VARIANT_DRIVER_02-simd-a := $(patsubst %.cpp,$(BUILD)/vec3-sse/%.o,$(LIB_SRC) \
                             common/host/lab_main.cpp common/host/main.cpp)
 
 else
