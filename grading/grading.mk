@@ -39,10 +39,11 @@ cuda-variant-driver: $(COMMON_OBJ)
 .PHONY: test-gradescope
 test-gradescope:
 	PYTHONPATH=$(CURDIR) $(PYTHON) grading/gradescope/test_gradescope.py
-# make grade-slurm LAB=NN SUBMISSIONS=DIR [REPORT=DIR] [PARTITION=P]: the same as a Slurm job
-# array, one task per submission, and a merge job for grades.csv and report.html
-# (grading/slurm.py).
+# make grade-slurm LAB=NN SUBMISSIONS=DIR [REPORT=DIR] [PARTITION=P] [TIME=H:MM:SS] [MEM=4G]:
+# the same as a Slurm job array, one task per submission, and a merge job for grades.csv and
+# report.html (grading/slurm.py, which says its defaults); the tasks run $(PYTHON) by name.
 grade-slurm:
 	@test -n "$(SUBMISSIONS)" || { echo "grade-slurm: needs SUBMISSIONS=DIR" >&2; exit 2; }
 	@$(PYTHON) -m grading.slurm $(LAB) $(SUBMISSIONS) --out $(or $(REPORT),grades) \
-	    $(if $(PARTITION),--partition $(PARTITION))
+	    --python $(PYTHON) $(if $(PARTITION),--partition $(PARTITION)) \
+	    $(if $(TIME),--time $(TIME)) $(if $(MEM),--mem $(MEM))
