@@ -65,7 +65,11 @@ PHONY_EXTRA += lint format
         clean
 .DEFAULT_GOAL := help
 
-help:
+# The staff section only where its targets work: the course repository, not a release (which
+# has no grading/release.py, no solutions to build every lab from).
+help: help-students $(if $(wildcard grading/release.py),help-staff)
+.PHONY: help-students help-staff
+help-students:
 	@echo "For students"
 	@echo "  make labNN        build your code for lab NN (labs/NN-name/skeleton) into ./labNN"
 	@echo "  make labNN-ref    lab NN's reference solution into ./labNN-ref"
@@ -83,7 +87,12 @@ help:
 	@echo "  make tradeoff     speed against accuracy: error vs time of every lab here, bias vs"
 	@echo "                    bounces, fast math, ray offsets (QUICK=1: CI size; PLOTS=0: no plots)"
 	@echo "  make lab05-bench  the lab-05 kernel shapes the handout measures (needs a GPU)"
+	@echo "  make kernel-report registers, spills, stack and shared memory of every CUDA kernel"
+	@echo "                    (needs nvcc, no GPU: your own kernels where the solution is not here)"
+	@echo "  make grade-gpu    no GPU here: grade LAB on the course's GPU machines (Slurm, from"
+	@echo "                    the course's login node); make run-gpu RUN='./lab05 ...' runs one"
 	@echo "                    labs: $(LAB_BINARIES)"
+help-staff:
 	@echo "For course staff"
 	@echo "  make release LAB=NN OUT=DIR  the student repository for lab NN (grading/README.md)"
 	@echo "  make gradescope LAB=NN       the Gradescope autograder zip for lab NN, in build/"
@@ -99,7 +108,6 @@ help:
 	@echo "  make bench-precision  float against double: time and error of lab 01's reference"
 	@echo "  make extremes-report  the extreme scenes in float and double (docs/extremes.md's table)"
 	@echo "  make check-nvcc   compile every header of common/core for the GPU (needs nvcc)"
-	@echo "  make kernel-report registers, spills, stack and shared memory of every CUDA kernel"
 	@echo "  make gpu-check OUT=DIR  on a GPU machine: build, test and benchmark the CUDA labs"
 	@echo "  make tradeoff-gpu OUT=DIR  on a GPU machine: make tradeoff's GPU rows (no plots)"
 	@echo "  make golden       regenerate the golden images in reference/ (minutes)"

@@ -362,7 +362,20 @@ def sandbox_problem(results: Results | None = None) -> str | None:
 
 def no_gpu_line(lab: str, reason: str) -> str:
     return (f"lab {lab} renders on an NVIDIA GPU and {reason}: not graded, marked for regrade "
-            f"on a machine with one")
+            f"on a machine with one (yours: make grade-gpu, through the course's Slurm)")
+
+
+def next_step(results: dict) -> str | None:
+    """At home, what to do about checks marked for regrade: the machine could not measure
+    them, and the score table alone does not say what helps."""
+    marked = [t["name"] for t in results["tests"] if t["extra_data"].get("regrade")]
+    if not marked:
+        return None
+    return (f"marked for regrade: {', '.join(marked)}. At home that means this machine could "
+            f"not measure it (too busy, too few cores, no GPU): close what else runs and run "
+            f"make grade again, on a machine with more cores for labs 03/04 (2 or more, "
+            f"idle) or with a GPU for labs 05-07 (make grade-gpu); the course "
+            f"regrades your hand-in on its own machines, so nothing is lost meanwhile.")
 
 
 def gpu_problem(lab: str, run_policy: RunPolicy) -> str | None:
@@ -599,6 +612,8 @@ def main(argv=None) -> int:
               budget_seconds=a.budget_seconds, run_seconds=a.run_seconds,
               progress=print_progress, parts=parts)
         print_table(a.lab, binary, results.as_dict())
+        if a.trusted and (step := next_step(results.as_dict())):
+            print(step)
         if not any(heatmaps.iterdir()):
             heatmaps.rmdir()
             print(f"wrote {out}")

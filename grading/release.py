@@ -111,6 +111,26 @@ def add_references(stage: pathlib.Path, lab: str, files: list[str]) -> list[str]
     return sorted(built)
 
 
+def no_gpu_section(lab: str) -> str:
+    """What a student of a GPU lab does without an NVIDIA GPU of their own (cuda.mk)."""
+    return f"""
+**No NVIDIA GPU here?** Lab {lab} renders on one, but most of the work does not need it:
+
+```sh
+make lab{lab}                # compiles your code where nvcc is; it runs only on a GPU
+make kernel-report        # your kernels' registers, spills, stack: build/kernel-report.md
+make grade-gpu            # on the course's login node: make grade on a GPU machine (Slurm)
+```
+
+`make grade-gpu` submits one Slurm job (one GPU) from this folder, which must be a checkout
+the GPU machines see (your home on the course's login node, where `sbatch` is), waits for it
+(minutes when the queue is busy) and prints the score table; `results.json` and the images
+land here. `make run-gpu RUN='./lab{lab} --width 128 --height 128 --spp 16 --out quick.ppm'`
+runs any command there the same way (write `$$` for a `$` in RUN). Without a GPU, `make
+grade` itself says so in one line and marks every check for regrade: nothing is scored.
+"""
+
+
 def student_readme(lab: str, folders: dict[str, str], prebuilt: list[str]) -> str:
     """The release's README.md: what students read first (the course's README is staff's)."""
     name = folders[lab]
@@ -143,7 +163,7 @@ make help                 # every command
 
 `make grade` grades lab {lab} (add `LAB=NN` for another); it builds `./lab{lab}` first and
 writes `results.json` and, where an image check fails, `grading-heatmaps/report.html`.
-
+{no_gpu_section(lab) if registry.lab(lab).gpu else ""}
 What else is here:
 - the reference binaries of lab {lab} and later, prebuilt for x86-64 Linux in
   `reference-bin/`, which any `make` copies to the top of this folder (`./lab{lab}-ref`); run

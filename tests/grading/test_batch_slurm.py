@@ -154,3 +154,16 @@ def test_the_scripts_say_what_they_ask_and_call_python_by_name(tmp_path):
         assert command.startswith("python3 -m grading.batch"), command
     default = slurm.scripts("03", tmp_path / "subs", tmp_path / "out", 4, None, None)[0]
     assert f"--time={slurm.DEFAULT_TIME}" in default and f"--mem={slurm.DEFAULT_MEM}" in default
+
+
+def test_run_gpu_runs_a_command_as_a_slurm_job_and_prints_its_log(slurm):
+    """`make run-gpu` (labs 05-07 without a GPU of one's own) on the test's one-node Slurm,
+    which has no GPUs: GPU_GRES= asks for none. The job runs in the checkout and its log is
+    printed when it ends."""
+    p = subprocess.run(["make", "-s", "-C", str(ROOT), "run-gpu", "RUN=pwd",
+                        "GPU_GRES=", "GPU_MEM=100M", "LAB=05"], capture_output=True, text=True,
+                       env=slurm, timeout=300)
+    for log in ROOT.glob("run-gpu-*.log"):
+        log.unlink()
+    assert p.returncode == 0, p.stdout + p.stderr
+    assert str(ROOT) in p.stdout.splitlines() and "ended with status 0" in p.stdout, p.stdout
