@@ -213,6 +213,12 @@ RUBRIC_KINDS: dict[str, Callable[[str], list[Item]]] = {
 }
 RUBRICS = {lab.number: RUBRIC_KINDS[lab.rubric](lab.number) for lab in registry.labs()}
 
+# What a grade takes, said when it starts (measured on a two-core VM: grading/README.md's
+# "Always a result"): the speed checks time the lab against its reference in rounds.
+HOW_LONG = {"serial": "seconds", "simd": "about a minute", "openmp": "one to a few minutes: "
+            "the speedup is timed in rounds", "mpi": "one to a few minutes: the speedup is "
+            "timed in rounds", "gpu": "about a minute", "gpu-soa": "about a minute"}
+
 # One run may take this long (seconds); every test render of a reference takes under 2 s on
 # a busy two-core machine. After a run has timed out, later runs get SHORT_RUN_SECONDS: a
 # program that hangs once is not given the full limit again and again.
@@ -607,7 +613,8 @@ def main(argv=None) -> int:
         heatmaps = pathlib.Path(a.heatmaps)
         clear_report(heatmaps)
         heatmaps.mkdir(parents=True, exist_ok=True)
-        print(f"grading lab {a.lab}: {binary}", flush=True)
+        how_long = HOW_LONG.get(registry.lab(a.lab).rubric, "minutes")
+        print(f"grading lab {a.lab}: {binary} ({how_long})", flush=True)
         grade(a.lab, binary.resolve(), heatmaps, trusted=a.trusted, results=results,
               budget_seconds=a.budget_seconds, run_seconds=a.run_seconds,
               progress=print_progress, parts=parts)

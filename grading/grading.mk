@@ -23,6 +23,8 @@ release:
 	    { echo "release: needs LAB=NN and OUT=DIR" >&2; exit 2; }
 	@test -f grading/release.py || \
 	    { echo "release: made from the course repository; this is a release" >&2; exit 2; }
+	@$(PYTHON) -c 'import numpy' 2>/dev/null || \
+	    { echo "release: $(PYTHON) has no numpy: run make deps first (it installs what the grader needs)" >&2; exit 2; }
 	@$(PYTHON) -m grading.release '$(LAB)' '$(OUT)'
 
 # The driver objects a variant of VARIANT_LAB links, and nothing else: the grader builds them

@@ -26,6 +26,7 @@ import signal
 import subprocess
 import sys
 import textwrap
+import time
 
 from grading import handin, leaks, reference_bins
 from grading.gradescope import repository_files
@@ -98,7 +99,14 @@ def add_references(stage: pathlib.Path, lab: str, files: list[str]) -> list[str]
     a GPU one is left out, saying so, where it cannot."""
     targets = [t for number, names in reference_bins.REFERENCES.items() if number >= lab
                for t in names]
+    fresh = not any(reference_bins.MIRROR.glob("obj-*"))
+    print(f"release: building {len(targets)} reference binaries for any x86-64 CPU in "
+          f"{reference_bins.MIRROR.relative_to(ROOT)}"
+          + (" (the first release compiles every reference and, with nvcc, every GPU "
+             "architecture: minutes; later releases relink)" if fresh else ""), flush=True)
+    start = time.monotonic()
     built, log = reference_bins.build(targets, files, stage / leaks.REFERENCE_BIN)
+    print(f"release: built {len(built)} in {time.monotonic() - start:.0f} s", flush=True)
     missing = [t for t in targets if t not in built]
     gpu = {t for number in reference_bins.GPU_LABS for t in reference_bins.REFERENCES[number]}
     cpu_missing = [t for t in missing if t not in gpu]
