@@ -9,6 +9,7 @@ from labkit.harness import (
     RunError,
     RunPolicy,
     build,
+    cpu_has_avx2,
     failure_message,
     policy,
     rerun_as,
@@ -77,3 +78,21 @@ def test_the_missing_gather_is_rows_never_gathered_not_a_work_split(tmp_path):
     assert not result.passed
     cause = result.detail.split("; ", 1)[1]
     assert "never gathered" in cause and "work split" not in cause, result.detail
+
+
+def test_a_wrong_lane_mask_in_lab02_is_named_before_the_statistics(tmp_path):
+    """Lab 02's rectangle test keeping hits behind the ray (its `crosses` mask dropped): the
+    golden check names the lanes, which lab 01's bits show, before "too noisy", which would
+    point at a loop over paths lab 02 students never write."""
+    if not cpu_has_avx2():
+        pytest.skip("this CPU has no AVX2/FMA: lab 02's Part B cannot run")
+    source = (ROOT / "common/simd/packet_tracer.h").read_text()
+    old = "return select(crosses & inside, t, t_max);"
+    assert old in source
+    mutant = build_variant("02-simd", tmp_path,
+                           {"packet_tracer.h": source.replace(old, "return select(inside, t, "
+                                                                   "t_max);")})
+    with draws.secret("lanes"), symptoms.grading("02"), policy(UNTRUSTED):
+        result = checks.check_golden(mutant, "cornell")
+    assert not result.passed
+    assert result.detail.startswith("lanes: ") and "lane mask" in result.detail, result.detail
