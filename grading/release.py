@@ -162,8 +162,8 @@ exactly these files with this repository's `common/`.
 make deps                 # install what the labs need (compiler libraries, OpenMPI, pytest, numpy)
 {build:<25} # build your code into ./lab{lab}
 {try_it}
-make grade                # the autograder's checks on your code: a score table and results.json
-make test                 # the unit tests of common/ and the public tests
+make grade                # the autograder's checks: a score table, results.json (up to minutes)
+make test                 # the unit tests of common/ and the public tests (minutes)
 make render               # the Cornell box with the fastest reference here, into cornell.ppm
 make handin               # handin-lab{lab}.zip: the files to upload to Gradescope
 make help                 # every command
