@@ -176,7 +176,7 @@ RUBRIC_KINDS: dict[str, Callable[[str], list[Item]]] = {
         Item("speedup", "speedup >= 1.5x on one core", 30,
              lambda b: checks.check_speedup(b, LAB01_REFERENCE, 1.5, one_core=True),
              requires=GOLDENS),
-        Item("part-a", "Part A: lab 01's checks on ./lab02a", 20,
+        Item("part-a", "Part A (./lab02a)", 20,
              lambda b, secret: part_a.check_part_a(b, secret, LAB01_REFERENCE), part="a"),
     ],
     "openmp": lambda lab: [
