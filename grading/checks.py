@@ -34,7 +34,7 @@ import numpy as np
 from grading import draws, hidden, report_html, symptoms
 from labkit import scenes
 from labkit.compare import GRADING_ALPHA, compare
-from labkit.harness import GOLDEN, ROOT, ImageError, golden, run_lab
+from labkit.harness import GOLDEN, ROOT, ImageError, golden, rerun_command, run_lab
 
 # The trusted renderer that makes golden data on the spot (the timed scene drawn for a grade).
 LAB01_REFERENCE = ROOT / "lab01-ref"
@@ -106,8 +106,15 @@ def check_golden(binary, scene: str, *, seed: int | None = None, spp: int = GOLD
         report_html.write_images(heatmap_dir, scene, run.image, g.mean)
     hint = "" if report.passed else symptoms.named(run.image, g.mean)
     cause = "" if report.passed else lanes_not_lab01(binary, launcher=launcher, threads=threads)
+    again = "" if report.passed else "; rerun: " + rerun_command(
+        binary, g.scene, launcher, ["--scene", str(g.scene),
+                                    *(["--threads", str(threads)] if threads else []),
+                                    "--width", str(g.meta["width"]), "--height",
+                                    str(g.meta["height"]), "--spp", str(spp), "--bounces",
+                                    str(g.meta["bounces"]), "--seed", str(seed), *extra,
+                                    "--pfm", "out.pfm"])
     return CheckResult(f"golden image '{scene}'", report.passed,
-                       (f"{cause}; " if cause else "") + report.summary() + hint)
+                       (f"{cause}; " if cause else "") + report.summary() + hint + again)
 
 
 def lanes_not_lab01(binary, **how) -> str:

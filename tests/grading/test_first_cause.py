@@ -92,7 +92,9 @@ def test_a_wrong_lane_mask_in_lab02_is_named_before_the_statistics(tmp_path):
     mutant = build_variant("02-simd", tmp_path,
                            {"packet_tracer.h": source.replace(old, "return select(inside, t, "
                                                                    "t_max);")})
-    with draws.secret("lanes"), symptoms.grading("02"), policy(UNTRUSTED):
+    with draws.secret("lanes"), symptoms.grading("02"), policy(UNTRUSTED), rerun_as("./lab02"):
         result = checks.check_golden(mutant, "cornell")
     assert not result.passed
     assert result.detail.startswith("lanes: ") and "lane mask" in result.detail, result.detail
+    # and the command to see it again at home, on the scene the check rendered
+    assert "rerun: ./lab02 --scene common/scenes/cornell.json " in result.detail, result.detail
