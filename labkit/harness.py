@@ -12,6 +12,7 @@ import dataclasses
 import json
 import os
 import pathlib
+import re
 import subprocess
 import time
 from typing import Callable, Sequence
@@ -285,7 +286,6 @@ def failure_message(failure: str, stderr: str, launcher: Sequence[str], home: st
     """A failed run in the order a student acts on it: the symptom, its cause where it is
     identified (an MPI error by name, a deadlock), the command to rerun it, then the program's
     and mpirun's own last words."""
-    import re
     cause = ""
     error = re.search(r"\bMPI_ERR_[A-Z_]+", stderr)
     call = re.search(r"An error occurred in (MPI_\w+)", stderr)
