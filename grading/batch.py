@@ -40,7 +40,7 @@ import threading
 import time
 import zipfile
 
-from grading import class_page, hidden, shown
+from grading import class_page, hidden, references, shown
 from grading.grade import BUDGET_SECONDS, RUBRICS
 from grading.speed_numbers import speed_numbers
 from labkit import gpu
@@ -572,7 +572,13 @@ def main(argv=None) -> int:
         return 2
     # One secret for the batch, saved for regrades: every student gets the same hidden scene.
     env = {**os.environ, "GRADING_SECRET": batch_secret(a.out)}
-    extra = ["--run-seconds", str(a.run_seconds)] if a.run_seconds else []
+    # Graders run side by side (one per GPU, a Slurm array's tasks): none of them runs make.
+    # The references are built once, here (a Slurm array's by grading/slurm.py, before it
+    # submits), and never rewritten while a grade runs (grading/references.py).
+    extra = ["--no-build", *(["--run-seconds", str(a.run_seconds)] if a.run_seconds else [])]
+    if a.task is None and not a.merge and (line := references.build(a.lab)):
+        print(f"error: {line}", file=sys.stderr)
+        return 2
     submitters = export_submitters(a.submissions)
     # A task's zips are unpacked where every task and the merge see them; a whole batch's
     # in a temporary folder.

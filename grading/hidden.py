@@ -124,7 +124,7 @@ def make_golden(reference, scene_path: pathlib.Path, size: int = SIZE,
 def check_hidden(binary, reference, secret: str, *, launcher=(), threads=None,
                  heatmap_dir: pathlib.Path | None = None):
     """The submission's render of the hidden scene against golden data made just now."""
-    from grading.checks import CheckResult, image_checked
+    from grading.checks import CheckResult, image_checked, lanes_not_lab01
 
     @image_checked("hidden scene")
     def run() -> CheckResult:
@@ -137,7 +137,10 @@ def check_hidden(binary, reference, secret: str, *, launcher=(), threads=None,
         report = compare(image, TEST_SPP, g.mean, g.variance, g.golden_spp, heatmap_path=heatmap,
                          block_sizes=BLOCK_SIZES, pooled_variance=True, alpha=GRADING_ALPHA)
         hint = "" if report.passed else symptoms.named(image, g.mean)
-        return CheckResult("hidden scene", report.passed, report.summary() + hint)
+        cause = "" if report.passed else lanes_not_lab01(binary, launcher=launcher,
+                                                         threads=threads)
+        return CheckResult("hidden scene", report.passed,
+                           (f"{cause}; " if cause else "") + report.summary() + hint)
     return run()
 
 

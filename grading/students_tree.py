@@ -230,6 +230,9 @@ def _tree_files(lab_folder: str) -> dict[str, bytes]:
         if lab.is_dir():
             picked += [f for f in sorted(lab.iterdir()) if f.is_file() and not f.is_symlink()]
     picked += sorted(p for p in (ROOT / "common").rglob("*") if p.is_file())
+    # A skeleton's folders (lab 02's part-a/vec3.h): the driver a part is linked with is
+    # built with them (labs/02-simd/lab.mk).
+    picked += sorted(p for p in (ROOT / "labs").glob("*/skeleton/*/*") if p.is_file())
     as_skeleton = skeleton_form(lab_folder)
     skeletons = _skeletons()
     files = {}
@@ -246,9 +249,12 @@ def _driver_target(variant_target: str) -> str:
     return "cuda-variant-driver" if variant_target == "cuda-variant" else "variant-driver"
 
 
-def cached_tree(lab_folder: str, target: str = "variant") -> pathlib.Path:
-    """The students' tree of `lab_folder` with its driver objects built (once per content and
-    compiler: build/students-trees/<lab>-<digest>/)."""
+def cached_tree(lab_folder: str, target: str = "variant",
+                variant_lab: str | None = None) -> pathlib.Path:
+    """The students' tree of `lab_folder` with the driver objects of `variant_lab` (default:
+    the lab itself; 02-simd-a: lab 02's Part A) built (once per content and compiler:
+    build/students-trees/<variant>-<digest>/)."""
+    variant_lab = variant_lab or lab_folder
     files = _tree_files(lab_folder)
     digest = hashlib.sha256()
     for rel, data in sorted(files.items()):
@@ -256,7 +262,7 @@ def cached_tree(lab_folder: str, target: str = "variant") -> pathlib.Path:
     digest.update(subprocess.run(["c++", "--version"], capture_output=True).stdout)
     digest.update(target.encode())
     cache = ROOT / "build" / "students-trees"
-    tree = cache / f"{lab_folder}-{digest.hexdigest()[:16]}"
+    tree = cache / f"{variant_lab}-{digest.hexdigest()[:16]}"
     if (tree / ".complete").exists():
         return tree
     cache.mkdir(parents=True, exist_ok=True)
@@ -266,10 +272,10 @@ def cached_tree(lab_folder: str, target: str = "variant") -> pathlib.Path:
             (partial / rel).parent.mkdir(parents=True, exist_ok=True)
             (partial / rel).write_bytes(data)
         p = subprocess.run(["make", "-s", "-j2", "-C", str(partial), _driver_target(target),
-                            f"VARIANT_LAB={lab_folder}"], capture_output=True, text=True,
+                            f"VARIANT_LAB={variant_lab}"], capture_output=True, text=True,
                            errors="replace", env={**os.environ, "MAKEFLAGS": ""})
         if p.returncode != 0:
-            raise RuntimeError(f"the students' tree of {lab_folder} does not build its "
+            raise RuntimeError(f"the students' tree of {variant_lab} does not build its "
                                f"driver: {(p.stdout + p.stderr)[-1500:]}")
         # The tree is never built again: its make dependency files would only reach the
         # repository's own make, which includes every *.d under build/.
@@ -286,11 +292,11 @@ def cached_tree(lab_folder: str, target: str = "variant") -> pathlib.Path:
 
 
 def stage(lab_folder: str, handin_files: dict[str, bytes], missing: list[str],
-          target: str = "variant") -> pathlib.Path:
+          target: str = "variant", variant_lab: str | None = None) -> pathlib.Path:
     """A fresh copy of the students' tree (mode 755, outside the repository, so the sandbox
     user reaches it wherever the repository lives) with the submission in `submission/` above
     the stubs of what it lacks. The caller removes the folder."""
-    tree = cached_tree(lab_folder, target)
+    tree = cached_tree(lab_folder, target, variant_lab)
     work = pathlib.Path(tempfile.mkdtemp(prefix="students-tree-"))
     work.chmod(0o755)
     root = work / "tree"
