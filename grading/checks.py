@@ -582,12 +582,15 @@ def one_thread_did_it(shares: list[float]) -> bool:
     return bool(shares) and all(share >= ONE_THREAD for share in shares)
 
 
-def serial_by_thread(shares: list[float], where: str) -> CheckResult:
+def serial_by_thread(shares: list[float], where: str, timed: str = "") -> CheckResult:
+    """The verdict on a program whose one thread did the work; `timed`: what the timed runs
+    measured, where they ran (the class page shows those numbers beside the verdict)."""
     return CheckResult("parallel speedup", False,
                        f"serial: in every timed run one thread did at least {ONE_THREAD:.0%} "
                        f"of the CPU time ({min(shares):.0%} at the least; measured by the "
                        f"grader, thread by thread, {where}); a parallel program shares its work "
-                       f"among its threads", credit=0.0)
+                       f"among its threads" + (f" (timed: {timed})" if timed else ""),
+                       credit=0.0)
 
 
 @image_checked("parallel speedup")
@@ -700,7 +703,8 @@ def _parallel_speedup(binary, baseline, settings: dict, *, threads, launcher, fr
                                f"machine, so not a speedup: refused, no points", credit=0.0)
         if one_thread_did_it(shares):
             return serial_by_thread(shares, f"{max(used):.2f} cores' worth at most, on a "
-                                            f"machine giving {capacity:.2f}")
+                                            f"machine giving {capacity:.2f}",
+                                    f"{timing.describe('yours')}{note}")
         if not parallel() and capacity >= SERIAL_TELLABLE:
             return CheckResult("parallel speedup", False,
                                f"serial: the timed runs used at most {max(used):.2f} cores' "

@@ -266,6 +266,21 @@ def test_the_cause_is_the_failing_gates_verdict_not_a_check_that_passed():
     assert batch.speed_numbers(SERIAL)["capacity"] == "1.97"  # measured: shown beside it
 
 
+def test_a_timed_serial_verdict_shows_its_numbers():
+    """A serial program whose runs were timed: the verdict keeps the times, speedup and
+    capacity measured, and the class page reads them beside it."""
+    from grading import checks
+    from labkit.harness import ParallelTiming
+    timing = ParallelTiming(base=0.6, best={"yours": 0.61}, capacity=1.96, cores=2)
+    verdict = checks.serial_by_thread([0.99, 0.98], "1.01 cores' worth at most, on a machine "
+                                      "giving 1.96", timing.describe("yours"))
+    results = {"tests": [result_test("parallel-speedup", "parallel speedup", 0, 40,
+                                     verdict.detail)]}
+    assert batch.speed_numbers(results) == {"reference_s": "0.600", "yours_s": "0.610",
+                                            "speedup": "0.98", "capacity": "1.96"}
+    assert "serial: in every timed run" in batch.failure_cause(results)
+
+
 def test_the_class_page_names_links_sorts_plots_and_says_a_shared_note_once(tmp_path,
                                                                              monkeypatch):
     monkeypatch.setitem(batch.RUBRICS, "03", [type("I", (), {"label": t["name"]})()
