@@ -159,7 +159,7 @@ def test_a_batch_grades_the_sources_beside_a_binary_without_namespaces(tmp_path)
                         "--out", str(report)], cwd=ROOT, capture_output=True, text=True,
                        timeout=600)
     results = json.loads((report / "ann" / "results.json").read_text())
-    assert p.returncode == 0 and "dedicated user" in results["sandbox"], p.stdout + p.stderr
+    assert p.returncode == 0 and "a user of its own" in results["sandbox"], p.stdout + p.stderr
     assert results["score"] <= 10, json.dumps(results, indent=1)[:3000]
     assert "ignored, graded from its sources" in results["output"], results["output"]
 
