@@ -753,17 +753,25 @@ def test_a_linked_submission_folder_is_its_rows_cause(tmp_path, monkeypatch):
     subs, report = tmp_path / "subs", tmp_path / "report"
     handin(subs / "ann", {"render.cpp": "int x;\n"})
     (subs / "eve").symlink_to(ROOT / "labs" / "01-serial" / "solution")
+    graded = stub_grades(monkeypatch, 100)
+    assert batch.main(["01", str(subs), "--out", str(report)]) == 0
+    rows = {r["student"]: r for r in csv.DictReader((report / "grades.csv").open())}
+    assert graded == ["ann"] and rows["eve"]["score"] == "0", rows
+    assert "symbolic link" in rows["eve"]["cause"], rows["eve"]
+
+
+def stub_grades(monkeypatch, score: int) -> list[str]:
+    """grade-batch's grader replaced by one giving `score` to every hand-in; the names of the
+    folders it was given, in order."""
+    from grading import batch
     graded = []
 
     def grade_one(lab, folder, out, extra, env):
         graded.append(folder.name)
         out.mkdir(parents=True, exist_ok=True)
-        return {"score": 100, "max_score": 100, "output": "", "tests": []}
+        return {"score": score, "max_score": 100, "output": "", "tests": []}
     monkeypatch.setattr(batch, "grade_one", grade_one)
-    assert batch.main(["01", str(subs), "--out", str(report)]) == 0
-    rows = {r["student"]: r for r in csv.DictReader((report / "grades.csv").open())}
-    assert graded == ["ann"] and rows["eve"]["score"] == "0", rows
-    assert "symbolic link" in rows["eve"]["cause"], rows["eve"]
+    return graded
 
 
 @pytest.mark.parametrize("metadata", [
@@ -783,13 +791,7 @@ def test_a_hostile_export_metadata_never_stops_the_class(tmp_path, monkeypatch, 
         handin(subs / name, {"render.cpp": "int x;\n"})
     (subs / "submission_metadata.yml").write_text(
         "submission_2:\n  :submitters:\n  - :name: Ada Lovelace\n" + metadata)
-    graded = []
-
-    def grade_one(lab, folder, out, extra, env):
-        graded.append(folder.name)
-        out.mkdir(parents=True, exist_ok=True)
-        return {"score": 50, "max_score": 100, "output": "", "tests": []}
-    monkeypatch.setattr(batch, "grade_one", grade_one)
+    graded = stub_grades(monkeypatch, 50)
     assert batch.main(["01", str(subs), "--out", str(report)]) == 0
     assert graded == ["submission_1", "submission_2"], capsys.readouterr()
     rows = list(csv.DictReader((report / "grades.csv").open()))
