@@ -546,8 +546,11 @@ class TreeClock:
     It also keeps each thread's own CPU time (/proc/PID/task/TID/stat; the last value seen of
     a thread that has ended), so that `busiest_thread_share` says how much of the work one
     thread did, whatever the load: a serial program does all of it on one thread, a parallel
-    one shares it. Both sides of that fraction are of the same sample (the latest), so the
-    last interval before the exit, which no sample sees, is missing from both.
+    one shares it. The fraction's denominator is the most work seen: the largest tree total,
+    or the sum of every thread's own time where that is larger (a child that has exited but
+    is not yet reaped can drop out of one sample's tree total, which alone would make its
+    sibling's share look whole). The last interval before the exit, which no sample sees, is
+    missing from both sides.
 
     With `nice` (the grader is root) each sample also raises the tree's new sessions and
     threads to that priority (RUN_NICE says why)."""
@@ -591,8 +594,9 @@ class TreeClock:
         for pid in tree:
             if pid in times:
                 self._sample_threads(pid, sessions[pid])
-        if ticks > 0:
-            self.busiest_thread_share = min(1.0, max(self._threads.values(), default=0) / ticks)
+        work = max(self.seconds * _CLOCK_TICKS, sum(self._threads.values()))
+        if work > 0:
+            self.busiest_thread_share = min(1.0, max(self._threads.values(), default=0) / work)
 
     def _sample_threads(self, pid: int, session: int) -> None:
         if self.nice is not None and session not in self._sessions:
