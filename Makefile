@@ -154,10 +154,12 @@ $(BUILD)/labs.mk: labs/labs.toml labkit/registry.py
 	@mv $@.partial $@
 include $(BUILD)/labs.mk
 
-# Each registered lab's own rules (its binaries, extra flags) live in labs/NN-name/lab.mk;
-# each adds its binaries to LAB_BINARIES.
+# Each registered lab's own rules (how its binaries are built, extra flags) live in
+# labs/NN-name/lab.mk; which binaries a lab has is the registry's (LAB_TARGETS_NN). A lab.mk
+# whose tools are missing here (nvcc, OpenMPI, an x86-64 compiler) gives its targets a rule
+# that says so and adds them to UNBUILDABLE, which `make labs` leaves out.
 # cuda.mk (nvcc, the cuda_lab rule) comes first: the CUDA labs' lab.mk files use it.
-LAB_BINARIES :=
+UNBUILDABLE :=
 include cuda.mk
 include $(foreach n,$(LABS),labs/$(LAB_FOLDER_$(n))/lab.mk)
 include grading/grading.mk
@@ -168,7 +170,6 @@ $(DOUBLE_BUILD)/labs/01-serial/solution/%.o: LAB_INCLUDES = -Ilabs/01-serial/sol
 lab01-ref-double: $(patsubst %.cpp,$(DOUBLE_BUILD)/%.o,$(wildcard labs/01-serial/solution/*.cpp)) \
                   $(DOUBLE_COMMON_OBJ)
 	$(CXX) $(CXXFLAGS) $^ $(INTO_TARGET)
-LAB_BINARIES += lab01-ref-double
 
 # A reference renders in double what float cannot place (common/host/double_twin.h): it links
 # build/twins/X.o, which carries the double binary X as data. Each lab's lab.mk names its
@@ -178,6 +179,7 @@ $(BUILD)/twins/%.o: % common/host/double_twin.S
 	$(CXX) -c -x assembler-with-cpp -DTWIN_PATH='"$<"' common/host/double_twin.S -o $@
 lab01-ref: $(BUILD)/twins/lab01-ref-double.o
 
+LAB_BINARIES := $(filter-out $(UNBUILDABLE),$(REGISTERED_TARGETS))
 labs: $(LAB_BINARIES)
 
 # ---- tests ------------------------------------------------------------------------------
@@ -360,6 +362,6 @@ variant: $(VARIANT_DRIVER_$(VARIANT_LAB))
 	    $(VARIANT_DRIVER_$(VARIANT_LAB)) -o '$(VARIANT)/lab' $(VARIANT_LIBS_$(VARIANT_LAB))
 
 clean:
-	rm -rf $(BUILD) $(LAB_BINARIES) .pytest_cache
+	rm -rf $(BUILD) $(REGISTERED_TARGETS) .pytest_cache
 
 -include $(shell find $(BUILD) -name '*.d' 2>/dev/null)

@@ -3,7 +3,7 @@
 #
 #   make cuda-variant VARIANT_LAB=<lab folder> VARIANT=DIR   a CUDA lab from a folder of sources
 #   make kernel-report           registers, spills, stack and shared memory of every kernel
-#   make check-gpu-headers       every header of common/cuda and common/wavefront compiles alone
+#   make check-gpu-headers       every header of common/cuda, common/wavefront and bench/gpu compiles alone
 #   make check-speed-targets     the benchmarks' speed-target verdicts, on the host (no GPU needed)
 #   make gpu-check OUT=DIR       on a GPU machine: build, test, benchmark, report (tools/gpu/check.sh)
 #   make grade-gpu [LAB=NN]      without a GPU: grade on the course's GPU machines through Slurm
@@ -44,6 +44,9 @@ NVCCFLAGS := -std=c++17 -O3 --threads 0 $(CUDA_WARN)
 
 # After a lab's own folders (LAB_INCLUDES), before common/core and common/host.
 CUDA_INCLUDES := -Icommon/cuda
+# The GPU benchmarks' own code (their main, speed targets, the wavefront benchmark): on the
+# include path of the benchmarks only, never of a lab.
+GPU_BENCH_INCLUDES := -Ibench/gpu
 
 $(BUILD)/%.o: %.cu
 	@mkdir -p $(dir $@)
@@ -65,10 +68,21 @@ CUDA_STUDENT_FILES_$(2) := $(4)
 $(BUILD)/labs/$(2)/skeleton/%.o: LAB_INCLUDES = -Ilabs/$(2)/skeleton $(addprefix -I,$(3))
 $(BUILD)/labs/$(2)/solution/%.o: LAB_INCLUDES = -Ilabs/$(2)/solution $(addprefix -I,$(3))
 $(1): $(patsubst %.cu,$(BUILD)/%.o,$(wildcard labs/$(2)/skeleton/*.cu)) $(COMMON_OBJ)
-	$(NVCC) $(CUDA_ARCH) $$^ -o $$@
+	$(NVCC) $(CUDA_ARCH) $$^ $$(INTO_TARGET)
 $(1)-ref: $(patsubst %.cu,$(BUILD)/%.o,$(wildcard labs/$(2)/solution/*.cu)) $(COMMON_OBJ)
-	$(NVCC) $(CUDA_ARCH) $$^ -o $$@
+	$(NVCC) $(CUDA_ARCH) $$^ $$(INTO_TARGET)
 endef
+
+# Without nvcc, each GPU lab's targets (the registry's) say so in one line and fail; the
+# labs' lab.mk files build them only where nvcc is.
+ifeq ($(HAVE_NVCC),)
+GPU_LAB_TARGETS := $(foreach n,$(GPU_LABS),$(LAB_TARGETS_$(n)))
+.PHONY: $(GPU_LAB_TARGETS)
+$(GPU_LAB_TARGETS):
+	@echo "$@: needs the CUDA toolkit ($(NVCC) not found)" >&2
+	@exit 1
+UNBUILDABLE += $(GPU_LAB_TARGETS)
+endif
 
 .PHONY: kernel-report gpu-check print-cuda-build-command cuda-variant check-gpu-headers \
         check-speed-targets
@@ -95,20 +109,22 @@ cuda-variant: $(COMMON_OBJ)
 
 # Each shared GPU header compiles alone, for sm_90 with warnings as errors: it includes what
 # it uses, whichever file includes it first (make check-nvcc does the same for common/core).
-GPU_HEADERS := $(wildcard common/cuda/*.h common/cuda/*.cuh common/wavefront/*.cuh)
-$(BUILD)/gpu-headers/%.o: common/%
+GPU_HEADERS := $(wildcard common/cuda/*.h common/cuda/*.cuh common/wavefront/*.cuh \
+                          bench/gpu/*.h bench/gpu/*.cuh)
+$(BUILD)/gpu-headers/%.o: %
 	@mkdir -p $(dir $@)
 	@printf '#include <%s>\n' $(notdir $<) > $(@:.o=.cu)
 	$(NVCC) -std=c++17 -arch=sm_90 -Xcompiler -Wall,-Werror -Werror all-warnings -Icommon/wavefront \
-	    $(CUDA_INCLUDES) $(INCLUDES) -MMD -MP -MF $(@:.o=.d) -MT $@ -c $(@:.o=.cu) -o $@
-check-gpu-headers: $(patsubst common/%,$(BUILD)/gpu-headers/%.o,$(GPU_HEADERS))
-	@echo "check-gpu-headers: $(words $(GPU_HEADERS)) headers of common/cuda and common/wavefront compile alone for sm_90"
+	    $(GPU_BENCH_INCLUDES) $(CUDA_INCLUDES) $(INCLUDES) -MMD -MP -MF $(@:.o=.d) -MT $@ \
+	    -c $(@:.o=.cu) -o $@
+check-gpu-headers: $(patsubst %,$(BUILD)/gpu-headers/%.o,$(GPU_HEADERS))
+	@echo "check-gpu-headers: $(words $(GPU_HEADERS)) headers of common/cuda, common/wavefront and bench/gpu compile alone for sm_90"
 
 # Host code only: the verdicts the benchmarks print (tests/cuda/speed_targets_check.cu).
 $(BUILD)/cuda/speed_targets_check: tests/cuda/speed_targets_check.cu
 	@mkdir -p $(dir $@)
-	$(NVCC) -std=c++17 -arch=sm_90 -Xcompiler -Wall,-Werror -Werror all-warnings $(CUDA_INCLUDES) \
-	    $(INCLUDES) -MMD -MP -MF $@.d $< -o $@
+	$(NVCC) -std=c++17 -arch=sm_90 -Xcompiler -Wall,-Werror -Werror all-warnings \
+	    $(GPU_BENCH_INCLUDES) $(CUDA_INCLUDES) $(INCLUDES) -MMD -MP -MF $@.d $< -o $@
 check-speed-targets: $(BUILD)/cuda/speed_targets_check
 	@$<
 
@@ -122,7 +138,7 @@ KERNEL_REPORT_NVCC = $(NVCC) -std=c++17 -O3 -arch=$(KERNEL_REPORT_ARCH) -Xptxas 
 # student's own kernels, compiled without a GPU.
 kernel_report_dir = $(if $(wildcard labs/$(1)/solution),solution,skeleton)
 kernel_report_compile = $(KERNEL_REPORT_NVCC) -Ilabs/$(1)/$(call kernel_report_dir,$(1)) \
-    $(CUDA_SHARED_INCLUDES_$(1)) $(CUDA_INCLUDES) $(INCLUDES) -c labs/$(1)/$(2) \
+    $(CUDA_SHARED_INCLUDES_$(1)) $(GPU_BENCH_INCLUDES) $(CUDA_INCLUDES) $(INCLUDES) -c labs/$(1)/$(2) \
     -o $(BUILD)/kernel-report/$(3).o
 kernel-report:
 	@mkdir -p $(BUILD)/kernel-report

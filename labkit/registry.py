@@ -237,7 +237,8 @@ def make_fragment() -> str:
                   f"LAB_KIND_{n} := {entry.kind}",
                   f"LAB_STUDENT_{n} := {' '.join(entry.student)}",
                   f"LAB_REFERENCE_{n} := {' '.join(entry.reference)}",
-                  f"LAB_EXTRAS_{n} := {' '.join(entry.extras)}"]
+                  f"LAB_EXTRAS_{n} := {' '.join(entry.extras)}",
+                  f"LAB_TARGETS_{n} := {' '.join(entry.targets)}"]
     return "".join(f"{line.rstrip()}\n" for line in lines)
 
 

@@ -3,7 +3,7 @@
 // estimator with lab 01's random numbers. The threads of one pixel split its samples between
 // them and add their partial sums in a fixed order, so the image is reproducible bit for bit.
 //!
-//! Lab 05's reference kernel; the wavefront benchmark (common/wavefront/wavefront_bench.cuh)
+//! Lab 05's reference kernel; the wavefront benchmark (bench/gpu/wavefront_bench.cuh)
 //! measures the wavefront labs against it.
 //! Lab 05 students write the regions between BEGIN/END SOLUTION; labkit/skeletons.py turns
 //! this file into labs/05-cuda-mega/skeleton/megakernel.cuh, which stands in for it in the

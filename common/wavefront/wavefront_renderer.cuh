@@ -49,20 +49,25 @@ struct WavefrontStats {
     size_t bytes_per_path = 0;  // the pool (its queues and radiance), device memory per slot
 };
 
-// Paths per wave unless memory or RT_LAB06_WAVE_PATHS says fewer: 2^21 (2M) paths, about
-// 0.34 GB of pool. Measured with lab06-bench's wave-size rows on an H200
-// (handouts/06-cuda-split.md).
+// Paths per wave unless memory or the caller says fewer: 2^21 (2M) paths, about 0.34 GB of
+// pool. Measured with lab06-bench's wave-size rows on an H200 (handouts/06-cuda-split.md).
 constexpr long long kDefaultWavePaths = 1 << 21;
 
-inline long long max_wave_paths(size_t bytes_per_path) {
+// The most paths of a wave: `wanted` (at least 1), and no more than half the GPU's free
+// memory holds.
+inline long long max_wave_paths(size_t bytes_per_path, long long wanted) {
     size_t free_bytes = 0, total_bytes = 0;
     check(cudaMemGetInfo(&free_bytes, &total_bytes), "reading the GPU's free memory");
-    long long paths = std::min<long long>(kDefaultWavePaths,
-                                          static_cast<long long>(free_bytes / 2 / bytes_per_path));
-    if (const char* limit = std::getenv("RT_LAB06_WAVE_PATHS")) {
-        paths = std::min<long long>(paths, std::max(1LL, std::atoll(limit)));
-    }
-    return paths;
+    return std::min<long long>(std::max(1LL, wanted),
+                               static_cast<long long>(free_bytes / 2 / bytes_per_path));
+}
+
+// What a wavefront lab's user may ask for: RT_LAB06_WAVE_PATHS lowers the wave size (the
+// tests render small images in many waves so); read once, where the lab starts its render.
+inline long long wave_paths_from_environment() {
+    const char* limit = std::getenv("RT_LAB06_WAVE_PATHS");
+    return limit ? std::min<long long>(kDefaultWavePaths, std::max(1LL, std::atoll(limit)))
+                 : kDefaultWavePaths;
 }
 
 // The rows of a band and the samples of a wave: a band is as many whole rows as one wave's
@@ -247,17 +252,19 @@ std::array<unsigned, kStageCount> prepare_stages(const cudaDeviceProp& prop, siz
     return grid;
 }
 
-// Renders the job with the kernels of Config C. Returns the GPU seconds of all stages.
+// Renders the job with the kernels of Config C, at most wave_paths paths a wave. Returns the
+// GPU seconds of all stages.
 template <class C>
 double render_waves(const RenderJob& job, const cudaDeviceProp& prop, const SceneLayout& layout,
-                    const float4* scene_pool, Image& image, WavefrontStats* stats) {
+                    const float4* scene_pool, long long wave_paths, Image& image,
+                    WavefrontStats* stats) {
     using Pool = typename C::Pool;
     const RenderSettings& settings = job.settings;
     const size_t shared_bytes = C::kSceneMemory == SceneMemory::Shared ? layout.bytes() : 0;
     const std::array<unsigned, kStageCount> grid = prepare_stages<C>(prop, shared_bytes, stats);
 
     const size_t bytes_per_path = Pool::bytes_for(1024) / 1024;
-    const WavePlan plan = plan_waves(settings, max_wave_paths(bytes_per_path));
+    const WavePlan plan = plan_waves(settings, max_wave_paths(bytes_per_path, wave_paths));
     const int band_pixels = plan.band_rows * settings.width;
     const int slots = band_pixels * plan.samples_per_wave;
     if (stats) stats->bytes_per_path = bytes_per_path;
@@ -312,12 +319,13 @@ RenderStats render_wavefront(const RenderJob& job, Image& image, WavefrontStats*
     const bool shared = choose_scene_memory(layout) == SceneMemory::Shared;
     const bool specular = has_specular_material(job.scene.materials, job.scene.num_materials);
     const bool box = geometry_kinds(job.scene).fits<BoxGeometry>();
+    const long long wave_paths = wave_paths_from_environment();
     using S = std::integral_constant<SceneMemory, SceneMemory::Shared>;
     using G = std::integral_constant<SceneMemory, SceneMemory::Global>;
     const auto render = [&](auto memory, auto materials, auto primitives) {
         using C = WavefrontConfig<Layout, decltype(memory)::value, Reserve::kPerBlock,
                                   decltype(materials), 1, false, true, decltype(primitives)>;
-        return render_waves<C>(job, prop, layout, scene_pool.data(), image, stats);
+        return render_waves<C>(job, prop, layout, scene_pool.data(), wave_paths, image, stats);
     };
     const auto in = [&](auto memory, auto materials) {
         return box ? render(memory, materials, BoxGeometry{})

@@ -36,9 +36,6 @@ VARIANT_FLAGS_03-openmp := -fopenmp
 VARIANT_DRIVER_03-openmp := $(COMMON_OBJ)
 VARIANT_LIBS_03-openmp := -fopenmp
 
-LAB_BINARIES += lab03 lab03-ref lab03-bench lab03-shared-rng lab03-shared-rng-race \
-                lab03-row-costs
-
 # The SIMD variant: solution/render.cpp with common/simd/ first on the include path (its
 # pixel_renderer.h renders with lab 02's packets at the CPU's width) and -DRT_USE_SIMD (which
 # renames its render() to render_avx2), entered through simd_entry.cpp (built without SIMD
@@ -50,12 +47,12 @@ $(LAB03_BUILD)/simd/render.o: $(LAB03)/solution/render.cpp
 $(LAB03_BUILD)/simd_entry.o: LAB_INCLUDES = -Icommon/simd
 lab03-simd-ref: $(LAB03_BUILD)/simd/render.o $(LAB03_BUILD)/simd_entry.o $(COMMON_OBJ) $(SIMD_OBJ)
 	$(CXX) $(CXXFLAGS) $^ -fopenmp $(INTO_TARGET)
-LAB_BINARIES += lab03-simd-ref
 else
 lab03-simd-ref:
 	@echo "lab03-simd-ref: needs an x86-64 CPU and compiler (AVX2)" >&2
 	@exit 1
 .PHONY: lab03-simd-ref
+UNBUILDABLE += lab03-simd-ref
 endif
 
 # The reference in double (OpenMP over lab 01's scalar renderer), which lab03-ref and
@@ -66,4 +63,3 @@ lab03-ref-double: $(patsubst %.cpp,$(DOUBLE_BUILD)/%.o,$(wildcard $(LAB03)/solut
                   $(DOUBLE_COMMON_OBJ)
 	$(CXX) $(CXXFLAGS) $^ -fopenmp $(INTO_TARGET)
 lab03-ref lab03-simd-ref: $(BUILD)/twins/lab03-ref-double.o
-LAB_BINARIES += lab03-ref-double

@@ -7,16 +7,7 @@
 #   make lab05-ref-double        the reference in double precision (common/core/real.h)
 LAB05 := labs/05-cuda-mega
 LAB05_BUILD := $(BUILD)/$(LAB05)
-LAB05_TARGETS := lab05 lab05-ref lab05-bench lab05-bench-fast-math lab05-ref-fast-math \
-                 lab05-ref-no-fma lab05-ref-double
-# Real files, not phony: a test that asks make for a binary that is up to date must not get it
-# relinked under another test that is running it ("Text file busy").
-ifeq ($(HAVE_NVCC),)
-.PHONY: $(LAB05_TARGETS)
-$(LAB05_TARGETS):
-	@echo "$@: needs the CUDA toolkit ($(NVCC) not found)" >&2
-	@exit 1
-else
+ifneq ($(HAVE_NVCC),)
 $(eval $(call cuda_lab,lab05,05-cuda-mega,,megakernel.cuh))
 
 # Variants of the reference and the benchmark: the same source under other flags, objects in
@@ -24,29 +15,28 @@ $(eval $(call cuda_lab,lab05,05-cuda-mega,,megakernel.cuh))
 define lab05_variant_object
 $(LAB05_BUILD)/$(1)/$(basename $(notdir $(2))).o: $(2)
 	@mkdir -p $$(dir $$@)
-	$$(NVCC) $$(NVCCFLAGS) $$(CUDA_ARCH) $(3) -I$(LAB05)/solution $$(CUDA_INCLUDES) \
-	    $$(INCLUDES) -MMD -MP -MF $$(@:.o=.d) -c $$< -o $$@
+	$$(NVCC) $$(NVCCFLAGS) $$(CUDA_ARCH) $(3) -I$(LAB05)/solution $$(GPU_BENCH_INCLUDES) \
+	    $$(CUDA_INCLUDES) $$(INCLUDES) -MMD -MP -MF $$(@:.o=.d) -c $$< -o $$@
 endef
 $(eval $(call lab05_variant_object,fast-math,$(LAB05)/solution/render.cu,--use_fast_math))
 $(eval $(call lab05_variant_object,no-fma,$(LAB05)/solution/render.cu,--fmad=false))
 $(eval $(call lab05_variant_object,double,$(LAB05)/solution/render.cu,-DRT_DOUBLE))
 $(eval $(call lab05_variant_object,fast-math,$(LAB05)/bench.cu,--use_fast_math))
 lab05-ref-fast-math: $(LAB05_BUILD)/fast-math/render.o $(COMMON_OBJ)
-	$(NVCC) $(CUDA_ARCH) $^ -o $@
+	$(NVCC) $(CUDA_ARCH) $^ $(INTO_TARGET)
 lab05-ref-no-fma: $(LAB05_BUILD)/no-fma/render.o $(COMMON_OBJ)
-	$(NVCC) $(CUDA_ARCH) $^ -o $@
+	$(NVCC) $(CUDA_ARCH) $^ $(INTO_TARGET)
 # The reference in double: linked with the double build's host objects (Makefile).
 lab05-ref-double: $(LAB05_BUILD)/double/render.o $(DOUBLE_COMMON_OBJ)
-	$(NVCC) $(CUDA_ARCH) $^ -o $@
+	$(NVCC) $(CUDA_ARCH) $^ $(INTO_TARGET)
 # lab05-ref carries it and hands it a scene float cannot place (common/host/double_twin.h).
 lab05-ref: $(BUILD)/twins/lab05-ref-double.o
 
 # The benchmark has its own main; it links the library part of common/host only. It runs the
 # reference kernel (common/cuda/megakernel.cuh) in every shape it measures.
+$(LAB05_BUILD)/bench.o: LAB_INCLUDES = $(GPU_BENCH_INCLUDES)
 lab05-bench: $(LAB05_BUILD)/bench.o $(LIB_OBJ)
-	$(NVCC) $(CUDA_ARCH) $^ -o $@
+	$(NVCC) $(CUDA_ARCH) $^ $(INTO_TARGET)
 lab05-bench-fast-math: $(LAB05_BUILD)/fast-math/bench.o $(LIB_OBJ)
-	$(NVCC) $(CUDA_ARCH) $^ -o $@
+	$(NVCC) $(CUDA_ARCH) $^ $(INTO_TARGET)
 endif
-
-LAB_BINARIES += $(LAB05_TARGETS)

@@ -1,4 +1,4 @@
-// lab06-bench: the wavefront benchmark (common/wavefront/wavefront_bench.cuh) on lab 06's
+// lab06-bench: the wavefront benchmark (bench/gpu/wavefront_bench.cuh) on lab 06's
 // path pool, the array of structures, next to lab 05's reference megakernel.
 #include <bench_main.h>
 #include <path_pool_aos.cuh>

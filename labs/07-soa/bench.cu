@@ -1,4 +1,4 @@
-// lab07-bench: the wavefront benchmark (common/wavefront/wavefront_bench.cuh) on both path
+// lab07-bench: the wavefront benchmark (bench/gpu/wavefront_bench.cuh) on both path
 // pools, lab 06's array of structures and lab 07's structure of arrays, in the same run on
 // the same scene, next to lab 05's reference megakernel.
 #include <bench_main.h>

@@ -4,20 +4,10 @@
 # common/wavefront/ (lab 06's kernels, queue and stage loop, in their reference form); only
 # the pool's layout is its own: skeleton/path_pool_soa.cuh stands in for the shared one.
 LAB07 := labs/07-soa
-LAB07_TARGETS := lab07 lab07-ref lab07-bench
-# Real files, not phony: a test that asks make for a binary that is up to date must not get it
-# relinked under another test that is running it ("Text file busy").
-ifeq ($(HAVE_NVCC),)
-.PHONY: $(LAB07_TARGETS)
-$(LAB07_TARGETS):
-	@echo "$@: needs the CUDA toolkit ($(NVCC) not found)" >&2
-	@exit 1
-else
+ifneq ($(HAVE_NVCC),)
 $(eval $(call cuda_lab,lab07,07-soa,common/wavefront,path_pool_soa.cuh))
 
-$(BUILD)/$(LAB07)/bench.o: LAB_INCLUDES = -Icommon/wavefront
+$(BUILD)/$(LAB07)/bench.o: LAB_INCLUDES = $(GPU_BENCH_INCLUDES) -Icommon/wavefront
 lab07-bench: $(BUILD)/$(LAB07)/bench.o $(LIB_OBJ)
-	$(NVCC) $(CUDA_ARCH) $^ -o $@
+	$(NVCC) $(CUDA_ARCH) $^ $(INTO_TARGET)
 endif
-
-LAB_BINARIES += $(LAB07_TARGETS)

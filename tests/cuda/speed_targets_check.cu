@@ -1,4 +1,4 @@
-// The benchmarks' speed-target verdicts (common/cuda/speed_targets.h), host code only: no
+// The benchmarks' speed-target verdicts (bench/gpu/speed_targets.h), host code only: no
 // GPU needed. Exits 0 when every case holds, else prints the first that does not and exits 1.
 // Built and run by tests/labs/test_lab05.py.
 #include <cstdio>

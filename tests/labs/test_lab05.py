@@ -24,7 +24,7 @@ from labkit.harness import ROOT, build, golden, run_lab
 LAB = "05-cuda-mega"
 # The H200 tests' bars: loose guards, at least 15% above what the reference measures on an
 # H200 (reference/gpu/h200/summary.md), so that a slower clock of the same GPU fails nothing
-# that works. The speed targets themselves (common/cuda/speed_targets.h: 13 ms for the
+# that works. The speed targets themselves (bench/gpu/speed_targets.h: 13 ms for the
 # reference on the baseline, 18 ms with RT_LAB05_GEOMETRY=general) are judged by lab05-bench.
 H200_BAR_MS = 26.0
 H200_GENERAL_BAR_MS = 37.0
@@ -65,18 +65,17 @@ def test_architectures(nvcc):
 
 
 def test_shared_gpu_headers_compile_alone(nvcc):
-    """Every header of common/cuda and common/wavefront compiles on its own (it includes what it
-    uses), for sm_90 with warnings as errors."""
+    """Every header of common/cuda, common/wavefront and bench/gpu compiles on its own (it
+    includes what it uses), for sm_90 with warnings as errors."""
     p = make("-j2", "check-gpu-headers")
     assert p.returncode == 0, p.stdout + p.stderr
-    headers = sorted((ROOT / "common" / "cuda").glob("*.*h")) + sorted(
-        (ROOT / "common" / "wavefront").glob("*.cuh")
-    )
+    headers = [h for folder in ("common/cuda", "common/wavefront", "bench/gpu")
+               for h in (ROOT / folder).glob("*.*h")]
     assert f"check-gpu-headers: {len(headers)} headers" in p.stdout, p.stdout
 
 
 def test_speed_target_verdicts(nvcc):
-    """What the benchmarks say of their speed targets (common/cuda/speed_targets.h): judged
+    """What the benchmarks say of their speed targets (bench/gpu/speed_targets.h): judged
     only for the baseline on the GPU the bars are set on; met, missed, not judged, not run
     (tests/cuda/speed_targets_check.cu holds the cases)."""
     p = make("check-speed-targets")
@@ -399,7 +398,7 @@ def test_students_build_runs(gpu, lab05):
 def test_h200_bar(lab05_ref):
     """On an H200, the baseline's kernel stays under H200_BAR_MS (best of 3): a loose guard
     against a slow reference, which a slower H200 still passes. The lab's real bar is a speed
-    target, printed by lab05-bench (common/cuda/speed_targets.h)."""
+    target, printed by lab05-bench (bench/gpu/speed_targets.h)."""
     from test_lab06 import best_seconds, on_h200
     on_h200()
     seconds = best_seconds(lab05_ref)

@@ -97,3 +97,21 @@ def test_the_ncu_rows_name_the_shapes_the_handout_quotes():
     shapes = rec.read()["ncu"]
     assert {"reference", "plain", "showcase", "reference, 1 bounce"} <= set(shapes)
     assert 1 <= shapes["reference"]["active"] <= 32
+
+
+def absolute_paths(value) -> list[str]:
+    """Every string in a JSON value that names a path from the root of a file system."""
+    if isinstance(value, dict):
+        return [p for v in value.values() for p in absolute_paths(v)]
+    if isinstance(value, list):
+        return [p for v in value for p in absolute_paths(v)]
+    return [value] if isinstance(value, str) and value.startswith("/") else []
+
+
+def test_the_record_names_no_machines_paths():
+    """A record is read on other machines: it names a scene as the repository does."""
+    import json
+    found = {path.name: absolute_paths(json.loads(path.read_text()))
+             for path in sorted(rec.RECORD.glob("*.json"))}
+    assert found and all(paths == [] for paths in found.values()), found
+    assert absolute_paths({"scene": ["/work/scene.json"]}) == ["/work/scene.json"]

@@ -40,7 +40,6 @@ try = "./lab{LAB} --width 128 --height 128 --spp 16 --out quick.ppm"
 """
 LAB_MK = f"""# Lab {LAB}: a throwaway copy of lab 01: ./lab{LAB} (skeleton) and ./lab{LAB}-ref.
 $(eval $(call cpu_lab,lab{LAB},{FOLDER},))
-LAB_BINARIES += lab{LAB} lab{LAB}-ref
 VARIANT_DRIVER_{FOLDER} := $(COMMON_OBJ)
 """
 GIT_ENV = {"GIT_AUTHOR_NAME": "t", "GIT_AUTHOR_EMAIL": "t@t.invalid",

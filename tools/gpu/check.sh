@@ -7,7 +7,7 @@
 #   3. the compiler's resource report (make kernel-report) and the scene loads in the SASS;
 #   4. the GPU tests (pytest), for real;
 #   5. the benchmarks on the baseline, CUDA events, best and median of 5 after a warm-up, each
-#      with its lab's speed targets (common/cuda/speed_targets.h) judged: every kernel shape
+#      with its lab's speed targets (bench/gpu/speed_targets.h) judged: every kernel shape
 #      of lab05-bench (DIR/bench.json), lab06-bench (bench-lab06.json) and lab07-bench
 #      (bench-lab07.json); process time against kernel time;
 #   6. accuracy of --use_fast_math and --fmad=false against the golden image and lab 01;
@@ -128,11 +128,13 @@ if ! skipped tests; then
 fi
 
 # ---- 5-7. measurements ------------------------------------------------------------------
+# The scene named as the repository names it: the record must not name this machine's paths.
+baseline=common/scenes/cornell.json
 if ! skipped bench && [ -x lab05-bench ]; then
     say "benchmark: lab05-bench --repeat 5 (the baseline)"
-    ./lab05-bench --repeat 5 > "$out/bench.json" 2>> "$log" && step[bench]=ok || step[bench]=failed
+    ./lab05-bench --repeat 5 --scene "$baseline" > "$out/bench.json" 2>> "$log" && step[bench]=ok || step[bench]=failed
     say "benchmark: lab05-bench-fast-math (--use_fast_math), the main shapes"
-    ./lab05-bench-fast-math --repeat 5 --only "${GPU_CHECK_FAST_MATH_VARIANTS:-reference,general,all-materials,scene-shared,no-register-cap,plain}" \
+    ./lab05-bench-fast-math --repeat 5 --scene "$baseline" --only "${GPU_CHECK_FAST_MATH_VARIANTS:-reference,general,all-materials,scene-shared,no-register-cap,plain}" \
         > "$out/bench-fast-math.json" 2>> "$log" && step[bench_fast_math]=ok || step[bench_fast_math]=failed
 fi
 # The wavefront labs' references (and AoS with each thread storing its own record) and their
@@ -140,7 +142,7 @@ fi
 for lab in lab06 lab07; do
     if [[ " ${GPU_CHECK_SKIP:-} " != *" bench "* ]] && [ -x $lab-bench ]; then
         say "benchmark: $lab-bench --repeat 5 (the baseline: the pools and the megakernel)"
-        ./$lab-bench --repeat 5 --only AoS,AoS-stored-by-thread,SoA,megakernel > "$out/bench-$lab.json" 2>> "$log" \
+        ./$lab-bench --repeat 5 --scene "$baseline" --only AoS,AoS-stored-by-thread,SoA,megakernel > "$out/bench-$lab.json" 2>> "$log" \
             && step[bench_$lab]=ok || step[bench_$lab]=failed
     fi
 done

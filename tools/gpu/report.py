@@ -142,7 +142,7 @@ TARGET_BENCHES = (("bench", "lab05-bench"), ("bench_lab06", "lab06-bench"), ("be
 
 
 def targets_table(result: dict) -> list[str]:
-    """The speed targets each benchmark printed (common/cuda/speed_targets.h) and whether the
+    """The speed targets each benchmark printed (bench/gpu/speed_targets.h) and whether the
     run met them; nothing for a call whose benchmarks printed none."""
     rows = []
     for key, bench in TARGET_BENCHES:

@@ -87,11 +87,7 @@ static Config wavefront(const Setup& s, std::string name, std::string change,
             [s, wave_paths](Image& image, WavefrontStats* stats) {
                 Progress progress(s.settings.height, false);
                 const RenderJob job{s.scene->view(), s.settings, s.camera, 0, progress};
-                const std::string paths = std::to_string(wave_paths);
-                setenv("RT_LAB06_WAVE_PATHS", paths.c_str(), 1);
-                const double seconds = render_waves<C>(job, s.prop, s.layout, s.pool, image, stats);
-                unsetenv("RT_LAB06_WAVE_PATHS");
-                return seconds;
+                return render_waves<C>(job, s.prop, s.layout, s.pool, wave_paths, image, stats);
             }};
 }
 
