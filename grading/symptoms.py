@@ -20,6 +20,8 @@ import math
 
 import numpy as np
 
+from labkit import registry
+
 # A transform must bring the image this much closer to `want` (mean absolute difference) to
 # be named: noise alone never does that, a real match does by far (a flipped Cornell box
 # flipped back drops to the noise, a tenth or less of the error).
@@ -30,19 +32,22 @@ GAMMA = 2.2
 # What the closed-form checks of this grade identified, and the lab being graded.
 _found: contextvars.ContextVar[list[str] | None] = contextvars.ContextVar("found", default=None)
 _lab: contextvars.ContextVar[str | None] = contextvars.ContextVar("lab", default=None)
+_part: contextvars.ContextVar[str] = contextvars.ContextVar("part", default="")
 # An exact closed form matches to float rounding (~1e-5 relative); a transformed one to 1e-3.
 EXACT = 1e-3
 
 
 @contextlib.contextmanager
-def grading(lab: str):
-    """One grade of lab `lab`: hints fit the lab, and identified causes outrank guesses."""
-    found, lab_token = _found.set([]), _lab.set(lab)
+def grading(lab: str, part: str = ""):
+    """One grade of lab `lab` (of its `part`, lab 02's "a"): hints fit the lab, and identified
+    causes outrank guesses."""
+    found, lab_token, part_token = _found.set([]), _lab.set(lab), _part.set(part)
     try:
         yield
     finally:
         _found.reset(found)
         _lab.reset(lab_token)
+        _part.reset(part_token)
 
 
 def record(cause: str) -> None:
@@ -52,29 +57,41 @@ def record(cause: str) -> None:
         found.append(cause)
 
 
+# Who renders which rows, by how the lab's work is split (its rubric in labs/labs.toml).
+_SPLIT_BY_RUBRIC = {
+    "openmp": "the remainder of rows divided among threads?",
+    "mpi": "the remainder of rows divided among ranks, or rows never gathered?",
+    "gpu": "a grid that does not cover the image, or blocks that return early?",
+    "gpu-soa": "a grid that does not cover the image, or blocks that return early?",
+}
+
+
+def _graded_lab() -> registry.Lab | None:
+    """The registry's entry of the lab being graded (None: a check run outside a grade)."""
+    number = _lab.get()
+    return None if number is None else registry.lab(number)
+
+
 def _where_work_is_split() -> str:
     """Who renders which rows in the lab being graded, for the hints that depend on it."""
-    lab = _lab.get()
-    if lab == "03":
-        return "the remainder of rows divided among threads?"
-    if lab == "04":
-        return "the remainder of rows divided among ranks, or rows never gathered?"
-    if lab in ("05", "06", "07"):
-        return "a grid that does not cover the image, or blocks that return early?"
+    lab = _graded_lab()
     if lab is None:  # a check run outside a grade: every lab's cause
         return "a loop bound that stops short, or the remainder of rows divided among ranks?"
-    return "a loop bound that stops short?"
+    return _SPLIT_BY_RUBRIC.get(lab.rubric, "a loop bound that stops short?")
 
 
-def current_lab() -> str | None:
-    """The lab being graded (None: a check run outside a grade)."""
-    return _lab.get()
+def packet_lab() -> bool:
+    """The lab being graded traces packets, one path a SIMD lane (its rubric "simd"; not a
+    part of it that does not, as lab 02's Part A)."""
+    lab = _graded_lab()
+    return lab is not None and lab.rubric == "simd" and not _part.get()
 
 
 def gpu_lab() -> bool:
     """The lab renders on a GPU, or is not known (a check run outside a grade): kernels and
     their synchronisation may then be named."""
-    return _lab.get() in (None, "05", "06", "07")
+    lab = _graded_lab()
+    return lab is None or lab.gpu
 
 
 def _matches(image: np.ndarray, want: np.ndarray) -> bool:
@@ -153,8 +170,10 @@ def black_rows(image: np.ndarray, want: np.ndarray) -> str:
         return ""
     where = (f"rows {rows[0]}-{rows[-1]}" if rows == list(range(rows[0], rows[-1] + 1))
              else f"{len(rows)} rows, the first {rows[0]}")
+    lab = _graded_lab()
+    gathered = lab is None or lab.rubric == "mpi"  # ranks send their rows to be gathered
     return (f"{len(rows)} of {gray.shape[0]} rows are exactly black ({where}): rows never "
-            f"rendered{' or never gathered' if _lab.get() in (None, '04') else ''} "
+            f"rendered{' or never gathered' if gathered else ''} "
             f"({_where_work_is_split()})")
 
 
