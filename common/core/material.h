@@ -3,13 +3,27 @@
 
 #include <cmath>
 
+#include <kinds.h>
 #include <real.h>
 #include <vec3.h>
 
-enum class MaterialType : int { Diffuse = 0, Mirror = 1, Glass = 2 };
+// The material kinds, declared here once: AllMaterials lists them, a material's type is its
+// kind's position in the list, and every set a renderer is compiled for names its kinds
+// (material_set.h).
+struct Diffuse {};  // Lambertian: albedo / pi
+struct Mirror {};   // perfect specular reflection, tinted by the albedo
+struct Glass {};    // smooth dielectric: Fresnel reflection or refraction by the ior
+
+using AllMaterials = Kinds<Diffuse, Mirror, Glass>;
+
+// A material's kind: its position in AllMaterials (material_type<Glass> is 2).
+enum class MaterialType : int {};
+
+template <class K>
+constexpr MaterialType material_type = static_cast<MaterialType>(kind_index<AllMaterials, K>);
 
 struct Material {
-    MaterialType type;  // which BSDF
+    MaterialType type;  // which BSDF: material_type<K> for a kind K of AllMaterials
     Vec3 albedo;        // diffuse reflectance or mirror tint (unused by glass)
     real ior;           // index of refraction inside glass (unused otherwise)
 };

@@ -52,15 +52,15 @@ struct SurfacePoint {
 template <class Primitives = AnyGeometry>
 RT_HD inline SurfacePoint surface_at(const SceneView& scene, const Ray& ray, const Hit& hit) {
     const Vec3 p = ray.at(hit.t);
-    if (Primitives::kSpheres && hit.kind == PrimitiveKind::Sphere) {
+    if (has_kind<Primitives, Sphere> && hit.kind == primitive_kind<Sphere>) {
         const Sphere& s = scene.spheres[hit.index];
         return {p, normalize(p - s.center), sphere_extent(s), s.material};
     }
-    if (Primitives::kRects && hit.kind == PrimitiveKind::Rect) {
+    if (has_kind<Primitives, AxisRect> && hit.kind == primitive_kind<AxisRect>) {
         const AxisRect& r = scene.rects[hit.index];
         return {p, rect_normal(r), r.extent, r.material};
     }
-    if (Primitives::kQuads && hit.kind == PrimitiveKind::Quad) {
+    if (has_kind<Primitives, ConvexQuad> && hit.kind == primitive_kind<ConvexQuad>) {
         const ConvexQuad& q = scene.quads[hit.index];
         return {p, q.normal, q.extent, q.material};
     }
@@ -75,29 +75,29 @@ template <class Primitives = AnyGeometry>
 RT_HD inline Hit closest_hit(const SceneView& scene, const Ray& ray) {
     Hit hit;
     // BEGIN SOLUTION
-    if constexpr (Primitives::kSpheres) {
+    if constexpr (has_kind<Primitives, Sphere>) {
         for (int i = 0; i < scene.num_spheres; ++i) {
             const real t = intersect_sphere(ray, scene.spheres[i], hit.t);
-            if (t < hit.t) hit = {t, PrimitiveKind::Sphere, i};
+            if (t < hit.t) hit = {t, primitive_kind<Sphere>, i};
         }
     }
-    if constexpr (Primitives::kSheared) {
+    if constexpr (needs_shear<Primitives>) {
         if (scene.num_triangles > 0 || scene.num_quads > 0) {  // the same for every ray
             const RayShear shear(ray.direction);
-            for (int i = 0; Primitives::kTriangles && i < scene.num_triangles; ++i) {
+            for (int i = 0; has_kind<Primitives, Triangle> && i < scene.num_triangles; ++i) {
                 const real t = intersect_triangle(ray, shear, scene.triangles[i], hit.t);
-                if (t < hit.t) hit = {t, PrimitiveKind::Triangle, i};
+                if (t < hit.t) hit = {t, primitive_kind<Triangle>, i};
             }
-            for (int i = 0; Primitives::kQuads && i < scene.num_quads; ++i) {
+            for (int i = 0; has_kind<Primitives, ConvexQuad> && i < scene.num_quads; ++i) {
                 const real t = intersect_quad(ray, shear, scene.quads[i], hit.t);
-                if (t < hit.t) hit = {t, PrimitiveKind::Quad, i};
+                if (t < hit.t) hit = {t, primitive_kind<ConvexQuad>, i};
             }
         }
     }
-    if constexpr (Primitives::kRects) {
+    if constexpr (has_kind<Primitives, AxisRect>) {
         for (int i = 0; i < scene.num_rects; ++i) {
             const real t = intersect_rect(ray, scene.rects[i], hit.t);
-            if (t < hit.t) hit = {t, PrimitiveKind::Rect, i};
+            if (t < hit.t) hit = {t, primitive_kind<AxisRect>, i};
         }
     }
     // SKELETON
@@ -105,9 +105,9 @@ RT_HD inline Hit closest_hit(const SceneView& scene, const Ray& ray) {
     //> // order, keeping the nearest hit: the triangles and the quads (build one RayShear per
     //> // ray, then intersect_triangle and intersect_quad), then the axis-aligned rectangles
     //> // (intersect_rect: the Cornell box's walls). Each hit records its kind and index.
-    //> for (int i = 0; Primitives::kSpheres && i < scene.num_spheres; ++i) {
+    //> for (int i = 0; has_kind<Primitives, Sphere> && i < scene.num_spheres; ++i) {
     //>     const real t = intersect_sphere(ray, scene.spheres[i], hit.t);
-    //>     if (t < hit.t) hit = {t, PrimitiveKind::Sphere, i};
+    //>     if (t < hit.t) hit = {t, primitive_kind<Sphere>, i};
     //> }
     // END SOLUTION
     return hit;
@@ -121,26 +121,26 @@ RT_HD inline bool occluded(const SceneView& scene, const Ray& ray, real t_max) {
     // On a GPU every lane tests every primitive and the answer comes after the loops: an exit
     // at the first blocker would only split the warp (kConvergedTests, rt_hd.h).
     bool blocked = false;
-    if constexpr (Primitives::kSpheres) {
+    if constexpr (has_kind<Primitives, Sphere>) {
         for (int i = 0; i < scene.num_spheres; ++i) {
             blocked |= intersect_sphere(ray, scene.spheres[i], t_max) < t_max;
             if (!kConvergedTests && blocked) return true;
         }
     }
-    if constexpr (Primitives::kSheared) {
+    if constexpr (needs_shear<Primitives>) {
         if (scene.num_triangles > 0 || scene.num_quads > 0) {
             const RayShear shear(ray.direction);
-            for (int i = 0; Primitives::kTriangles && i < scene.num_triangles; ++i) {
+            for (int i = 0; has_kind<Primitives, Triangle> && i < scene.num_triangles; ++i) {
                 blocked |= intersect_triangle(ray, shear, scene.triangles[i], t_max) < t_max;
                 if (!kConvergedTests && blocked) return true;
             }
-            for (int i = 0; Primitives::kQuads && i < scene.num_quads; ++i) {
+            for (int i = 0; has_kind<Primitives, ConvexQuad> && i < scene.num_quads; ++i) {
                 blocked |= intersect_quad(ray, shear, scene.quads[i], t_max) < t_max;
                 if (!kConvergedTests && blocked) return true;
             }
         }
     }
-    if constexpr (Primitives::kRects) {
+    if constexpr (has_kind<Primitives, AxisRect>) {
         for (int i = 0; i < scene.num_rects; ++i) {
             blocked |= rect_blocks(ray, scene.rects[i], t_max);
             if (!kConvergedTests && blocked) return true;
@@ -161,11 +161,11 @@ RT_HD inline bool occluded(const SceneView& scene, const Ray& ray, real t_max) {
 // convex_quad.h, axis_rect.h); zero on a sphere, which has none.
 template <class Primitives = AnyGeometry>
 RT_HD inline Vec3 step_off_hit_edges(const SceneView& scene, const Hit& hit, Vec3 p, real margin) {
-    if (Primitives::kTriangles && hit.kind == PrimitiveKind::Triangle)
+    if (has_kind<Primitives, Triangle> && hit.kind == primitive_kind<Triangle>)
         return step_off_edges(scene.triangles[hit.index], p, margin);
-    if (Primitives::kQuads && hit.kind == PrimitiveKind::Quad)
+    if (has_kind<Primitives, ConvexQuad> && hit.kind == primitive_kind<ConvexQuad>)
         return step_off_edges(scene.quads[hit.index], p, margin);
-    if (Primitives::kRects && hit.kind == PrimitiveKind::Rect)
+    if (has_kind<Primitives, AxisRect> && hit.kind == primitive_kind<AxisRect>)
         return step_off_edges(scene.rects[hit.index], p, margin);
     return Vec3(0.0f);
 }
@@ -274,7 +274,7 @@ RT_HD RT_FORCE_INLINE bool bounce_step(const SceneView& scene, const Hit& hit, c
     const int bounce = path.bounce++;
     path.alive = path.bounce < max_bounces;
 
-    if (!Materials::kSpecular || material.type == MaterialType::Diffuse) {
+    if (!has_specular<Materials> || material.type == material_type<Diffuse>) {
         const bool lit = scene.has_light && sample_light(scene, surface.position, above, facing,
                                                          material.albedo, shadow);
         if (lit) shadow.radiance = path.throughput * shadow.radiance;
@@ -285,7 +285,7 @@ RT_HD RT_FORCE_INLINE bool bounce_step(const SceneView& scene, const Hit& hit, c
         }
         return lit;
     }
-    if constexpr (Materials::kSpecular) {
+    if constexpr (has_specular<Materials>) {
         if (!path.alive) return false;
         // A specular path may bounce 64 times inside a closed mirror or glass room, and must
         // stay inside: its origin also steps off any edge of the triangle, quad
@@ -295,7 +295,8 @@ RT_HD RT_FORCE_INLINE bool bounce_step(const SceneView& scene, const Hit& hit, c
         // sphere). refract() normalises already.
         const Vec3 off_edges = step_off_hit_edges<Primitives>(
             scene, hit, surface.position, ray_offset(surface.position, hit.t, surface.extent));
-        if (!Materials::kGlass || (Materials::kMirror && material.type == MaterialType::Mirror)) {
+        if (!has_kind<Materials, Glass> ||
+            (has_kind<Materials, Mirror> && material.type == material_type<Mirror>)) {
             path.throughput *= material.albedo;
             path.ray = {above + off_edges, normalize(reflect(incoming, facing))};
         } else {  // glass: reflect or refract, chosen with the Fresnel reflectance

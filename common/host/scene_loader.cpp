@@ -215,14 +215,14 @@ void read_light(const SceneReader& r, const json& root, Scene& scene) {
 Material read_material(const SceneReader& r, const json& m, const std::string& p) {
     if (!m.is_object()) r.fail(p, "expected an object, found " + SceneReader::type_of(m));
     const json& type = r.require(m, p, "type");
-    Material mat{MaterialType::Diffuse, Vec3(0.0f), 1.0f};
+    Material mat{material_type<Diffuse>, Vec3(0.0f), 1.0f};
     if (type == "diffuse" || type == "mirror") {
         r.check_keys(m, p, {"type", "albedo"});
-        mat.type = type == "diffuse" ? MaterialType::Diffuse : MaterialType::Mirror;
+        mat.type = type == "diffuse" ? material_type<Diffuse> : material_type<Mirror>;
         mat.albedo = r.albedo(r.require(m, p, "albedo"), p + "/albedo");
     } else if (type == "glass") {
         r.check_keys(m, p, {"type", "ior"});
-        mat.type = MaterialType::Glass;
+        mat.type = material_type<Glass>;
         mat.ior = r.number(r.require(m, p, "ior"), p + "/ior");
         if (!(mat.ior >= 1.0f && mat.ior <= 5.0f))
             r.fail(p + "/ior", "expected an index of refraction in [1, 5]");

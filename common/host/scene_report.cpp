@@ -42,9 +42,9 @@ SceneUse scene_use(const Scene& scene) {
     use.rects = static_cast<int>(scene.rects.size());
     use.split_pieces = scene.t_junction_pieces;
     for (const Material& m : scene.materials) {
-        use.diffuse += m.type == MaterialType::Diffuse;
-        use.mirrors += m.type == MaterialType::Mirror;
-        use.glass += m.type == MaterialType::Glass;
+        use.diffuse += m.type == material_type<Diffuse>;
+        use.mirrors += m.type == material_type<Mirror>;
+        use.glass += m.type == material_type<Glass>;
     }
     use.light = scene.has_light;
     use.background = !is_black(scene.background);

@@ -45,17 +45,19 @@ static void expect_choice(SceneMemory memory, bool specular, GeometryKinds kinds
 }
 
 int main() {
-    // kinds: spheres, triangles, quads, rects
-    expect_choice(SceneMemory::Constant, false, {true, false, false, true}, "constant/diffuse/box");
-    expect_choice(SceneMemory::Global, true, {false, false, false, true},
+    expect_choice(SceneMemory::Constant, false, geometry_kinds_of<Kinds<Sphere, AxisRect>>(),
+                  "constant/diffuse/box");
+    expect_choice(SceneMemory::Global, true, geometry_kinds_of<Kinds<AxisRect>>(),
                   "global/any-material/box");
-    expect_choice(SceneMemory::Constant, false, {true, false, true, false},
+    expect_choice(SceneMemory::Constant, false, geometry_kinds_of<Kinds<Sphere, ConvexQuad>>(),
                   "constant/diffuse/general");
-    expect_choice(SceneMemory::Constant, true, {true, true, true, false},
+    expect_choice(SceneMemory::Constant, true,
+                  geometry_kinds_of<Kinds<Sphere, Triangle, ConvexQuad>>(),
                   "constant/any-material/general");
-    expect_choice(SceneMemory::Constant, false, {false, true, false, true},
+    expect_choice(SceneMemory::Constant, false, geometry_kinds_of<Kinds<Triangle, AxisRect>>(),
                   "constant/diffuse/any-geometry");
-    expect_choice(SceneMemory::Global, false, {true, true, true, true},
+    expect_choice(SceneMemory::Global, false,
+                  geometry_kinds_of<Kinds<Sphere, Triangle, ConvexQuad, AxisRect>>(),
                   "global/diffuse/any-geometry");
 
     // The constant bank while the pool fits in it, else global memory.
@@ -104,7 +106,7 @@ int main() {
     expect(triangles.view.num_rects == 0 && triangles.view.num_quads == 0 &&
                triangles.view.num_triangles == 5,
            "triangles: every quad and rectangle as two triangles");
-    expect(geometry_kinds(triangles.view).fits<GeometrySet<true, true, false, false>>(),
+    expect(geometry_kinds(triangles.view).fits<Kinds<Sphere, Triangle>>(),
            "triangles: spheres and triangles only");
 
     // RT_LAB05_GEOMETRY.

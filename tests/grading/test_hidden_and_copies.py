@@ -84,8 +84,8 @@ def test_a_renderer_that_skips_a_primitive_kind_fails_the_hidden_scene(lab01_ref
     from grading import hidden
     from labkit.variants import build_variant
     assert hidden.check_hidden(lab01_ref, lab01_ref, "kinds").passed
-    for name, loop in (("triangles", "if (t < hit.t) hit = {t, PrimitiveKind::Triangle, i};"),
-                       ("quads", "if (t < hit.t) hit = {t, PrimitiveKind::Quad, i};")):
+    for name, loop in (("triangles", "if (t < hit.t) hit = {t, primitive_kind<Triangle>, i};"),
+                       ("quads", "if (t < hit.t) hit = {t, primitive_kind<ConvexQuad>, i};")):
         binary = build_variant("01-serial", tmp_path / name, skipping(loop))
         result = hidden.check_hidden(binary, lab01_ref, "kinds")
         assert not result.passed, f"a renderer without {name} passed: {result.detail}"

@@ -46,7 +46,8 @@ MUTANTS = {
         "blocked |= intersect_triangle(ray, shear, scene.triangles[i], t_max) < t_max;",
         "blocked |= false;", ["showcase"]),
     "every rectangle hit names rectangle 0": (
-        "path_tracer.h", "hit = {t, PrimitiveKind::Rect, i};", "hit = {t, PrimitiveKind::Rect, 0};",
+        "path_tracer.h", "hit = {t, primitive_kind<AxisRect>, i};",
+        "hit = {t, primitive_kind<AxisRect>, 0};",
         ["cornell", "showcase"]),
     "rectangle: inside test of one axis reversed": (
         "axis_rect.h",

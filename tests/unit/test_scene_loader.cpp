@@ -126,7 +126,7 @@ TEST(SceneLoader, CornellLoads) {
     }
     // The sphere uses "ball".
     EXPECT_EQ(s.material_names[s.spheres[0].material], "ball");
-    EXPECT_EQ(s.materials[s.spheres[0].material].type, MaterialType::Diffuse);
+    EXPECT_EQ(s.materials[s.spheres[0].material].type, material_type<Diffuse>);
     // Every wall faces into the box, towards its centre (0.5, 0.5, -0.5).
     for (const AxisRect& r : s.rects) {
         const Vec3 to_centre = Vec3(0.5f, 0.5f, -0.5f) - along_axis(rect_axis(r), r.plane);
@@ -191,7 +191,7 @@ TEST(SceneLoader, MinimalSceneGetsDefaults) {
     EXPECT_FLOAT_EQ(s.camera.up.y, 1.0f);
     EXPECT_FLOAT_EQ(s.camera.vfov_degrees, 55.0f);
     ASSERT_EQ(s.materials.size(), 1u);
-    EXPECT_EQ(s.materials[0].type, MaterialType::Diffuse);
+    EXPECT_EQ(s.materials[0].type, material_type<Diffuse>);
     EXPECT_FLOAT_EQ(s.materials[0].albedo.z, 0.3f);
 }
 
@@ -225,11 +225,11 @@ TEST(SceneLoader, EverythingAsWritten) {
         ADD_FAILURE() << "no material " << name;
         return s.materials[0];
     };
-    EXPECT_EQ(material("glass").type, MaterialType::Glass);
+    EXPECT_EQ(material("glass").type, material_type<Glass>);
     EXPECT_FLOAT_EQ(material("glass").ior, 1.5f);
-    EXPECT_EQ(material("steel").type, MaterialType::Mirror);
+    EXPECT_EQ(material("steel").type, material_type<Mirror>);
     EXPECT_FLOAT_EQ(material("steel").albedo.z, 0.7f);
-    EXPECT_EQ(material("white").type, MaterialType::Diffuse);
+    EXPECT_EQ(material("white").type, material_type<Diffuse>);
     ASSERT_EQ(s.spheres.size(), 2u);
     EXPECT_EQ(s.material_names[s.spheres[0].material], "steel");
     EXPECT_EQ(s.material_names[s.spheres[1].material], "glass");
@@ -266,10 +266,10 @@ std::string scene_of(const std::vector<std::string>& quads,
     return text + "]}";
 }
 
-struct Kinds {
+struct PrimitiveCounts {
     size_t triangles, quads, rects;
 };
-Kinds kinds_of(const std::string& text) {
+PrimitiveCounts kinds_of(const std::string& text) {
     const Scene s = parse_scene(text, kName);
     return {s.triangles.size(), s.quads.size(), s.rects.size()};
 }
@@ -278,7 +278,7 @@ Kinds kinds_of(const std::string& text) {
 
 TEST(SceneLoader, EachQuadBecomesTheKindItIs) {
     const auto one = [](const std::string& quad) { return kinds_of(scene_of({quad})); };
-    const auto is = [](Kinds k, size_t t, size_t q, size_t r) {
+    const auto is = [](PrimitiveCounts k, size_t t, size_t q, size_t r) {
         return k.triangles == t && k.quads == q && k.rects == r;
     };
     EXPECT_TRUE(is(one("[[0,0,0], [1,0,0], [1,1,0], [0,1,0]]"), 0, 0, 1));  // a rectangle
@@ -304,7 +304,7 @@ TEST(SceneLoader, RectanglesThatShareAnEdgeWithAnotherKindBecomeQuads) {
     const std::string back = "[[0,0,-1], [1,0,-1], [1,1,-1], [0,1,-1]]";
     const std::string left = "[[0,0,0], [0,0,-1], [0,1,-1], [0,1,0]]";
     const std::string far_wall = "[[5,0,0], [5,1,0], [5,1,-1], [5,0,-1]]";
-    Kinds k = kinds_of(scene_of({floor, back, left, far_wall}));
+    PrimitiveCounts k = kinds_of(scene_of({floor, back, left, far_wall}));
     EXPECT_EQ(k.rects, 4u);
     // A triangle on the floor's front edge (z = 0): the floor, and the back and left walls
     // that share its edges, become quads; the far wall, apart from them, stays a rectangle.
@@ -327,7 +327,7 @@ TEST(SceneLoader, KindsDoNotDependOnWhereTheSceneIs) {
     const std::vector<std::string> quads = {
         "[[0,0,0], [1,0,0], [1,1,0], [0,1,0]]", "[[2,0,0], [3,0,0], [3.5,1,0], [2.5,1,0]]",
         "[[4,0,0], [5,0,0], [5,1,0.01], [4,1,0]]"};  // apart: no shared edges
-    const Kinds here = kinds_of(scene_of(quads));
+    const PrimitiveCounts here = kinds_of(scene_of(quads));
     EXPECT_EQ(here.rects, 1u);
     EXPECT_EQ(here.quads, 1u);
     EXPECT_EQ(here.triangles, 2u);

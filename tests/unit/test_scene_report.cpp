@@ -10,9 +10,9 @@ namespace {
 Scene scene_with(double detail_radius, double wall) {
     Scene s;
     Material diffuse{};
-    diffuse.type = MaterialType::Diffuse;
+    diffuse.type = material_type<Diffuse>;
     Material glass = diffuse;
-    glass.type = MaterialType::Glass;
+    glass.type = material_type<Glass>;
     s.materials = {diffuse, glass};
     s.material_names = {"wall", "bead"};
     const float w = static_cast<float>(wall);

@@ -18,7 +18,7 @@ namespace {
 Scene mirror_floor() {
     Scene scene;
     Material m{};
-    m.type = MaterialType::Mirror;
+    m.type = material_type<Mirror>;
     m.albedo = Vec3(1.0f);
     scene.materials.push_back(m);
     scene.material_names.push_back("mirror");
@@ -48,7 +48,7 @@ std::string parse_error(const std::string& text) {
 TEST(SpecularBounce, ReflectedDirectionsStayUnitLength) {
     Scene scene;
     Material m{};
-    m.type = MaterialType::Mirror;
+    m.type = material_type<Mirror>;
     m.albedo = Vec3(1.0f);
     scene.materials.push_back(m);
     scene.material_names.push_back("mirror");
@@ -103,7 +103,7 @@ TEST(StepOffEdges, AMirrorHitOnARoomsEdgeStartsInFrontOfBothFaces) {
     const Ray ray{{0.4f, 0.8f, 0.25f}, {0.6f, -0.8f, 0.0f}};
     Hit hit;
     hit.t = 1.0f;
-    hit.kind = PrimitiveKind::Triangle;
+    hit.kind = primitive_kind<Triangle>;
     hit.index = 1;  // the floor's second triangle holds the edge x = 1
     ASSERT_EQ(ray.at(hit.t).x, 1.0f);
     ASSERT_EQ(ray.at(hit.t).y, 0.0f);
@@ -121,10 +121,10 @@ TEST(StepOffEdges, AMirrorHitOnARoomsEdgeStartsInFrontOfBothFaces) {
 TEST(StepOffEdges, RectanglesAndQuadsStepOffTheirEdgesToo) {
     const Vec3 a(-1, 0, -1), b(-1, 0, 1), c(1, 0, 1), d(1, 0, -1);          // the floor
     const Vec3 e(1, 0, -1), f(1, 0, 1), g(1, 1, 1), h(1, 1, -1);            // the wall x = 1
-    for (const PrimitiveKind kind : {PrimitiveKind::Rect, PrimitiveKind::Quad}) {
+    for (const PrimitiveKind kind : {primitive_kind<AxisRect>, primitive_kind<ConvexQuad>}) {
         Scene scene = mirror_floor();
         scene.triangles.clear();
-        if (kind == PrimitiveKind::Rect) {
+        if (kind == primitive_kind<AxisRect>) {
             const Vec3 floor[4] = {a, b, c, d}, wall[4] = {e, f, g, h};
             scene.rects = {make_axis_rect(floor, 1, 0), make_axis_rect(wall, 0, 0)};
         } else {
@@ -150,7 +150,7 @@ TEST(StepOffEdges, RectanglesAndQuadsStepOffTheirEdgesToo) {
 // no sample, and nothing that sample_light returns is NaN.
 TEST(SampleLight, ALightAtTheSurfacePointGivesNoSample) {
     Scene scene = mirror_floor();
-    scene.materials[0].type = MaterialType::Diffuse;
+    scene.materials[0].type = material_type<Diffuse>;
     scene.has_light = true;
     scene.light.intensity = Vec3(1.0f);
     const Vec3 n(0, 1, 0);

@@ -211,18 +211,18 @@ inline HitPacket<F> closest_hit(const SceneView& scene, const RayPacket<F>& ray,
         hit.index = select(nearer, I(i), hit.index);
     };
     for (int i = 0; i < scene.num_spheres; ++i)
-        keep(intersect_sphere(ray, scene.spheres[i], hit.t), PrimitiveKind::Sphere, i);
+        keep(intersect_sphere(ray, scene.spheres[i], hit.t), primitive_kind<Sphere>, i);
     if (scene.num_triangles > 0 || scene.num_quads > 0) {
         const RayShearN<F> shear(ray);
         for (int i = 0; i < scene.num_triangles; ++i) {
-            keep(intersect_triangle(ray, shear, scene.triangles[i], hit.t), PrimitiveKind::Triangle,
-                 i);
+            keep(intersect_triangle(ray, shear, scene.triangles[i], hit.t),
+                 primitive_kind<Triangle>, i);
         }
         for (int i = 0; i < scene.num_quads; ++i)
-            keep(intersect_quad(ray, shear, scene.quads[i], hit.t), PrimitiveKind::Quad, i);
+            keep(intersect_quad(ray, shear, scene.quads[i], hit.t), primitive_kind<ConvexQuad>, i);
     }
     for (int i = 0; i < scene.num_rects; ++i)
-        keep(intersect_rect(ray, scene.rects[i], hit.t), PrimitiveKind::Rect, i);
+        keep(intersect_rect(ray, scene.rects[i], hit.t), primitive_kind<AxisRect>, i);
     return hit;
 }
 
@@ -295,7 +295,7 @@ inline SurfacePacket<F> surface_at(const SceneView& scene, const RayPacket<F>& r
         s.extent = select(lanes, extent, s.extent);
         s.material = select(lanes, material, s.material);
     };
-    const auto on_sphere = mask & hit.on(PrimitiveKind::Sphere);
+    const auto on_sphere = mask & hit.on(primitive_kind<Sphere>);
     if (any(on_sphere)) {
         constexpr int kS = stride_of<Sphere>();
         const Sphere& s0 = scene.spheres[0];
@@ -320,9 +320,9 @@ inline SurfacePacket<F> surface_at(const SceneView& scene, const RayPacket<F>& r
              gather(first->extent, kT, hit.index, lanes),
              gather(first->material, kT, hit.index, lanes));
     };
-    take_flat(PrimitiveKind::Triangle, scene.triangles);
-    take_flat(PrimitiveKind::Quad, scene.quads);
-    const auto on_rect = mask & hit.on(PrimitiveKind::Rect);
+    take_flat(primitive_kind<Triangle>, scene.triangles);
+    take_flat(primitive_kind<ConvexQuad>, scene.quads);
+    const auto on_rect = mask & hit.on(primitive_kind<AxisRect>);
     if (any(on_rect)) {  // rect_normal (axis_rect.h), lane by lane
         constexpr int kR = stride_of<AxisRect>();
         const AxisRect& r0 = scene.rects[0];
@@ -370,9 +370,9 @@ inline Vec3xN<F> specular_edge_step(const SceneView& scene, const HitPacket<F>& 
                                     const SurfacePacket<F>& surface, MaskOf<F> specular) {
     using I = IntOf<F>;
     Vec3xN<F> step(Vec3(0.0f));
-    const auto on_triangle = specular & hit.on(PrimitiveKind::Triangle);
-    const auto on_quad = specular & hit.on(PrimitiveKind::Quad);
-    const auto on_rect = specular & hit.on(PrimitiveKind::Rect);
+    const auto on_triangle = specular & hit.on(primitive_kind<Triangle>);
+    const auto on_quad = specular & hit.on(primitive_kind<ConvexQuad>);
+    const auto on_rect = specular & hit.on(primitive_kind<AxisRect>);
     if (none(on_triangle | on_quad | on_rect)) return step;
     // ray_offset (ray.h), lane by lane
     const F margin =
@@ -501,9 +501,9 @@ RT_PACKET_INLINE MaskOf<F> bounce_step(const SceneView& scene, const HitPacket<F
     const Vec3xN<F> above = offset_ray_origin(surface.position, facing, hit.t, surface.extent);
     const int bounce = path.bounce++;
     const bool last = path.bounce >= max_bounces;
-    const Mask diffuse = path.alive & (type == static_cast<int>(MaterialType::Diffuse));
-    const Mask mirror = path.alive & (type == static_cast<int>(MaterialType::Mirror));
-    const Mask glass = path.alive & (type == static_cast<int>(MaterialType::Glass));
+    const Mask diffuse = path.alive & (type == static_cast<int>(material_type<Diffuse>));
+    const Mask mirror = path.alive & (type == static_cast<int>(material_type<Mirror>));
+    const Mask glass = path.alive & (type == static_cast<int>(material_type<Glass>));
 
     Mask lit = Mask::none();
     if (scene.has_light && any(diffuse)) {
