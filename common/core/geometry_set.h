@@ -63,9 +63,9 @@ RT_HD GeometryKinds geometry_kinds_of() {
 
 RT_HD inline GeometryKinds geometry_kinds(const SceneView& scene) {
     GeometryKinds kinds{};
-    kinds.present[kind_index<AllPrimitives, Sphere>] = scene.num_spheres > 0;
-    kinds.present[kind_index<AllPrimitives, Triangle>] = scene.num_triangles > 0;
-    kinds.present[kind_index<AllPrimitives, ConvexQuad>] = scene.num_quads > 0;
-    kinds.present[kind_index<AllPrimitives, AxisRect>] = scene.num_rects > 0;
+    for_each_kind(AllPrimitives{}, [&](auto kind) {
+        using K = typename decltype(kind)::type;
+        kinds.present[kind_index<AllPrimitives, K>] = scene.of<K>().count > 0;
+    });
     return kinds;
 }

@@ -65,11 +65,34 @@ constexpr bool has_kind = kind_index<Set, K> >= 0;
 template <class Sub, class Set>
 constexpr bool kinds_within = kinds_detail::Within<Sub, Set>::value;
 
-// Calls f(KindTag<K>{}) for every kind of the set, in the list's order.
+// Calls f(KindTag<K>{}) for every kind of the set, in the list's order. Host and device: f
+// is whatever the caller is (a host-only loop hands it a host lambda, which nvcc would
+// otherwise refuse to see called from here).
+#ifdef __CUDACC__
+#pragma nv_exec_check_disable
+#endif
 template <class... K, class F>
 RT_HD inline void for_each_kind(Kinds<K...>, F&& f) {
     (f(KindTag<K>{}), ...);
 }
+
+// One Slot<K> per kind K of a list, reached by kind: PerKind<KindSpan, AllPrimitives> holds a
+// KindSpan<Sphere>, a KindSpan<Triangle>, ... and of<Sphere>() is the first. What a scene
+// keeps per kind (its arrays, their places in a GPU pool, their counts) is declared this way,
+// so a kind added to the list gets its slot everywhere.
+template <template <class> class Slot, class List>
+struct PerKind;
+template <template <class> class Slot, class... K>
+struct PerKind<Slot, Kinds<K...>> : Slot<K>... {
+    template <class T>
+    RT_HD Slot<T>& of() {
+        return *this;
+    }
+    template <class T>
+    RT_HD const Slot<T>& of() const {
+        return *this;
+    }
+};
 
 // The bits a field needs to number `count` kinds (0..count-1).
 constexpr int bits_to_number(int count) {

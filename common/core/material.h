@@ -9,10 +9,19 @@
 
 // The material kinds, declared here once: AllMaterials lists them, a material's type is its
 // kind's position in the list, and every set a renderer is compiled for names its kinds
-// (material_set.h).
-struct Diffuse {};  // Lambertian: albedo / pi
-struct Mirror {};   // perfect specular reflection, tinted by the albedo
-struct Glass {};    // smooth dielectric: Fresnel reflection or refraction by the ior
+// (material_set.h). kName: what the scene report calls one; kReportKey: its --json key.
+struct Diffuse {  // Lambertian: albedo / pi
+    static constexpr const char* kName = "diffuse";
+    static constexpr const char* kReportKey = "diffuse";
+};
+struct Mirror {  // perfect specular reflection, tinted by the albedo
+    static constexpr const char* kName = "mirror";
+    static constexpr const char* kReportKey = "mirrors";
+};
+struct Glass {  // smooth dielectric: Fresnel reflection or refraction by the ior
+    static constexpr const char* kName = "glass";
+    static constexpr const char* kReportKey = "glass";
+};
 
 using AllMaterials = Kinds<Diffuse, Mirror, Glass>;
 

@@ -77,16 +77,17 @@ int main() {
     SceneView scene{&sphere, 1, &triangle, 1, &quad, 1, &rect, 1, &material, 1, {}, false, {}};
 
     const SceneInForm as_loaded(scene, GeometryForm::AsLoaded);
-    expect(as_loaded.view.num_rects == 1 && as_loaded.view.rects == &rect &&
-               as_loaded.view.num_quads == 1 && as_loaded.view.num_triangles == 1,
+    expect(as_loaded.view.of<AxisRect>().count == 1 && as_loaded.view.of<AxisRect>() == &rect &&
+               as_loaded.view.of<ConvexQuad>().count == 1 &&
+               as_loaded.view.of<Triangle>().count == 1,
            "as loaded: the scene's own arrays");
 
     const SceneInForm quads(scene, GeometryForm::Quads);
-    expect(quads.view.num_rects == 0 && quads.view.num_quads == 2 &&
-               quads.view.num_triangles == 1 && quads.view.num_spheres == 1 &&
-               quads.view.triangles == &triangle,
+    expect(quads.view.of<AxisRect>().count == 0 && quads.view.of<ConvexQuad>().count == 2 &&
+               quads.view.of<Triangle>().count == 1 && quads.view.of<Sphere>().count == 1 &&
+               quads.view.of<Triangle>() == &triangle,
            "quads: the rectangle joins the quads, the rest stays");
-    const ConvexQuad& from_rect = quads.view.quads[1];
+    const ConvexQuad& from_rect = quads.view.of<ConvexQuad>()[1];
     const Vec3 n = rect_normal(rect);
     expect(from_rect.normal.x == n.x && from_rect.normal.y == n.y && from_rect.normal.z == n.z &&
                from_rect.material == rect.material && from_rect.extent == rect.extent,
@@ -103,8 +104,8 @@ int main() {
     }
 
     const SceneInForm triangles(scene, GeometryForm::Triangles);
-    expect(triangles.view.num_rects == 0 && triangles.view.num_quads == 0 &&
-               triangles.view.num_triangles == 5,
+    expect(triangles.view.of<AxisRect>().count == 0 && triangles.view.of<ConvexQuad>().count == 0 &&
+               triangles.view.of<Triangle>().count == 5,
            "triangles: every quad and rectangle as two triangles");
     expect(geometry_kinds(triangles.view).fits<Kinds<Sphere, Triangle>>(),
            "triangles: spheres and triangles only");

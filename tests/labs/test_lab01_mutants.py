@@ -39,11 +39,11 @@ MUTANTS = {
                                "(cos_theta / (kPi * distance))", ["interior", "plane"]),
     "shadow rays ignore spheres": (
         "path_tracer.h",
-        "blocked |= intersect_sphere(ray, scene.spheres[i], t_max) < t_max;",
+        "blocked |= intersect_sphere(ray, scene.of<Sphere>()[i], t_max) < t_max;",
         "blocked |= false;", ["cornell"]),
     "shadow rays ignore triangles": (
         "path_tracer.h",
-        "blocked |= intersect_triangle(ray, shear, scene.triangles[i], t_max) < t_max;",
+        "blocked |= intersect_triangle(ray, shear, scene.of<Triangle>()[i], t_max) < t_max;",
         "blocked |= false;", ["showcase"]),
     "every rectangle hit names rectangle 0": (
         "path_tracer.h", "hit = {t, primitive_kind<AxisRect>, i};",

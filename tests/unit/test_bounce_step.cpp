@@ -21,8 +21,8 @@ struct FloorScene {
         scene.materials.push_back(m);
         scene.material_names.push_back("floor");
         const Vec3 a(-10, 0, -10), b(-10, 0, 10), c(10, 0, 10), d(10, 0, -10);
-        scene.triangles.push_back(make_triangle(a, b, c, 0));
-        scene.triangles.push_back(make_triangle(a, c, d, 0));
+        scene.of<Triangle>().push_back(make_triangle(a, b, c, 0));
+        scene.of<Triangle>().push_back(make_triangle(a, c, d, 0));
         scene.has_light = true;
         scene.light.position = {1.0f, 2.0f, 0.5f};
         scene.light.intensity = Vec3(3.0f);

@@ -26,14 +26,14 @@ Scene diffuse_box() {
     s.material_names = {"walls", "ball"};
     const Vec3 a(-1, 0, -1), b(-1, 0, 1), c(1, 0, 1), d(1, 0, -1);
     const Vec3 up(0, 2, 0);
-    s.triangles = {make_triangle(a, b, c, 0), make_triangle(a, c, d, 0),
-                   make_triangle(a + up, c + up, b + up, 0),
-                   make_triangle(a + up, d + up, c + up, 0)};
+    s.of<Triangle>() = {make_triangle(a, b, c, 0), make_triangle(a, c, d, 0),
+                        make_triangle(a + up, c + up, b + up, 0),
+                        make_triangle(a + up, d + up, c + up, 0)};
     Sphere ball{};
     ball.center = {0.3f, 0.4f, 0.1f};
     ball.radius = 0.3f;
     ball.material = 1;
-    s.spheres = {ball};
+    s.of<Sphere>() = {ball};
     s.has_light = true;
     s.light.position = {-0.2f, 1.5f, 0.2f};
     s.light.intensity = Vec3(2.0f);

@@ -27,15 +27,15 @@ struct TestScene {
     // The square [-h, h]^2 of the plane y = 0, facing +y, as two triangles.
     void floor(int m, float h = 10.0f) {
         const Vec3 a(-h, 0, -h), b(-h, 0, h), c(h, 0, h), d(h, 0, -h);
-        scene.triangles.push_back(make_triangle(a, b, c, m));
-        scene.triangles.push_back(make_triangle(a, c, d, m));
+        scene.of<Triangle>().push_back(make_triangle(a, b, c, m));
+        scene.of<Triangle>().push_back(make_triangle(a, c, d, m));
     }
     void sphere(Vec3 c, float r, int m) {
         Sphere s{};
         s.center = c;
         s.radius = r;
         s.material = m;
-        scene.spheres.push_back(s);
+        scene.of<Sphere>().push_back(s);
     }
     void light(Vec3 p, Vec3 intensity) {
         scene.has_light = true;
@@ -83,14 +83,15 @@ Scene scaled(const Scene& base, float s) {
     out.camera.look_at = base.camera.look_at * s;
     out.light.position = base.light.position * s;
     out.light.intensity = base.light.intensity * (s * s);
-    for (Sphere& sp : out.spheres) {
+    for (Sphere& sp : out.of<Sphere>()) {
         sp.center = sp.center * s;
         sp.radius *= s;
     }
-    for (Triangle& t : out.triangles) t = make_triangle(t.v0 * s, t.v1 * s, t.v2 * s, t.material);
-    for (ConvexQuad& q : out.quads)
+    for (Triangle& t : out.of<Triangle>())
+        t = make_triangle(t.v0 * s, t.v1 * s, t.v2 * s, t.material);
+    for (ConvexQuad& q : out.of<ConvexQuad>())
         q = make_convex_quad(q.v0 * s, q.v1 * s, q.v2 * s, q.v3 * s, q.material);
-    for (AxisRect& r : out.rects) {
+    for (AxisRect& r : out.of<AxisRect>()) {
         Vec3 corners[4];
         rect_corners(r, corners);
         for (Vec3& c : corners) c = c * s;
@@ -353,8 +354,8 @@ TEST(PathTracer, RenderPixelAveragesOverThePixel) {
     TestScene ts;
     const int black = ts.material(material_type<Diffuse>, Vec3(0.0f));
     const Vec3 a(-100, -100, -2), b(0, -100, -2), c(0, 100, -2), d(-100, 100, -2);
-    ts.scene.triangles.push_back(make_triangle(a, b, c, black));
-    ts.scene.triangles.push_back(make_triangle(a, c, d, black));
+    ts.scene.of<Triangle>().push_back(make_triangle(a, b, c, black));
+    ts.scene.of<Triangle>().push_back(make_triangle(a, c, d, black));
     ts.scene.background = Vec3(1.0f);
     const Camera cam = Camera::look_at({0, 0, 0}, {0, 0, -1}, {0, 1, 0}, 90.0f, 1, 1);
     RenderSettings rs;
@@ -424,9 +425,9 @@ TEST(PathTracer, ClosedBoxDoesNotLeak) {
             for (int f = 0; f < 6; ++f) {
                 const int m = f == 1 ? mirror : wall;
                 const int* q = faces[f];
-                ts.scene.triangles.push_back(
+                ts.scene.of<Triangle>().push_back(
                     make_triangle(corner[q[0]], corner[q[1]], corner[q[2]], m));
-                ts.scene.triangles.push_back(
+                ts.scene.of<Triangle>().push_back(
                     make_triangle(corner[q[0]], corner[q[2]], corner[q[3]], m));
             }
             ts.sphere((Vec3(0.3f, -0.4f, 0.2f) + offset) * scale, 0.3f * scale, glass);
