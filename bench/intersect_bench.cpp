@@ -69,13 +69,13 @@ struct Walls {
 const Walls& walls() {
     static const Walls w = [] {
         Walls out;
-        out.of<AxisRect>() = cornell().of<AxisRect>();
-        for (const AxisRect& r : out.of<AxisRect>()) {
+        out.rects = cornell().of<AxisRect>();
+        for (const AxisRect& r : out.rects) {
             Vec3 c[4];
             rect_corners(r, c);
-            out.of<ConvexQuad>().push_back(make_convex_quad(c[0], c[1], c[2], c[3], r.material));
-            out.of<Triangle>().push_back(make_triangle(c[0], c[1], c[2], r.material));
-            out.of<Triangle>().push_back(make_triangle(c[0], c[2], c[3], r.material));
+            out.quads.push_back(make_convex_quad(c[0], c[1], c[2], c[3], r.material));
+            out.triangles.push_back(make_triangle(c[0], c[1], c[2], r.material));
+            out.triangles.push_back(make_triangle(c[0], c[2], c[3], r.material));
         }
         return out;
     }();
@@ -84,7 +84,7 @@ const Walls& walls() {
 
 // One wall per iteration: a rectangle, a quad, or a quad's worth of triangles (two tests).
 void BM_intersect_triangle_pair(benchmark::State& state) {
-    const std::vector<Triangle>& tris = walls().of<Triangle>();
+    const std::vector<Triangle>& tris = walls().triangles;
     const std::vector<Ray> rays = sample_rays(4096);
     size_t i = 0;
     for (auto _ : state) {
@@ -99,7 +99,7 @@ void BM_intersect_triangle_pair(benchmark::State& state) {
 BENCHMARK(BM_intersect_triangle_pair);
 
 void BM_intersect_quad(benchmark::State& state) {
-    const std::vector<ConvexQuad>& quads = walls().of<ConvexQuad>();
+    const std::vector<ConvexQuad>& quads = walls().quads;
     const std::vector<Ray> rays = sample_rays(4096);
     size_t i = 0;
     for (auto _ : state) {
@@ -112,7 +112,7 @@ void BM_intersect_quad(benchmark::State& state) {
 BENCHMARK(BM_intersect_quad);
 
 void BM_intersect_rect(benchmark::State& state) {
-    const std::vector<AxisRect>& rects = walls().of<AxisRect>();
+    const std::vector<AxisRect>& rects = walls().rects;
     const std::vector<Ray> rays = sample_rays(4096);
     size_t i = 0;
     for (auto _ : state) {

@@ -155,7 +155,7 @@ inline Hit closest_hit(const SimdSceneView& scene, const Ray& ray) {
     const BroadcastRay r(ray);
     for (int i = 0; i < scene.num_sphere_packets; ++i) {
         const Float8 t_max = hit.t;
-        const Float8 t = intersect_spheres8(r, scene.of<Sphere>()[i], t_max);
+        const Float8 t = intersect_spheres8(r, scene.spheres[i], t_max);
         const int hits = (t < t_max).bits();
         if (hits == 0) continue;
         const int lane = nearest_lane(t, hits);
@@ -163,19 +163,19 @@ inline Hit closest_hit(const SimdSceneView& scene, const Ray& ray) {
     }
     for (int i = 0; i < scene.num_triangle_packets; ++i) {
         const Float8 t_max = hit.t;
-        const Float8 t = intersect_triangles8(r, scene.of<Triangle>()[i], t_max);
+        const Float8 t = intersect_triangles8(r, scene.triangles[i], t_max);
         const int hits = (t < t_max).bits();
         if (hits == 0) continue;
         const int lane = nearest_lane(t, hits);
         hit = {t.lane(lane), primitive_kind<Triangle>, i * kSimdWidth + lane};
     }
-    for (int i = 0; i < scene.of<ConvexQuad>().count; ++i) {
-        const float t = intersect_quad(ray, r.shear, scene.of<ConvexQuad>()[i], hit.t);
+    for (int i = 0; i < scene.num_quads; ++i) {
+        const float t = intersect_quad(ray, r.shear, scene.quads[i], hit.t);
         if (t < hit.t) hit = {t, primitive_kind<ConvexQuad>, i};
     }
     for (int i = 0; i < scene.num_rect_packets; ++i) {
         const Float8 t_max = hit.t;
-        const Float8 t = intersect_rects8(r, scene.of<AxisRect>()[i], t_max);
+        const Float8 t = intersect_rects8(r, scene.rects[i], t_max);
         const int hits = (t < t_max).bits();
         if (hits == 0) continue;
         const int lane = nearest_lane(t, hits);
@@ -190,16 +190,16 @@ inline bool occluded(const SimdSceneView& scene, const Ray& ray, float t_max) {
     const BroadcastRay r(ray);
     const Float8 limit = t_max;
     for (int i = 0; i < scene.num_sphere_packets; ++i) {
-        if (any(intersect_spheres8(r, scene.of<Sphere>()[i], limit) < limit)) return true;
+        if (any(intersect_spheres8(r, scene.spheres[i], limit) < limit)) return true;
     }
     for (int i = 0; i < scene.num_triangle_packets; ++i) {
-        if (any(intersect_triangles8(r, scene.of<Triangle>()[i], limit) < limit)) return true;
+        if (any(intersect_triangles8(r, scene.triangles[i], limit) < limit)) return true;
     }
-    for (int i = 0; i < scene.of<ConvexQuad>().count; ++i) {
-        if (intersect_quad(ray, r.shear, scene.of<ConvexQuad>()[i], t_max) < t_max) return true;
+    for (int i = 0; i < scene.num_quads; ++i) {
+        if (intersect_quad(ray, r.shear, scene.quads[i], t_max) < t_max) return true;
     }
     for (int i = 0; i < scene.num_rect_packets; ++i) {
-        if (any(intersect_rects8(r, scene.of<AxisRect>()[i], limit) < limit)) return true;
+        if (any(intersect_rects8(r, scene.rects[i], limit) < limit)) return true;
     }
     return false;
 }
