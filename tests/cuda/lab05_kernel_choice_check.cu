@@ -74,18 +74,22 @@ int main() {
     const Triangle triangle = make_triangle({1, 0, 0}, {1, 1, 0}, {1, 1, -1}, 0);
     const Sphere sphere{{0.5f, 0.2f, -0.5f}, 0.2f, 0};
     const Material material{};
-    SceneView scene{&sphere, 1, &triangle, 1, &quad, 1, &rect, 1, &material, 1, {}, false, {}};
+    SceneView scene{{}, &material, 1, {}, false, {}};
+    scene.of<Sphere>() = {&sphere, 1};
+    scene.of<Triangle>() = {&triangle, 1};
+    scene.of<ConvexQuad>() = {&quad, 1};
+    scene.of<AxisRect>() = {&rect, 1};
 
     const SceneInForm as_loaded(scene, GeometryForm::AsLoaded);
-    expect(as_loaded.view.of<AxisRect>().count == 1 && as_loaded.view.of<AxisRect>() == &rect &&
-               as_loaded.view.of<ConvexQuad>().count == 1 &&
-               as_loaded.view.of<Triangle>().count == 1,
-           "as loaded: the scene's own arrays");
+    expect(
+        as_loaded.view.of<AxisRect>().count == 1 && as_loaded.view.of<AxisRect>().items == &rect &&
+            as_loaded.view.of<ConvexQuad>().count == 1 && as_loaded.view.of<Triangle>().count == 1,
+        "as loaded: the scene's own arrays");
 
     const SceneInForm quads(scene, GeometryForm::Quads);
     expect(quads.view.of<AxisRect>().count == 0 && quads.view.of<ConvexQuad>().count == 2 &&
                quads.view.of<Triangle>().count == 1 && quads.view.of<Sphere>().count == 1 &&
-               quads.view.of<Triangle>() == &triangle,
+               quads.view.of<Triangle>().items == &triangle,
            "quads: the rectangle joins the quads, the rest stays");
     const ConvexQuad& from_rect = quads.view.of<ConvexQuad>()[1];
     const Vec3 n = rect_normal(rect);
