@@ -18,8 +18,13 @@
 enum class PrimitiveKind : int { None = 0 };
 
 template <class K>
-constexpr PrimitiveKind primitive_kind =
-    static_cast<PrimitiveKind>(kind_index<AllPrimitives, K> + 1);
+struct PrimitiveKindOf {
+    static_assert(has_kind<AllPrimitives, K>, "a primitive kind is one of AllPrimitives");
+    static constexpr PrimitiveKind value =
+        static_cast<PrimitiveKind>(kind_index<AllPrimitives, K> + 1);
+};
+template <class K>
+constexpr PrimitiveKind primitive_kind = PrimitiveKindOf<K>::value;
 
 using AnyGeometry = AllPrimitives;             // every scene: the default
 using BoxGeometry = Kinds<Sphere, AxisRect>;   // spheres and rectangles (Cornell)

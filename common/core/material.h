@@ -29,7 +29,12 @@ using AllMaterials = Kinds<Diffuse, Mirror, Glass>;
 enum class MaterialType : int {};
 
 template <class K>
-constexpr MaterialType material_type = static_cast<MaterialType>(kind_index<AllMaterials, K>);
+struct MaterialTypeOf {
+    static_assert(has_kind<AllMaterials, K>, "a material kind is one of AllMaterials");
+    static constexpr MaterialType value = static_cast<MaterialType>(kind_index<AllMaterials, K>);
+};
+template <class K>
+constexpr MaterialType material_type = MaterialTypeOf<K>::value;
 
 struct Material {
     MaterialType type;  // which BSDF: material_type<K> for a kind K of AllMaterials
