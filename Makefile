@@ -53,6 +53,12 @@ DOUBLE_BUILD      := $(BUILD)/double
 DOUBLE_LIB_OBJ    := $(LIB_OBJ:$(BUILD)/%=$(DOUBLE_BUILD)/%)
 DOUBLE_COMMON_OBJ := $(COMMON_OBJ:$(BUILD)/%=$(DOUBLE_BUILD)/%)
 
+# A lab binary is a real file that make leaves alone while it is up to date, and is linked
+# into a private file renamed over it: a grader running ./lab01-ref while another process
+# relinks it runs the old binary or the new one, never a half-written one ("Permission
+# denied", "Text file busy"). A link rule ends with $(INTO_TARGET) in place of -o $@.
+INTO_TARGET = -o $@.partial-$$$$ && mv -f $@.partial-$$$$ $@
+
 PHONY_EXTRA := variant
 PHONY_EXTRA += render grade handin check-nvcc bench-micro bench-cpu bench-serial count-work bench-precision
 PHONY_EXTRA += bench-simd bench-openmp bench-mpi extremes-report
@@ -61,7 +67,11 @@ PHONY_EXTRA += lint format gpu-figures
         clean
 .DEFAULT_GOAL := help
 
-help:
+# The staff section only where its targets work: the course repository, not a release (which
+# has no grading/release.py, no solutions to build every lab from).
+help: help-students $(if $(wildcard grading/release.py),help-staff)
+.PHONY: help-students help-staff
+help-students:
 	@echo "For students"
 	@echo "  make labNN        build your code for lab NN (labs/NN-name/skeleton) into ./labNN"
 	@echo "  make labNN-ref    lab NN's reference solution into ./labNN-ref"
@@ -80,7 +90,12 @@ help:
 	@echo "  make tradeoff     speed against accuracy: error vs time of every lab here, bias vs"
 	@echo "                    bounces, fast math, ray offsets (QUICK=1: CI size; PLOTS=0: no plots)"
 	@echo "  make lab05-bench  the lab-05 kernel shapes the handout measures (needs a GPU)"
+	@echo "  make kernel-report registers, spills, stack and shared memory of every CUDA kernel"
+	@echo "                    (needs nvcc, no GPU: your own kernels where the solution is not here)"
+	@echo "  make grade-gpu    no GPU here: grade LAB on the course's GPU machines (Slurm, from"
+	@echo "                    the course's login node); make run-gpu RUN='./lab05 ...' runs one"
 	@echo "                    labs: $(LAB_BINARIES)"
+help-staff:
 	@echo "For course staff"
 	@echo "  make release LAB=NN OUT=DIR  the student repository for lab NN (grading/README.md)"
 	@echo "  make gradescope LAB=NN       the Gradescope autograder zip for lab NN, in build/"
@@ -97,7 +112,6 @@ help:
 	@echo "  make extremes-report  the extreme scenes in float and double (docs/extremes.md's table)"
 	@echo "  make check-nvcc   compile every header of common/core for the GPU (needs nvcc)"
 	@echo "  make gpu-figures  the handouts' GPU tables from reference/gpu/h200/ (CHECK=1: compare)"
-	@echo "  make kernel-report registers, spills, stack and shared memory of every CUDA kernel"
 	@echo "  make gpu-check OUT=DIR  on a GPU machine: build, test and benchmark the CUDA labs"
 	@echo "  make tradeoff-gpu OUT=DIR  on a GPU machine: make tradeoff's GPU rows (no plots)"
 	@echo "  make golden       regenerate the golden images in reference/ (minutes)"
@@ -126,10 +140,9 @@ define cpu_lab
 $(BUILD)/labs/$(2)/skeleton/%.o: LAB_INCLUDES = -Ilabs/$(2)/skeleton
 $(BUILD)/labs/$(2)/solution/%.o: LAB_INCLUDES = -Ilabs/$(2)/solution
 $(1): $(patsubst %.cpp,$(BUILD)/%.o,$(wildcard labs/$(2)/skeleton/*.cpp)) $(COMMON_OBJ)
-	$(CXX) $(CXXFLAGS) $$^ -o $$@ $(3)
+	$(CXX) $(CXXFLAGS) $$^ $(3) $$(INTO_TARGET)
 $(1)-ref: $(patsubst %.cpp,$(BUILD)/%.o,$(wildcard labs/$(2)/solution/*.cpp)) $(COMMON_OBJ)
-	$(CXX) $(CXXFLAGS) $$^ -o $$@ $(3)
-.PHONY: $(1) $(1)-ref
+	$(CXX) $(CXXFLAGS) $$^ $(3) $$(INTO_TARGET)
 endef
 
 # The labs are declared once, in labs/labs.toml (DESIGN.md section 2); build/labs.mk is what
@@ -154,7 +167,7 @@ include grading/grading.mk
 $(DOUBLE_BUILD)/labs/01-serial/solution/%.o: LAB_INCLUDES = -Ilabs/01-serial/solution
 lab01-ref-double: $(patsubst %.cpp,$(DOUBLE_BUILD)/%.o,$(wildcard labs/01-serial/solution/*.cpp)) \
                   $(DOUBLE_COMMON_OBJ)
-	$(CXX) $(CXXFLAGS) $^ -o $@
+	$(CXX) $(CXXFLAGS) $^ $(INTO_TARGET)
 LAB_BINARIES += lab01-ref-double
 
 # A reference renders in double what float cannot place (common/host/double_twin.h): it links
@@ -335,12 +348,16 @@ bench-precision: lab01-ref lab01-ref-double
 # compiles DIR/*.cpp with DIR first on the include path (a header there stands in for the
 # shared one) and links the lab's driver into DIR/lab. Each lab.mk sets VARIANT_FLAGS_<lab>,
 # VARIANT_DRIVER_<lab> and VARIANT_LIBS_<lab> to what its own binaries are built with.
+# A hand-in's file names reach the shell quoted (the grader also refuses any outside
+# [A-Za-z0-9_.+-]): each word of $(1) in single quotes, a quote in it as '\''.
+quoted = $(foreach f,$(1),'$(subst ','\'',$(f))')
+
 variant: $(VARIANT_DRIVER_$(VARIANT_LAB))
 	@test -n "$(VARIANT)" -a -n "$(VARIANT_DRIVER_$(VARIANT_LAB))" || \
 	    { echo "variant: needs VARIANT=DIR and VARIANT_LAB=<a lab with VARIANT_DRIVER_<lab>>" >&2; exit 2; }
-	$(CXX) $(filter-out -MMD -MP,$(CXXFLAGS)) -w -I$(VARIANT) $(VARIANT_FLAGS_$(VARIANT_LAB)) \
-	    $(INCLUDES) $(sort $(wildcard $(VARIANT)/*.cpp)) $(VARIANT_DRIVER_$(VARIANT_LAB)) \
-	    -o $(VARIANT)/lab $(VARIANT_LIBS_$(VARIANT_LAB))
+	$(CXX) $(filter-out -MMD -MP,$(CXXFLAGS)) -w -I'$(VARIANT)' $(VARIANT_FLAGS_$(VARIANT_LAB)) \
+	    $(INCLUDES) $(call quoted,$(sort $(wildcard $(VARIANT)/*.cpp))) \
+	    $(VARIANT_DRIVER_$(VARIANT_LAB)) -o '$(VARIANT)/lab' $(VARIANT_LIBS_$(VARIANT_LAB))
 
 clean:
 	rm -rf $(BUILD) $(LAB_BINARIES) .pytest_cache

@@ -6,6 +6,8 @@
 #   make check-gpu-headers       every header of common/cuda and common/wavefront compiles alone
 #   make check-speed-targets     the benchmarks' speed-target verdicts, on the host (no GPU needed)
 #   make gpu-check OUT=DIR       on a GPU machine: build, test, benchmark, report (tools/gpu/check.sh)
+#   make grade-gpu [LAB=NN]      without a GPU: grade on the course's GPU machines through Slurm
+#   make run-gpu RUN='./lab05 ...'  without a GPU: run a command there through Slurm
 #   make tradeoff-gpu OUT=DIR    on a GPU machine: make tradeoff's GPU rows (tools/gpu/tradeoff.sh)
 #
 # The shared GPU code is on the include path of every CUDA build, after the lab's own folder:
@@ -86,8 +88,9 @@ cuda-variant: $(COMMON_OBJ)
 	    { echo "cuda-variant: needs VARIANT=DIR and VARIANT_LAB=<a CUDA lab folder: $(CUDA_LAB_FOLDERS)>" >&2; exit 2; }
 	@missing="$(filter-out $(notdir $(wildcard $(VARIANT)/*)),$(CUDA_STUDENT_FILES_$(VARIANT_LAB)))"; \
 	    test -z "$$missing" || { echo "error: $(VARIANT) has no $$missing: lab $(VARIANT_LAB)'s students write it" >&2; exit 2; }
-	$(NVCC) $(NVCCFLAGS) $(CUDA_ARCH) -I$(VARIANT) $(CUDA_SHARED_INCLUDES_$(VARIANT_LAB)) \
-	    $(CUDA_INCLUDES) $(INCLUDES) $(sort $(wildcard $(VARIANT)/*.cu)) $(COMMON_OBJ) -o $(VARIANT)/lab
+	$(NVCC) $(NVCCFLAGS) $(CUDA_ARCH) -I'$(VARIANT)' $(CUDA_SHARED_INCLUDES_$(VARIANT_LAB)) \
+	    $(CUDA_INCLUDES) $(INCLUDES) $(call quoted,$(sort $(wildcard $(VARIANT)/*.cu))) \
+	    $(COMMON_OBJ) -o '$(VARIANT)/lab'
 
 
 # Each shared GPU header compiles alone, for sm_90 with warnings as errors: it includes what
@@ -115,17 +118,44 @@ check-speed-targets: $(BUILD)/cuda/speed_targets_check
 # Each source gets the include path its own build uses.
 KERNEL_REPORT_ARCH = $(if $(CUDA_GPU_CAPS),sm_$(firstword $(CUDA_GPU_CAPS)),sm_90)
 KERNEL_REPORT_NVCC = $(NVCC) -std=c++17 -O3 -arch=$(KERNEL_REPORT_ARCH) -Xptxas -v
-kernel_report_compile = $(KERNEL_REPORT_NVCC) -Ilabs/$(1)/solution $(CUDA_SHARED_INCLUDES_$(1)) \
-    $(CUDA_INCLUDES) $(INCLUDES) -c labs/$(1)/$(2) -o $(BUILD)/kernel-report/$(3).o
+# A lab whose solution is not here (a student release) is reported from skeleton/: the
+# student's own kernels, compiled without a GPU.
+kernel_report_dir = $(if $(wildcard labs/$(1)/solution),solution,skeleton)
+kernel_report_compile = $(KERNEL_REPORT_NVCC) -Ilabs/$(1)/$(call kernel_report_dir,$(1)) \
+    $(CUDA_SHARED_INCLUDES_$(1)) $(CUDA_INCLUDES) $(INCLUDES) -c labs/$(1)/$(2) \
+    -o $(BUILD)/kernel-report/$(3).o
 kernel-report:
 	@mkdir -p $(BUILD)/kernel-report
 	@{ $(foreach n,$(GPU_LABS),\
-	       $(call kernel_report_compile,$(LAB_FOLDER_$(n)),solution/render.cu,lab$(n)) &&) \
-	   $(call kernel_report_compile,05-cuda-mega,bench.cu,lab05-bench); \
+	       $(call kernel_report_compile,$(LAB_FOLDER_$(n)),$(call kernel_report_dir,$(LAB_FOLDER_$(n)))/render.cu,lab$(n)) &&) \
+	   $(if $(wildcard labs/05-cuda-mega/solution),$(call kernel_report_compile,05-cuda-mega,bench.cu,lab05-bench),true); \
 	 } > $(BUILD)/kernel-report/ptxas.log 2>&1 || { cat $(BUILD)/kernel-report/ptxas.log; exit 1; }
 	@$(PYTHON) labs/05-cuda-mega/kernel_report.py $(BUILD)/kernel-report/ptxas.log \
 	    --arch $(KERNEL_REPORT_ARCH) --out $(BUILD)/kernel-report.md
 endif
+
+# Without a GPU of one's own: `make grade-gpu` grades lab LAB (`make grade` as here) and
+# `make run-gpu RUN='./lab05 --out quick.ppm'` runs a command, each as one Slurm job on the
+# course's GPU machines (one GPU, --gres=gpu:1), from this folder, which must be on a file system
+# they see (a checkout under your home on the course's login node, where sbatch is). It waits
+# for the job and prints its log (grade-gpu-JOB.log here, beside results.json and the images).
+# GPU_PARTITION, GPU_TIME (default 0:30:00), GPU_MEM (default 8G) and GPU_GRES (default
+# --gres=gpu:1) are the job's.
+GPU_TIME ?= 0:30:00
+GPU_MEM ?= 8G
+GPU_GRES ?= --gres=gpu:1
+.PHONY: grade-gpu run-gpu
+grade-gpu: RUN = $(MAKE) --no-print-directory grade LAB=$(LAB)
+grade-gpu run-gpu:
+	@test -n "$(RUN)" || { echo "run-gpu: needs RUN='command', e.g. RUN='./lab$(LAB) --out quick.ppm'" >&2; exit 2; }
+	@command -v sbatch >/dev/null || { echo "$@: no sbatch here: run it on the course's login node, where Slurm is (ssh there, then make $@ in your checkout)" >&2; exit 2; }
+	@echo "$@: one Slurm job on a GPU machine ($(GPU_GRES) --time=$(GPU_TIME) --mem=$(GPU_MEM)$(if $(GPU_PARTITION), --partition=$(GPU_PARTITION))); waiting for it (minutes if the queue is busy)"
+	@job=$$(sbatch --parsable --wait --job-name=$@-lab$(LAB) $(GPU_GRES) --time=$(GPU_TIME) \
+	    --mem=$(GPU_MEM) $(if $(GPU_PARTITION),--partition=$(GPU_PARTITION)) --chdir="$(CURDIR)" \
+	    --output="$(CURDIR)/$@-%j.log" --wrap='$(RUN)'); status=$$?; job=$${job%%;*}; \
+	    if [ -z "$$job" ]; then echo "$@: sbatch did not take the job (its error is above)" >&2; exit 2; fi; \
+	    cat "$@-$$job.log" 2>/dev/null; echo "$@: job $$job ended with status $$status; its log is $@-$$job.log"; \
+	    exit $$status
 
 # Everything a GPU machine should check, in one call: tools/gpu/check.sh OUT.
 OUT ?= $(BUILD)/gpu-check

@@ -8,22 +8,25 @@ with the same hidden scene; a CSV for the gradebook and an HTML page to read.
 SUBMISSIONS may be Gradescope's export of the assignment, unzipped as it comes
 (submission_<id>/ folders and submission_metadata.yml): grades.csv is then keyed by the
 export's submission ids and names each one's submitters. Otherwise SUBMISSIONS/<student>/
-holds either a lab binary named `lab` or the student's hand-in (its
-files, at the top or in one folder below: grading/handin.py finds them); SUBMISSIONS/
-<student>.zip is a hand-in zip as `make handin` writes it. REPORT/<student>/results.json is
-each student's results.json; REPORT/grades.csv and REPORT/report.html sum them up: per
-student the points, the provisional points apart (a check the machine was too busy to
-measure), the timed seconds, speedup and capacity, and the cause of a failure (compile
-error, crash, timeout, race, work split, which image check); a last row sums up the class and counts
-the flagged (provisional, or not graded for the machine's sake: regrade those on a quiet
-machine). Progress goes to stdout as `[k/N] name ...` with an estimate of the time left.
+holds the student's hand-in (its files, at the top or in one folder below: grading/handin.py
+finds them); SUBMISSIONS/<student>.zip is a hand-in zip as `make handin` writes it. A hand-in
+is graded from its sources, always: a program in it is never run (grading a built program is
+`python3 -m grading.grade --binary`, course staff's choice on their command line). A zip over
+the intake's limits, or one that cannot be read, is refused in one line, which becomes that
+student's cause; a metadata file that cannot be read costs the names, never the grades.
+REPORT/<student>/results.json is each student's results.json; REPORT/grades.csv and
+REPORT/report.html sum them up: per student the points, the provisional points apart (a check
+the machine was too busy to measure), the timed seconds, speedup and capacity, and the cause of
+a failure (compile error, crash, timeout, race, work split, which image check); a last row sums
+up the class and counts the flagged (provisional, or not graded for the machine's sake: regrade
+those on a quiet machine). Progress goes to stdout as `[k/N] name ...` with an estimate of the
+time left.
 """
 from __future__ import annotations
 
 import argparse
 import concurrent.futures
 import csv
-import html
 import json
 import os
 import pathlib
@@ -37,34 +40,71 @@ import threading
 import time
 import zipfile
 
-from grading import hidden
-from grading.grade import RUBRICS
+from grading import class_page, hidden, references, shown
+from grading.grade import BUDGET_SECONDS, RUBRICS
 from grading.speed_numbers import speed_numbers
 from labkit import gpu
 from labkit.harness import ROOT
 
+# A grade ends within the grader's budget (grade.BUDGET_SECONDS) plus a compile; a grader
+# still running well past it is stopped (SIGTERM: it writes its results and cleans up, then
+# SIGKILL), so that one hand-in never holds up the class.
+GRADER_SECONDS = BUDGET_SECONDS + 20 * 60
+STOP_GRACE_SECONDS = 60
+
+
+def grader_command(lab: str, folder: pathlib.Path, out: pathlib.Path, extra: list[str]) -> list:
+    return [sys.executable, "-m", "grading.grade", lab, "--sources", str(folder),
+            "--results", str(out / "results.json"), "--heatmaps", str(out / "heatmaps"), *extra]
+
 
 def grade_one(lab: str, folder: pathlib.Path, out: pathlib.Path, extra: list[str],
               env: dict) -> dict:
+    """One student's grade, from the hand-in's sources (anything else in it is named in
+    results.json and never run)."""
     out.mkdir(parents=True, exist_ok=True)
-    binary = folder / "lab"
-    what = ["--binary", str(binary)] if binary.is_file() else ["--sources", str(folder)]
     results = out / "results.json"
-    subprocess.run([sys.executable, "-m", "grading.grade", lab, *what, "--results", str(results),
-                    "--heatmaps", str(out / "heatmaps"), *extra],
-                   cwd=ROOT, env=env, stdout=(out / "grader.log").open("w"),
-                   stderr=subprocess.STDOUT)
+    stopped = ""
+    with (out / "grader.log").open("w") as log:
+        grader = subprocess.Popen(grader_command(lab, folder, out, extra), cwd=ROOT, env=env,
+                                  stdout=log, stderr=subprocess.STDOUT)
+        try:
+            grader.wait(timeout=GRADER_SECONDS)
+        except subprocess.TimeoutExpired:
+            stopped = f"the grader did not finish in {GRADER_SECONDS:g} s and was stopped"
+            grader.terminate()
+            try:
+                grader.wait(timeout=STOP_GRACE_SECONDS)
+            except subprocess.TimeoutExpired:
+                grader.kill()
+                grader.wait()
     try:
-        return json.loads(results.read_text())
+        graded = json.loads(results.read_text())
     except (OSError, ValueError) as e:  # the grader always writes one; say so if it did not
-        return {"score": 0, "output": f"the grader left no results.json: {e}", "tests": []}
+        graded = {"score": 0, "output": f"the grader left no results.json: {e}", "tests": []}
+    if stopped:  # said in results.json too, where a later merge reads it
+        graded["output"] = f"{stopped}\n{graded.get('output', '')}".rstrip()
+        results.write_text(json.dumps(graded, indent=2))
+    return graded
+
+
+def refused_results(lab: str, reason: str) -> dict:
+    """results.json's content for a hand-in refused before any grader ran (a zip over the
+    intake's limits): every check of the rubric 0, saying why; final, not flagged."""
+    from grading.results import Results, Test
+    results = Results()
+    results.add_all(Test(i.id, i.label, i.points, visibility=i.visibility) for i in RUBRICS[lab])
+    results.refuse(f"the hand-in was refused: {reason}")
+    return results.as_dict()
 
 
 # The cause of a failure, from what the failing check or the grader said: first match wins.
 CAUSES = [
+    ("timeout", re.compile(r"the grader did not finish in")),  # stopped by the batch
     ("no results", re.compile(r"left no results\.json")),
     ("compile error", re.compile(r"does not compile")),
     ("no hand-in", re.compile(r"the hand-in holds (none|lab)")),
+    ("refused", re.compile(r"the hand-in was refused")),
     ("timeout", re.compile(r"timed out")),
     ("work split", re.compile(r"deterministic but different")),
     ("race", re.compile(r"nondeterministic|data race|differs? for|differs from the serial")),
@@ -88,17 +128,28 @@ def flagged(results: dict) -> bool:
             or not results.get("tests"))
 
 
+def waiting(test: dict) -> bool:
+    """A check whose points wait for a gate and which lost none of its own: not run yet, or
+    run and passed ("not counted until ...; it saw: PASS ..."). The gate's verdict is the
+    cause, never a check that passed."""
+    output = test.get("output", "")
+    return output.startswith("not graded until") or (
+        output.startswith("not counted until") and "it saw: PASS" in output)
+
+
 def failure_cause(results: dict) -> str:
     """Why points were lost, in a few words, with the first failing check's words: the
     compiler's first error, a signal, a timeout, a race, which image check."""
     tests = results.get("tests", [])
     top = results.get("output", "")
-    failing = [t for t in tests if t.get("status") != "passed"
-               and not t.get("output", "").startswith("not graded until")]
+    failing = [t for t in tests if t.get("status") != "passed" and not waiting(t)]
     texts = [top] + [f"{t['name']}: {t.get('output', '')}" for t in failing]
     for cause, pattern in CAUSES:
         for text in texts:
             if pattern.search(text):
+                if cause == "refused":  # the grader's one line, once
+                    why = text.split("the hand-in was refused: ", 1)[1].splitlines()
+                    return f"refused: {why[0][:200] if why else ''}"
                 if cause == "compile error":  # the compiler's first line after the note
                     lines = top.splitlines()
                     at = next((i for i, line in enumerate(lines) if "does not compile" in line), 0)
@@ -114,6 +165,17 @@ def failure_cause(results: dict) -> str:
     return ""
 
 
+class CleanWriter:
+    """csv.writer whose every cell passes shown.cell: a name or a compiler's line that a
+    spreadsheet would run as a formula is shown as text."""
+
+    def __init__(self, f):
+        self.writer = csv.writer(f)
+
+    def writerow(self, cells) -> None:
+        self.writer.writerow([shown.cell(c) for c in cells])
+
+
 COLUMNS = ["student", "score", "max_score", "provisional_points", "flagged", "reference_s",
            "yours_s", "speedup", "capacity", "cause"]
 
@@ -126,7 +188,7 @@ def write_csv(path: pathlib.Path, lab: str, rows: dict[str, dict],
     names its submitters."""
     labels = [i.label for i in RUBRICS[lab]]
     with path.open("w", newline="") as f:
-        w = csv.writer(f)
+        w = CleanWriter(f)
         head = ["submission_id", "submitters"] if submitters is not None else []
         w.writerow([*head, *COLUMNS, *labels])
         for student, r in rows.items():
@@ -179,61 +241,56 @@ def summary_row(lab: str, rows: dict[str, dict], labels: list[str]) -> list:
     ]
 
 
-def write_html(path: pathlib.Path, lab: str, rows: dict[str, dict]) -> None:
-    labels = [i.label for i in RUBRICS[lab]]
-    e = html.escape
-    head = "".join(f"<th>{e(label)}</th>" for label in labels)
-    body = []
-    for student, r in rows.items():
-        by_name = {t["name"]: t for t in r.get("tests", [])}
-        cells = []
-        for label in labels:
-            t = by_name.get(label)
-            if t is None:
-                cells.append("<td></td>")
-                continue
-            cls = "regrade" if t.get("extra_data", {}).get("regrade") else t.get("status", "failed")
-            cells.append(f'<td class="{cls}" title="{e(t.get("output", ""))}">'
-                         f'{t["score"]}/{t["max_score"]}</td>')
-        note = e(r.get("output", "").splitlines()[0]) if r.get("output") else ""
-        # Each student's own page (images, heatmaps, what each check saw), where the grader
-        # wrote one: grading/report_html.py.
-        page = path.parent / student / "heatmaps" / "report.html"
-        name = (f'<a href="{e(student)}/heatmaps/report.html">{e(student)}</a>' if page.exists()
-                else e(student))
-        numbers = speed_numbers(r)
-        facts = "".join(f"<td>{e(numbers[k])}</td>" for k in ("yours_s", "speedup", "capacity"))
-        flag = " (flagged)" if flagged(r) else ""
-        body.append(f"<tr><th>{name}{flag}</th><td>{r.get('score', 0)}</td>"
-                    f"<td>{provisional_points(r) or ''}</td>{facts}{''.join(cells)}"
-                    f"<td>{e(failure_cause(r))}</td><td>{note}</td></tr>")
-    path.write_text(f"""<!doctype html><meta charset="utf-8"><title>Lab {lab} grades</title>
-<style>body{{font-family:sans-serif}} td,th{{padding:2px 8px;border:1px solid #ccc}}
-.passed{{background:#cfc}} .failed{{background:#fcc}} .regrade{{background:#ffc}}
-table{{border-collapse:collapse}}</style>
-<h1>Lab {lab}: {len(rows)} submissions, {sum(flagged(r) for r in rows.values())} flagged</h1>
-<p>Hover a cell for what the check saw; yellow: marked for regrade (machine too busy).</p>
-<table><tr><th>student</th><th>score</th><th>provisional</th><th>seconds</th><th>speedup</th>
-<th>capacity</th>{head}<th>cause</th><th>note</th></tr>
-{chr(10).join(body)}</table>
-""")
-
-
 EXPORT_METADATA = "submission_metadata.yml"
 
 
-def parse_export_metadata(text: str) -> dict[str, list[dict[str, str]]]:
-    """Gradescope's submission_metadata.yml: folder -> its submitters (":name", ":sid",
-    ":email" without the colons). With PyYAML where installed; else this subset of YAML,
-    which is all the export writes for the fields read here."""
-    try:
-        import yaml
-        data = yaml.safe_load(text) or {}
-        return {str(folder): [{str(k).lstrip(":"): str(v) for k, v in person.items()}
-                              for person in (meta or {}).get(":submitters", []) or []]
-                for folder, meta in data.items()}
-    except ImportError:
+class MetadataError(Exception):
+    """submission_metadata.yml cannot be read as a whole: one line."""
+
+
+MAX_METADATA_BYTES = 16 << 20  # an export of a few thousand submissions is a few MiB
+UNREADABLE = "(unreadable in submission_metadata.yml)"
+
+
+def _yaml_loader():
+    """PyYAML's safe loader, reading a tag it does not know (Ruby's, or a hostile
+    `!!python/...`) as an empty value instead of stopping: nothing is ever constructed."""
+    import yaml
+
+    class Loader(yaml.SafeLoader):
         pass
+    Loader.add_constructor(None, lambda loader, node: None)
+    return yaml, Loader
+
+
+def _submitters(meta) -> list[dict[str, str]] | None:
+    """One folder's submitters, or None where the entry is not what the export writes."""
+    people = meta.get(":submitters") if isinstance(meta, dict) else None
+    if not isinstance(people, list) or not all(
+            isinstance(p, dict) and all(isinstance(v, (str, int, float)) for v in p.values())
+            for p in people):
+        return None  # a list, a tag read as nothing, where text belongs
+    return [{str(k).lstrip(":"): str(v) for k, v in person.items()} for person in people]
+
+
+def parse_export_metadata(text: str) -> dict[str, list[dict[str, str]] | None]:
+    """Gradescope's submission_metadata.yml: folder -> its submitters (":name", ":sid",
+    ":email" without the colons), None for an entry that is not what the export writes.
+    With PyYAML where installed; else this subset of YAML, which is all the export writes for
+    the fields read here. MetadataError when the file as a whole cannot be read."""
+    try:
+        yaml, loader = _yaml_loader()
+    except ImportError:
+        yaml = None
+    if yaml is not None:
+        try:
+            data = yaml.load(text, Loader=loader) or {}
+        except (yaml.YAMLError, RecursionError, ValueError) as e:
+            raise MetadataError(f"not YAML: {shown.line(str(e).splitlines()[0])}") from None
+        if not isinstance(data, dict):
+            raise MetadataError(f"a {type(data).__name__} where a map of submission "
+                                f"folders belongs")
+        return {str(folder): _submitters(meta) for folder, meta in data.items()}
     found: dict[str, list[dict[str, str]]] = {}
     folder, person = None, None
     for line in text.splitlines():
@@ -257,9 +314,27 @@ def export_submitters(folder: pathlib.Path) -> dict[str, str] | None:
     path = folder / EXPORT_METADATA
     if not path.is_file():
         return None
-    return {name: "; ".join(f"{p.get('name', '')} <{p.get('email', '')}> ({p.get('sid', '')})"
-                            for p in people)
-            for name, people in parse_export_metadata(path.read_text()).items()}
+    try:
+        if path.stat().st_size > MAX_METADATA_BYTES:
+            raise MetadataError(f"larger than {MAX_METADATA_BYTES >> 20} MiB")
+        parsed = parse_export_metadata(path.read_text(errors="replace"))
+    except (MetadataError, OSError) as e:
+        # The grades do not depend on it: every submission folder is graded, without names.
+        print(f"warning: {path}: {e}; grading every submission_* folder without names",
+              file=sys.stderr)
+        return {entry.name if entry.is_dir() else entry.stem: UNREADABLE
+                for entry in sorted(folder.iterdir())
+                if entry.name.startswith("submission_") and (entry.is_dir() or
+                                                            entry.suffix == ".zip")}
+    bad = [name for name, people in parsed.items() if people is None]
+    if bad:
+        print(f"warning: {path}: {len(bad)} entries not as the export writes them "
+              f"({shown.line(', '.join(bad[:3]))}{' ...' if len(bad) > 3 else ''}); graded "
+              f"without names", file=sys.stderr)
+    return {name: UNREADABLE if people is None else
+            "; ".join(f"{p.get('name', '')} <{p.get('email', '')}> ({p.get('sid', '')})"
+                      for p in people)
+            for name, people in parsed.items()}
 
 
 def submission_id(folder_name: str) -> str:
@@ -285,19 +360,29 @@ def batch_secret(out: pathlib.Path) -> str:
     return secret
 
 
-def submissions(folder: pathlib.Path, unpacked: pathlib.Path) -> dict[str, pathlib.Path]:
+def submissions(folder: pathlib.Path, unpacked: pathlib.Path) -> dict[str, pathlib.Path | str]:
     """Student -> the folder to grade: SUBMISSIONS/<student>/, or SUBMISSIONS/<student>.zip
-    unpacked under `unpacked` (a zip that cannot be read becomes an empty folder, which the
-    grader then refuses, naming the files it lacks)."""
-    found = {}
+    unpacked under `unpacked`; or, for a zip refused (over the intake's limits, unreadable),
+    the one line saying why, which becomes that student's cause."""
+    found: dict[str, pathlib.Path | str] = {}
     for entry in sorted(folder.iterdir()):
+        if entry.is_symlink():  # it would grade whatever it points at: a solution, /
+            if entry.suffix == ".zip" or entry.is_dir():
+                found[entry.stem if entry.suffix == ".zip" else entry.name] = shown.line(
+                    f"{entry.name} is a symbolic link: hand in the folder or zip itself")
+            continue
         if entry.is_dir():
             found[entry.name] = entry
         elif entry.suffix == ".zip" and entry.is_file():
             target = unpacked / entry.stem
             if not target.is_dir():  # unpacked aside, then renamed: tasks running at once
                 partial = unpacked / f".{entry.stem}.partial-{os.getpid()}"
-                unzip(entry, partial)
+                try:
+                    unzip(entry, partial)
+                except ZipRefused as e:
+                    shutil.rmtree(partial, ignore_errors=True)
+                    found.setdefault(entry.stem, shown.line(f"{entry.name}: {e}"))
+                    continue
                 try:
                     os.rename(partial, target)
                 except OSError:  # another task's copy came first
@@ -306,22 +391,71 @@ def submissions(folder: pathlib.Path, unpacked: pathlib.Path) -> dict[str, pathl
     return found
 
 
+# A hand-in is a few source files of tens of KiB: a zip far beyond that is refused before it
+# fills the disk (a 1 MiB zip can unpack to 1 GiB).
+ZIP_MAX_BYTES = 64 << 20      # unpacked, all members together
+ZIP_MAX_MEMBERS = 4096
+ZIP_MAX_DEPTH = 16            # folders above a member
+ZIP_MAX_RATIO = 100           # unpacked to packed, once it unpacks to more than 1 MiB
+
+
+class ZipRefused(Exception):
+    """A hand-in zip that is not unpacked: one line."""
+
+
+def by_export(found: dict[str, pathlib.Path | str],
+              submitters: dict[str, str] | None) -> dict[str, pathlib.Path | str]:
+    """For a Gradescope export, the submissions its metadata lists, in name order (the order
+    Slurm's tasks count in); one it lists without a folder or zip is a row saying so."""
+    if submitters is None:
+        return found
+    return {name: found.get(name, "the export holds no folder or zip of this submission")
+            for name in sorted(submitters)}
+
+
 def unzip(archive: pathlib.Path, target: pathlib.Path) -> None:
-    """Unpack a hand-in zip into `target`: no absolute paths, no "..", nothing outside. A zip
-    that cannot be read leaves an empty folder, which the grader refuses, naming the files."""
+    """Unpack a hand-in zip into `target`: no absolute paths, no "..", nothing outside, and
+    within the limits above, checked on what the zip declares and again on the bytes it
+    actually unpacks (a header may lie). ZipRefused says which limit, or that it cannot be
+    read."""
     target.mkdir(parents=True, exist_ok=True)
     try:
         with zipfile.ZipFile(archive) as z:
-            for member in z.infolist():
+            members = z.infolist()
+            if len(members) > ZIP_MAX_MEMBERS:
+                raise ZipRefused(f"{len(members)} members, more than {ZIP_MAX_MEMBERS}")
+            declared = sum(m.file_size for m in members)
+            deepest = max((len(pathlib.PurePosixPath(m.filename).parts) - 1 for m in members),
+                          default=0)
+            if deepest > ZIP_MAX_DEPTH:
+                raise ZipRefused(f"a member {deepest} folders deep, more than {ZIP_MAX_DEPTH}")
+            if declared > ZIP_MAX_BYTES:
+                raise ZipRefused(f"unpacks to {declared >> 20} MiB, more than "
+                                 f"{ZIP_MAX_BYTES >> 20} MiB")
+            _check_ratio(declared, archive.stat().st_size)
+            written = 0
+            for member in members:
                 name = pathlib.PurePosixPath(member.filename)
                 if member.is_dir() or name.is_absolute() or ".." in name.parts:
                     continue
                 dest = target / name
                 dest.parent.mkdir(parents=True, exist_ok=True)
                 with z.open(member) as src, dest.open("wb") as dst:
-                    shutil.copyfileobj(src, dst, 1 << 20)
-    except (zipfile.BadZipFile, OSError):
-        pass
+                    while chunk := src.read(1 << 20):
+                        written += len(chunk)
+                        if written > ZIP_MAX_BYTES:
+                            raise ZipRefused(f"unpacks to more than {ZIP_MAX_BYTES >> 20} MiB")
+                        dst.write(chunk)
+            _check_ratio(written, archive.stat().st_size)
+    except (zipfile.BadZipFile, zipfile.LargeZipFile, NotImplementedError, EOFError,
+            ValueError, OSError, RuntimeError) as e:
+        raise ZipRefused(f"it cannot be read as a zip ({e})") from None
+
+
+def _check_ratio(unpacked: int, packed: int) -> None:
+    if unpacked > 1 << 20 and unpacked > ZIP_MAX_RATIO * max(packed, 1):
+        raise ZipRefused(f"it unpacks {unpacked // max(packed, 1)} times its size, more than "
+                         f"{ZIP_MAX_RATIO}")
 
 
 def previous(out: pathlib.Path, student: str) -> dict | None:
@@ -353,7 +487,7 @@ def gpu_indices() -> list[str]:
         if p.returncode == 0 else []
 
 
-def grade_all(lab: str, todo: list[str], found: dict[str, pathlib.Path], out: pathlib.Path,
+def grade_all(lab: str, todo: list[str], found: dict[str, pathlib.Path | str], out: pathlib.Path,
               extra: list[str], env: dict, rows: dict) -> None:
     """Grade `todo`, printing progress. A GPU lab on a host with several GPUs grades one
     submission per GPU at once (each grader sees one GPU: its speed is timed against the
@@ -371,21 +505,27 @@ def grade_all(lab: str, todo: list[str], found: dict[str, pathlib.Path], out: pa
         try:
             with lock:
                 where = f" on GPU {device}" if device is not None else ""
-                print(f"[{done[0] + 1}/{len(todo)}] {student}{where} ..."
+                print(f"[{done[0] + 1}/{len(todo)}] {shown.line(student)}{where} ..."
                       f"{eta(done[0], len(todo), time.monotonic() - start)}", flush=True)
             # The index counts as nvidia-smi does (PCI bus order), for CUDA and for the
             # sandbox, which shows this GPU's node only (labkit/gpu.py: assigned_node).
             local = env if device is None else {**env, "CUDA_VISIBLE_DEVICES": device,
                                                 "CUDA_DEVICE_ORDER": "PCI_BUS_ID"}
-            r = grade_one(lab, found[student], out / student, extra, local)
+            what = found[student]
+            if isinstance(what, str):  # refused at intake: its row says why, nothing runs
+                r = refused_results(lab, what)
+                (out / student).mkdir(parents=True, exist_ok=True)
+                (out / student / "results.json").write_text(json.dumps(r, indent=2))
+            else:
+                r = grade_one(lab, what, out / student, extra, local)
         finally:
             free.put(device)
         with lock:
             rows[student] = r
             done[0] += 1
             note = " (flagged)" if flagged(r) else ""
-            print(f"[{done[0]}/{len(todo)}] {student}: {r.get('score', 0)}/"
-                  f"{r.get('max_score', '')}{note} {failure_cause(r)}".rstrip(), flush=True)
+            print(shown.line(f"[{done[0]}/{len(todo)}] {student}: {r.get('score', 0)}/"
+                             f"{r.get('max_score', '')}{note} {failure_cause(r)}"), flush=True)
 
     if lanes == 1:
         for student in todo:
@@ -401,7 +541,8 @@ def write_report(out: pathlib.Path, lab: str, rows: dict[str, dict | None],
     rows = {s: r if r is not None else {"score": 0, "output": "not graded", "tests": []}
             for s, r in rows.items()}
     write_csv(out / "grades.csv", lab, rows, submitters)
-    write_html(out / "report.html", lab, rows)
+    class_page.write_html(out / "report.html", lab, rows, [i.label for i in RUBRICS[lab]],
+                          submitters)
     count = sum(flagged(r) for r in rows.values())
     print(f"wrote {out / 'grades.csv'} and {out / 'report.html'}: {len(rows)} students, "
           f"{count} flagged{' (regrade them: make grade-batch ... ONLY=flagged)' if count else ''}")
@@ -431,7 +572,13 @@ def main(argv=None) -> int:
         return 2
     # One secret for the batch, saved for regrades: every student gets the same hidden scene.
     env = {**os.environ, "GRADING_SECRET": batch_secret(a.out)}
-    extra = ["--run-seconds", str(a.run_seconds)] if a.run_seconds else []
+    # Graders run side by side (one per GPU, a Slurm array's tasks): none of them runs make.
+    # The references are built once, here (a Slurm array's by grading/slurm.py, before it
+    # submits), and never rewritten while a grade runs (grading/references.py).
+    extra = ["--no-build", *(["--run-seconds", str(a.run_seconds)] if a.run_seconds else [])]
+    if a.task is None and not a.merge and (line := references.build(a.lab)):
+        print(f"error: {line}", file=sys.stderr)
+        return 2
     submitters = export_submitters(a.submissions)
     # A task's zips are unpacked where every task and the merge see them; a whole batch's
     # in a temporary folder.
@@ -441,8 +588,7 @@ def main(argv=None) -> int:
     )
     try:
         found = submissions(a.submissions, unpacked)
-        if submitters is not None:  # a Gradescope export: its submissions, by its metadata
-            found = {name: folder for name, folder in found.items() if name in submitters}
+        found = by_export(found, submitters)
         rows = {student: previous(a.out, student) for student in found}
         if a.merge:
             write_report(a.out, a.lab, rows, submitters)

@@ -25,6 +25,7 @@ import dataclasses
 import functools
 import os
 import pathlib
+import re
 import tempfile
 import time
 
@@ -33,7 +34,7 @@ import numpy as np
 from grading import draws, hidden, report_html, symptoms
 from labkit import scenes
 from labkit.compare import GRADING_ALPHA, compare
-from labkit.harness import GOLDEN, ROOT, ImageError, golden, run_lab
+from labkit.harness import GOLDEN, ROOT, ImageError, golden, rerun_command, run_lab
 
 # The trusted renderer that makes golden data on the spot (the timed scene drawn for a grade).
 LAB01_REFERENCE = ROOT / "lab01-ref"
@@ -104,7 +105,40 @@ def check_golden(binary, scene: str, *, seed: int | None = None, spp: int = GOLD
     if heatmap_dir and run.image is not None:  # for the page (grading/report_html.py)
         report_html.write_images(heatmap_dir, scene, run.image, g.mean)
     hint = "" if report.passed else symptoms.named(run.image, g.mean)
-    return CheckResult(f"golden image '{scene}'", report.passed, report.summary() + hint)
+    cause = "" if report.passed else lanes_not_lab01(binary, launcher=launcher, threads=threads)
+    again = "" if report.passed else "; rerun: " + rerun_command(
+        binary, g.scene, launcher, ["--scene", str(g.scene),
+                                    *(["--threads", str(threads)] if threads else []),
+                                    "--width", str(g.meta["width"]), "--height",
+                                    str(g.meta["height"]), "--spp", str(spp), "--bounces",
+                                    str(g.meta["bounces"]), "--seed", str(seed), *extra,
+                                    "--pfm", "out.pfm"])
+    return CheckResult(f"golden image '{scene}'", report.passed,
+                       (f"{cause}; " if cause else "") + report.summary() + hint + again)
+
+
+def lanes_not_lab01(binary, **how) -> str:
+    """Lab 02's identified cause of a wrong image, "" elsewhere or where it does not apply:
+    every lane of a packet computes lab 01's path with lab 01's roundings (handout 02), so a
+    render whose bits differ from lab01-ref's on the public scene has lanes whose hit, miss
+    or bounce is not their own: a mask. Told before the comparison's statistics, whose "too
+    noisy" would otherwise point at a loop over paths lab 02 students never write."""
+    if symptoms.current_lab() != "02":
+        return ""
+    settings = dict(width=32, height=32, spp=8, seed=draws.seed("lanes"))
+    try:
+        want = run_lab(LAB01_REFERENCE, **settings).image
+        image = run_lab(binary, **settings, **how).image
+    except Exception:  # the check itself reports a crash or a bad image
+        return ""
+    if image.shape != want.shape or image.tobytes() == want.tobytes():
+        return ""
+    pixels = int(np.count_nonzero(np.any(image != want, axis=2)))
+    return (f"lanes: {pixels} of {want.shape[0] * want.shape[1]} pixels of the Cornell box "
+            f"are not lab 01's bits, which every lane computes exactly: a lane mask keeps a "
+            f"hit, a miss or a finished path for lanes it does not belong to (each intersect "
+            f"returns t only where the ray crosses the surface in front of t_max and inside "
+            f"it; a dead lane adds nothing)")
 
 
 def stored_golden_copied(image: np.ndarray) -> str | None:
@@ -530,6 +564,11 @@ BUSY = 1.9
 SERIAL_TELLABLE = 1.25
 QUOTA_TOO_SMALL = 1.5  # cores' worth of CPU (count or cgroup quota) below which nothing is timed
 ONE_THREAD = 0.9
+# A speedup this many times the capacity measured in the same rounds is impossible: a
+# program cannot get more from the cores than n copies of the serial reference do, beyond
+# noise and a faster serial path. One that does read something it had kept (its own first
+# render, another run's image) or slowed the reference: refused, never scored.
+IMPOSSIBLE = 1.5
 
 
 def busiest_thread_share(run) -> float:
@@ -543,12 +582,15 @@ def one_thread_did_it(shares: list[float]) -> bool:
     return bool(shares) and all(share >= ONE_THREAD for share in shares)
 
 
-def serial_by_thread(shares: list[float], where: str) -> CheckResult:
+def serial_by_thread(shares: list[float], where: str, timed: str = "") -> CheckResult:
+    """The verdict on a program whose one thread did the work; `timed`: what the timed runs
+    measured, where they ran (the class page shows those numbers beside the verdict)."""
     return CheckResult("parallel speedup", False,
                        f"serial: in every timed run one thread did at least {ONE_THREAD:.0%} "
                        f"of the CPU time ({min(shares):.0%} at the least; measured by the "
                        f"grader, thread by thread, {where}); a parallel program shares its work "
-                       f"among its threads", credit=0.0)
+                       f"among its threads" + (f" (timed: {timed})" if timed else ""),
+                       credit=0.0)
 
 
 @image_checked("parallel speedup")
@@ -654,9 +696,15 @@ def _parallel_speedup(binary, baseline, settings: dict, *, threads, launcher, fr
         if wrong:
             return CheckResult("parallel speedup", False,
                                f"{wrong[0]}: speed is graded only for a correct image", credit=0.0)
+        if timing.speedup("yours") > IMPOSSIBLE * timing.capacity:
+            return CheckResult("parallel speedup", False,
+                               f"impossible: {timing.describe('yours')}; more than "
+                               f"{IMPOSSIBLE:g} times the capacity no program can get from the "
+                               f"machine, so not a speedup: refused, no points", credit=0.0)
         if one_thread_did_it(shares):
             return serial_by_thread(shares, f"{max(used):.2f} cores' worth at most, on a "
-                                            f"machine giving {capacity:.2f}")
+                                            f"machine giving {capacity:.2f}",
+                                    f"{timing.describe('yours')}{note}")
         if not parallel() and capacity >= SERIAL_TELLABLE:
             return CheckResult("parallel speedup", False,
                                f"serial: the timed runs used at most {max(used):.2f} cores' "
@@ -716,7 +764,7 @@ def check_bitwise_equal(binary, baseline, *, runs=None) -> CheckResult:
                                "identical for " + ", ".join(runs))
         return CheckResult("bit-identical to lab 01", False,
                            f"differs for {', '.join(differing)}; "
-                           + why_different(binary, settings, runs, images, differing))
+                           + why_different(binary, settings, runs, images, differing, want))
 
 
 def row_ranges(rows: list[int]) -> str:
@@ -734,13 +782,21 @@ def rows_differing(a: np.ndarray, b: np.ndarray) -> list[int]:
     return [int(y) for y in np.nonzero(np.any((a != b).reshape(a.shape[0], -1), axis=1))[0]]
 
 
-def why_different(binary, settings: dict, runs: dict, images: dict, differing: list[str]) -> str:
-    """Tells the two causes of other bits apart by rendering twice more each way that
-    differed, the most threads or ranks first: renders that change from run to run at one
+def why_different(binary, settings: dict, runs: dict, images: dict, differing: list[str],
+                  want: np.ndarray | None = None) -> str:
+    """Tells the causes of other bits apart. Identified first: rows exactly black where lab
+    01's image (`want`) is not, rows never rendered or never gathered (lab 04's skeleton),
+    which would otherwise read as a work split below. Then, by rendering twice more each way
+    that differed, the most threads or ranks first: renders that change from run to run at one
     count (a data race, a generator shared by threads), or the same image every time that
     depends on the count (random numbers drawn by thread, rank or chunk instead of by pixel:
     how the work is split). A race need not show in every run, so every differing count is
     tried before an image is called deterministic."""
+    if want is not None:
+        for label in differing:
+            black = symptoms.black_rows(images[label], want)
+            if black:
+                return f"at {label}, {black}"
     for label in reversed(differing):
         first = images[label]
         again = [run_lab(binary, **settings, **runs[label]).image for _ in range(2)]
@@ -761,9 +817,61 @@ def why_different(binary, settings: dict, runs: dict, images: dict, differing: l
             f"rank or chunk, not by pixel?)")
 
 
-def mpirun(ranks: int) -> list[str]:
-    """The launcher for MPI labs; -q keeps mpirun's banners out of stderr."""
-    return ["mpirun", "-q", "--oversubscribe", "--bind-to", "none", "-np", str(ranks)]
+def mpirun(ranks: int, distribution: str | None = None, *env: str) -> list[str]:
+    """The launcher for MPI labs, RT_MPI_DISTRIBUTION set for every rank when `distribution`
+    is given and each NAME=VALUE of `env` too (the sandbox passes none of the grader's
+    environment on). Not -q: it would hide OpenMPI's own error text (MPI_ERR_TRUNCATE, a
+    rank that died), the cause a student needs; a run that succeeds prints no banner."""
+    cmd = ["mpirun", "--oversubscribe", "--bind-to", "none", "-np", str(ranks)]
+    for setting in ([f"RT_MPI_DISTRIBUTION={distribution}"] if distribution else []) + list(env):
+        cmd += ["-x", setting]
+    return cmd
+
+
+DISTRIBUTIONS = ("block", "interleaved", "dynamic")
+
+
+def report_rows(stderr: str) -> dict[int, set[int]]:
+    """RT_MPI_REPORT's lines ("rank 1: ... : rows 1,4,7-9"): {rank: the rows it rendered}."""
+    rows: dict[int, set[int]] = {}
+    for rank, ranges in re.findall(r"^rank (\d+): .*: rows (\S+)$", stderr, re.M):
+        rows[int(rank)] = set()
+        for part in ranges.split(","):
+            first, _, last = part.partition("-")
+            if first.isdigit() and (not last or last.isdigit()):
+                rows[int(rank)].update(range(int(first), int(last or first) + 1))
+    return rows
+
+
+def check_distributions(binary, ranks: int = 3, width: int = 16, height: int = 12) -> CheckResult:
+    """Lab 04's tasks 2 and 3, which the image cannot show (every distribution renders lab
+    01's bits, blocks included): the rows each rank rendered, as RT_MPI_REPORT lists them,
+    for `ranks` ranks: interleaved is every `ranks`-th row from the rank's own; dynamic is
+    not the fixed bands of block. Half the points each."""
+    bands = {r: set(range(height * r // ranks, height * (r + 1) // ranks)) for r in range(ranks)}
+    verdicts = []
+    for distribution in ("interleaved", "dynamic"):
+        run = run_lab(binary, width=width, height=height, spp=2,
+                      launcher=mpirun(ranks, distribution, "RT_MPI_REPORT=1"))
+        rows = report_rows(run.stderr)
+        if sorted(rows) != list(range(ranks)) or set().union(*rows.values()) != set(range(height)):
+            verdicts.append((False, f"{distribution}: RT_MPI_REPORT=1 does not list every "
+                                    f"row once among ranks 0-{ranks - 1}"))
+        elif distribution == "interleaved":
+            want = {r: set(range(r, height, ranks)) for r in range(ranks)}
+            verdicts.append((rows == want, f"interleaved: rank 1 rendered rows "
+                                           f"{row_ranges(sorted(rows[1]))}" + (
+                "" if rows == want else f", not {row_ranges(sorted(want[1]))} (rank r renders "
+                                        f"rows r, r + {ranks}, ...: task 2 undone?)")))
+        else:
+            verdicts.append((rows != bands, "dynamic: " + (
+                "rows handed out as ranks finish" if rows != bands else
+                "the rows were split into block's fixed bands (task 3, the master and its "
+                "workers, undone?)")))
+    passed = sum(ok for ok, _ in verdicts)
+    detail = f"{ranks} ranks, {width}x{height}: " + "; ".join(text for _, text in verdicts)
+    return CheckResult("rows per distribution", passed == len(verdicts), detail,
+                       credit=passed / len(verdicts))
 
 
 # ---- scenes far from the origin, and primitives far larger than the view -----------------

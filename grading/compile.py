@@ -44,17 +44,25 @@ def keep_binary(binary: pathlib.Path) -> pathlib.Path:
 
 
 def build_in_sandbox(variant_lab: str, handin: pathlib.Path, target: str = "variant",
-                     trusted: bool = False) -> tuple[pathlib.Path | None, str, str]:
+                     trusted: bool = False, files: dict[str, bytes] | None = None,
+                     tree_lab: str | None = None) -> tuple[pathlib.Path | None, str, str]:
     """Build the hand-in folder `handin` as `variant_lab` (e.g. 01-serial) with `make target`
     (cuda-variant for a CUDA lab): (binary, "", note) or (None, why, note). `why` is one line
     for a hand-in refused before compiling, else the compiler's output; `note` says which
-    expected files the skeleton's stubs stood in for."""
+    expected files the skeleton's stubs stood in for. `files` (already read from the hand-in)
+    and `tree_lab` (the lab whose students' tree it is built in) build a part of a lab
+    (grading/part_a.py: lab 02's Part A, variant 02-simd-a, in lab 02's tree)."""
     try:
-        files, missing = students_tree.collect(handin, variant_lab)
+        files, missing = (files, []) if files is not None else \
+            students_tree.collect(handin, variant_lab)
     except students_tree.HandInError as e:
-        return None, f"refused: {e}", ""
-    note = (f"not handed in, the skeleton's copy used: {', '.join(missing)}" if missing else "")
-    work = students_tree.stage(variant_lab, files, missing, target)
+        return None, f"refused: {e}", students_tree.ignored(handin)
+    note = "\n".join(line for line in (
+        students_tree.ignored(handin),  # programs and other files: never run, only named
+        f"not handed in, the skeleton's copy used: {', '.join(missing)}" if missing else "",
+    ) if line)
+    work = students_tree.stage(tree_lab or variant_lab, files, missing, target,
+                               variant_lab=variant_lab)
     try:
         tree, src = work / "tree", work / "tree" / "submission"
         # nvcc is found by its absolute path: the sandbox's PATH holds only the system's

@@ -23,6 +23,8 @@ release:
 	    { echo "release: needs LAB=NN and OUT=DIR" >&2; exit 2; }
 	@test -f grading/release.py || \
 	    { echo "release: made from the course repository; this is a release" >&2; exit 2; }
+	@$(PYTHON) -c 'import numpy' 2>/dev/null || \
+	    { echo "release: $(PYTHON) has no numpy: run make deps first (it installs what the grader needs)" >&2; exit 2; }
 	@$(PYTHON) -m grading.release '$(LAB)' '$(OUT)'
 
 # The driver objects a variant of VARIANT_LAB links, and nothing else: the grader builds them
@@ -39,10 +41,11 @@ cuda-variant-driver: $(COMMON_OBJ)
 .PHONY: test-gradescope
 test-gradescope:
 	PYTHONPATH=$(CURDIR) $(PYTHON) grading/gradescope/test_gradescope.py
-# make grade-slurm LAB=NN SUBMISSIONS=DIR [REPORT=DIR] [PARTITION=P]: the same as a Slurm job
-# array, one task per submission, and a merge job for grades.csv and report.html
-# (grading/slurm.py).
+# make grade-slurm LAB=NN SUBMISSIONS=DIR [REPORT=DIR] [PARTITION=P] [TIME=H:MM:SS] [MEM=4G]:
+# the same as a Slurm job array, one task per submission, and a merge job for grades.csv and
+# report.html (grading/slurm.py, which says its defaults); the tasks run $(PYTHON) by name.
 grade-slurm:
 	@test -n "$(SUBMISSIONS)" || { echo "grade-slurm: needs SUBMISSIONS=DIR" >&2; exit 2; }
 	@$(PYTHON) -m grading.slurm $(LAB) $(SUBMISSIONS) --out $(or $(REPORT),grades) \
-	    $(if $(PARTITION),--partition $(PARTITION))
+	    --python $(PYTHON) $(if $(PARTITION),--partition $(PARTITION)) \
+	    $(if $(TIME),--time $(TIME)) $(if $(MEM),--mem $(MEM))

@@ -83,6 +83,16 @@ def passes_when(lab: str, item: grade.Item) -> str:
         runs = options.get("runs")
         how = ", ".join(runs) if runs else default_bitwise_threads()
         return f"the image is `lab01-ref`'s bit for bit with {how}"
+    if item.id == "part-a":
+        return ("`./lab02a` (your `part-a/vec3.h` in lab 01's renderer) passes lab 01's sphere "
+                "interior, lit plane, glass pane and the hidden scene, a quarter of the points "
+                "each, once its Vec3 no longer says \"scalar fallback\" (the skeleton's, "
+                "correct but not SSE, earns none)")
+    if item.id == "distributions":
+        ranks = parameter(checks.check_distributions, "ranks")
+        return (f"with `RT_MPI_DISTRIBUTION=interleaved` rank r of {ranks} renders "
+                f"rows r, r + {ranks}, r + {2 * ranks}, ..., with `dynamic` the rows are not "
+                f"block's fixed bands (as `RT_MPI_REPORT=1` lists them); half the points each")
     if item.id == "parallel-speedup":
         fraction = parameter(checks.check_parallel_speedup, "fraction")
         who = ("`mpirun -np N` (N = the cores), 1 thread a rank" if launcher

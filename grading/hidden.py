@@ -36,6 +36,13 @@ TEST_SPP = 64
 # dilute; pooled variance keeps small blocks over 32 renders' golden data honest
 # (labkit/compare.py, "Small blocks and pooled variance").
 BLOCK_SIZES = (4, 8, 16)
+# A failed render is rendered once more with another seed, and the scene fails only when both
+# do. The glass ball's caustics (light seen through glass from a diffuse wall, which no light
+# sample reaches) put a rare bright path in some 4x4 block now and then, further in the tail
+# than the normal model and 32 golden renders allow: a correct renderer failed about once in a
+# few hundred secrets. A second failure of the same size is that chance squared; a wrong
+# renderer is as wrong under any seed, and a right image must still be rendered to pass.
+TEST_SEEDS = (7, 8)
 
 
 def new_secret() -> str:
@@ -124,20 +131,27 @@ def make_golden(reference, scene_path: pathlib.Path, size: int = SIZE,
 def check_hidden(binary, reference, secret: str, *, launcher=(), threads=None,
                  heatmap_dir: pathlib.Path | None = None):
     """The submission's render of the hidden scene against golden data made just now."""
-    from grading.checks import CheckResult, image_checked
+    from grading.checks import CheckResult, image_checked, lanes_not_lab01
 
     @image_checked("hidden scene")
     def run() -> CheckResult:
         with tempfile.TemporaryDirectory() as tmp:
             path = scenes.write_scene(pathlib.Path(tmp) / "scene.json", hidden_scene(secret))
             g = make_golden(reference, path)
-            image = run_lab(binary, path, width=SIZE, height=SIZE, bounces=BOUNCES, spp=TEST_SPP,
-                            seed=7, launcher=launcher, threads=threads).image
-        heatmap = heatmap_dir / "hidden-diff.png" if heatmap_dir else None
-        report = compare(image, TEST_SPP, g.mean, g.variance, g.golden_spp, heatmap_path=heatmap,
-                         block_sizes=BLOCK_SIZES, pooled_variance=True, alpha=GRADING_ALPHA)
+            heatmap = heatmap_dir / "hidden-diff.png" if heatmap_dir else None
+            for seed in TEST_SEEDS:
+                image = run_lab(binary, path, width=SIZE, height=SIZE, bounces=BOUNCES,
+                                spp=TEST_SPP, seed=seed, launcher=launcher, threads=threads).image
+                report = compare(image, TEST_SPP, g.mean, g.variance, g.golden_spp,
+                                 heatmap_path=heatmap, block_sizes=BLOCK_SIZES,
+                                 pooled_variance=True, alpha=GRADING_ALPHA)
+                if report.passed:
+                    break
         hint = "" if report.passed else symptoms.named(image, g.mean)
-        return CheckResult("hidden scene", report.passed, report.summary() + hint)
+        cause = "" if report.passed else lanes_not_lab01(binary, launcher=launcher,
+                                                         threads=threads)
+        return CheckResult("hidden scene", report.passed,
+                           (f"{cause}; " if cause else "") + report.summary() + hint)
     return run()
 
 

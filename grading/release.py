@@ -26,6 +26,7 @@ import signal
 import subprocess
 import sys
 import textwrap
+import time
 
 from grading import handin, leaks, reference_bins
 from grading.gradescope import repository_files
@@ -98,7 +99,14 @@ def add_references(stage: pathlib.Path, lab: str, files: list[str]) -> list[str]
     a GPU one is left out, saying so, where it cannot."""
     targets = [t for number, names in reference_bins.REFERENCES.items() if number >= lab
                for t in names]
+    fresh = not any(reference_bins.MIRROR.glob("obj-*"))
+    print(f"release: building {len(targets)} reference binaries for any x86-64 CPU in "
+          f"{reference_bins.MIRROR.relative_to(ROOT)}"
+          + (" (the first release compiles every reference and, with nvcc, every GPU "
+             "architecture: minutes; later releases relink)" if fresh else ""), flush=True)
+    start = time.monotonic()
     built, log = reference_bins.build(targets, files, stage / leaks.REFERENCE_BIN)
+    print(f"release: built {len(built)} in {time.monotonic() - start:.0f} s", flush=True)
     missing = [t for t in targets if t not in built]
     gpu = {t for number in reference_bins.GPU_LABS for t in reference_bins.REFERENCES[number]}
     cpu_missing = [t for t in missing if t not in gpu]
@@ -109,6 +117,26 @@ def add_references(stage: pathlib.Path, lab: str, files: list[str]) -> list[str]
         print(f"release: left out {', '.join(missing)} (the CUDA toolkit is missing or the "
               f"build failed); those labs ship without a reference binary", file=sys.stderr)
     return sorted(built)
+
+
+def no_gpu_section(lab: str) -> str:
+    """What a student of a GPU lab does without an NVIDIA GPU of their own (cuda.mk)."""
+    return f"""
+**No NVIDIA GPU here?** Lab {lab} renders on one, but most of the work does not need it:
+
+```sh
+make lab{lab}                # compiles your code where nvcc is; it runs only on a GPU
+make kernel-report        # your kernels' registers, spills, stack: build/kernel-report.md
+make grade-gpu            # on the course's login node: make grade on a GPU machine (Slurm)
+```
+
+`make grade-gpu` submits one Slurm job (one GPU) from this folder, which must be a checkout
+the GPU machines see (your home on the course's login node, where `sbatch` is), waits for it
+(minutes when the queue is busy) and prints the score table; `results.json` and the images
+land here. `make run-gpu RUN='./lab{lab} --width 128 --height 128 --spp 16 --out quick.ppm'`
+runs any command there the same way (write `$$` for a `$` in RUN). Without a GPU, `make
+grade` itself says so in one line and marks every check for regrade: nothing is scored.
+"""
 
 
 def student_readme(lab: str, folders: dict[str, str], prebuilt: list[str]) -> str:
@@ -134,8 +162,8 @@ exactly these files with this repository's `common/`.
 make deps                 # install what the labs need (compiler libraries, OpenMPI, pytest, numpy)
 {build:<25} # build your code into ./lab{lab}
 {try_it}
-make grade                # the autograder's checks on your code: a score table and results.json
-make test                 # the unit tests of common/ and the public tests
+make grade                # the autograder's checks: a score table, results.json (up to minutes)
+make test                 # the unit tests of common/ and the public tests (minutes)
 make render               # the Cornell box with the fastest reference here, into cornell.ppm
 make handin               # handin-lab{lab}.zip: the files to upload to Gradescope
 make help                 # every command
@@ -143,7 +171,7 @@ make help                 # every command
 
 `make grade` grades lab {lab} (add `LAB=NN` for another); it builds `./lab{lab}` first and
 writes `results.json` and, where an image check fails, `grading-heatmaps/report.html`.
-
+{no_gpu_section(lab) if registry.lab(lab).gpu else ""}
 What else is here:
 - the reference binaries of lab {lab} and later, prebuilt for x86-64 Linux in
   `reference-bin/`, which any `make` copies to the top of this folder (`./lab{lab}-ref`); run

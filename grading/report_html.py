@@ -6,11 +6,11 @@ the grader was given for heatmaps (`--heatmaps`; `make grade-batch` gives each s
 """
 from __future__ import annotations
 
-import html
 import pathlib
 
 import numpy as np
 
+from grading import shown
 from labkit.heatmap import heatmap_scale, write_png
 
 
@@ -32,7 +32,7 @@ def write_images(folder: pathlib.Path, scene: str, yours: np.ndarray, golden: np
 
 def write_report(folder: pathlib.Path, lab: str, who: str, results: dict) -> pathlib.Path:
     """`folder/report.html` from a grade's results.json content and the images in `folder`."""
-    e = html.escape
+    e = shown.html  # every string here may come from the submission
     rows = []
     for t in results.get("tests", []):
         state = "regrade" if t.get("extra_data", {}).get("regrade") else t.get("status", "failed")

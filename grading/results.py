@@ -14,6 +14,7 @@ import pathlib
 import tempfile
 import time
 
+from grading import shown
 from grading.speed_numbers import leaderboard
 
 # Gradescope shows the output of a test as is; a submission's stderr must not make it huge.
@@ -49,7 +50,9 @@ class Test:
         output and extra_data, never in the score)."""
         if provisional:
             output = f"{output} (+{provisional} if the regrade confirms)"
-        self.score, self.output, self.seconds = score, clip(output), seconds
+        # What a check saw quotes the submission (its stderr, the compiler): cleaned here,
+        # before results.json, a terminal or a page shows it (grading/shown.py).
+        self.score, self.output, self.seconds = score, clip(shown.clean(output)), seconds
         self.finished, self.regrade, self.ok = True, regrade, ok
         self.provisional = provisional if regrade else 0
 
@@ -128,7 +131,7 @@ class Results:
         d = {"score": sum(t.score for t in self.tests),
              "max_score": sum(t.max_score for t in self.tests),
              "execution_time": round(time.perf_counter() - self.start, 3),
-             "output": "\n".join(self.notes), "visibility": "visible",
+             "output": shown.clean("\n".join(self.notes)), "visibility": "visible",
              "sandbox": self.sandbox,
              "tests": [t.as_dict() for t in self.tests]}
         board = leaderboard(d)  # labs 02-07, once their speed was measured on a correct image

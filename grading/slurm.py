@@ -1,7 +1,9 @@
 """A class graded as a Slurm job array, where it outgrows one machine.
 
-    make grade-slurm LAB=NN SUBMISSIONS=DIR [REPORT=DIR] [PARTITION=P]
-    python3 -m grading.slurm NN SUBMISSIONS --out REPORT [--partition P] [--no-submit]
+    make grade-slurm LAB=NN SUBMISSIONS=DIR [REPORT=DIR] [PARTITION=P] [TIME=H:MM:SS]
+                     [MEM=SIZE] [PYTHON=python3]
+    python3 -m grading.slurm NN SUBMISSIONS --out REPORT [--partition P] [--time T] [--mem M]
+                             [--python NAME] [--no-submit]
 
 One array task per submission (`python3 -m grading.batch ... --task K`: the K-th in name
 order, in its own grader process, in the sandbox, with the batch's hidden-scene secret that
@@ -9,9 +11,15 @@ this step saves in REPORT before anything is submitted), then a merge job that r
 task has ended, however it ended (`--dependency=afterany`), and writes grades.csv and
 report.html from the tasks' results.json (`--merge`). Each task asks for one whole node
 (`--exclusive`): CPU labs are graded on speed, which another grade on the same cores would
-distort. The scripts are written to REPORT (grade-array.sbatch, merge.sbatch) and submitted
-with sbatch, whose job ids are printed; --no-submit only writes them. The repository must be
-on a file system every node sees (it is each task's working directory).
+distort. Each task asks for --time (default TIME, one hour: a grade's own budget is 40
+minutes) and --mem (default MEM, 4G), on --partition where given (else the cluster's
+default); the scripts call Python by name (--python, default python3, found on the node's
+PATH), never by this machine's absolute path. What was asked is printed and written at the
+top of each script. The references are built here once, before anything is submitted; the
+tasks grade with --no-build (grading/references.py). The scripts are written to REPORT
+(grade-array.sbatch, merge.sbatch) and submitted with sbatch, whose job ids are printed;
+--no-submit only writes them. The repository must be on a file system every node sees (it
+is each task's working directory).
 """
 from __future__ import annotations
 
@@ -24,39 +32,58 @@ import subprocess
 import sys
 import tempfile
 
-from grading import batch
+from grading import batch, references, shown
 from grading.grade import RUBRICS
 from labkit.harness import ROOT
 
 
 def count(submissions: pathlib.Path, out: pathlib.Path) -> int:
     found = batch.submissions(submissions, out / ".unpacked")
-    listed = batch.export_submitters(submissions)
-    return len([s for s in found if listed is None or s in listed])
+    return len(batch.by_export(found, batch.export_submitters(submissions)))
+
+
+DEFAULT_TIME = "01:00:00"
+DEFAULT_MEM = "4G"
+DEFAULT_PYTHON = "python3"
+
+
+def asked(partition: str | None, time_limit: str, mem: str, python: str) -> str:
+    """What the scripts ask of Slurm, in one line, and how to change it."""
+    return (f"each task: --time={time_limit} --mem={mem} "
+            f"{f'--partition={partition}' if partition else '(the default partition)'}, "
+            f"{python} on the node's PATH (make grade-slurm TIME= MEM= PARTITION= PYTHON= "
+            f"change them)")
 
 
 def scripts(lab: str, submissions: pathlib.Path, out: pathlib.Path, n: int,
-            partition: str | None, run_seconds: float | None) -> tuple[str, str]:
+            partition: str | None, run_seconds: float | None, time_limit: str = DEFAULT_TIME,
+            mem: str = DEFAULT_MEM, python: str = DEFAULT_PYTHON) -> tuple[str, str]:
     """(the array job's script, the merge job's script)."""
-    q = shlex.quote
-    part = f"#SBATCH --partition={partition}\n" if partition else ""
+    # Paths on a directive line stay on it (a newline would add a directive of its own):
+    # one cleaner for everything shown or run (grading/shown.py).
+    def q(text: object) -> str:
+        return shlex.quote(shown.line(text))
+    out_line = shown.line(str(out))
+    part = f"#SBATCH --partition={shown.line(partition)}\n" if partition else ""
+    part += f"#SBATCH --time={shown.line(time_limit)}\n#SBATCH --mem={shown.line(mem)}\n"
+    part += f"# {shown.line(asked(partition, time_limit, mem, python))}\n"
     extra = f" --run-seconds {run_seconds:g}" if run_seconds else ""
     common = (f"cd {q(str(ROOT))}\n"
-              f"{q(sys.executable)} -m grading.batch {lab} {q(str(submissions))} "
+              f"{q(python)} -m grading.batch {lab} {q(str(submissions))} "
               f"--out {q(str(out))}{extra}")
     array = f"""#!/bin/bash
 #SBATCH --job-name=grade-lab{lab}
 #SBATCH --array=0-{n - 1}
 #SBATCH --exclusive
 #SBATCH --nodes=1
-#SBATCH --output={out}/slurm-%A_%a.log
+#SBATCH --output={out_line}/slurm-%A_%a.log
 {part}# One submission per task: the K-th in name order (grading/slurm.py).
 {common} --task "$SLURM_ARRAY_TASK_ID"
 """
     merge = f"""#!/bin/bash
 #SBATCH --job-name=grade-lab{lab}-merge
 #SBATCH --nodes=1
-#SBATCH --output={out}/slurm-merge-%j.log
+#SBATCH --output={out_line}/slurm-merge-%j.log
 {part}# grades.csv and report.html from every task's results.json (grading/slurm.py).
 {common} --merge
 """
@@ -77,6 +104,10 @@ def main(argv=None) -> int:
     p.add_argument("--out", type=pathlib.Path, default=pathlib.Path("grades"))
     p.add_argument("--partition")
     p.add_argument("--run-seconds", type=float)
+    p.add_argument("--time", default=DEFAULT_TIME, help=f"each task's --time ({DEFAULT_TIME})")
+    p.add_argument("--mem", default=DEFAULT_MEM, help=f"each task's --mem ({DEFAULT_MEM})")
+    p.add_argument("--python", default=DEFAULT_PYTHON,
+                   help=f"the Python the tasks run, by name ({DEFAULT_PYTHON})")
     p.add_argument("--no-submit", action="store_true", help="write the scripts only")
     a = p.parse_args(argv)
     submissions, out = a.submissions.absolute(), a.out.absolute()
@@ -87,12 +118,18 @@ def main(argv=None) -> int:
         print("error: grade-slurm: no sbatch here (Slurm's client, Debian's slurm-client); "
               "--no-submit writes the scripts only", file=sys.stderr)
         return 2
+    line = references.build(a.lab)  # built once: the tasks run with --no-build, side by side
+    if line:
+        print(f"error: grade-slurm: {line}", file=sys.stderr)
+        return 2
     batch.batch_secret(out)  # saved before any task starts: all of them read it
     n = count(submissions, out)
     if n == 0:
         print(f"error: grade-slurm: no submissions in {submissions}", file=sys.stderr)
         return 2
-    array, merge = scripts(a.lab, submissions, out, n, a.partition, a.run_seconds)
+    array, merge = scripts(a.lab, submissions, out, n, a.partition, a.run_seconds,
+                           a.time, a.mem, a.python)
+    print(asked(a.partition, a.time, a.mem, a.python))
     paths = []
     for name, text in (("grade-array.sbatch", array), ("merge.sbatch", merge)):
         with tempfile.NamedTemporaryFile("w", dir=out, delete=False, suffix=".partial") as f:

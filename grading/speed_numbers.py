@@ -13,7 +13,8 @@ SPEED_CHECKS = ("parallel-speedup", "speedup", "speed")
 SPEED = re.compile(r"(?P<speedup>\d+(?:\.\d+)?)x (?:over the serial reference )?"
                    r"\((?P<reference>\d+(?:\.\d+)?) s -> (?P<yours>\d+(?:\.\d+)?) s")
 CAPACITY = re.compile(r"giving (?P<capacity>\d+(?:\.\d+)?)x capacity|"
-                      r"gave only (?P<busy>\d+(?:\.\d+)?) cores")
+                      r"gave only (?P<busy>\d+(?:\.\d+)?) cores|"
+                      r"machine giving (?P<serial>\d+(?:\.\d+)?)")  # a serial verdict's
 
 
 def speed_numbers(results: dict) -> dict[str, str]:
@@ -28,7 +29,7 @@ def speed_numbers(results: dict) -> dict[str, str]:
             found.update(reference_s=m["reference"], yours_s=m["yours"], speedup=m["speedup"])
         c = CAPACITY.search(t.get("output", ""))
         if c:
-            found["capacity"] = c["capacity"] or c["busy"]
+            found["capacity"] = c["capacity"] or c["busy"] or c["serial"]
         for key, name in (
             ("reference_seconds", "reference_s"),
             ("seconds_reference", "reference_s"),

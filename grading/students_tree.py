@@ -17,6 +17,10 @@ build/ are the references'. So a submission is compiled in a students' tree made
 - the submission's files, read without following links (`collect`), above the pristine
   skeleton: a file the lab expects that the hand-in lacks is the skeleton's stub, and a
   hand-in holding none of the expected files is refused in one line that names them.
+
+A hand-in is sources and nothing else: a program or any other file in it is never run or
+built, only named in one line (`ignored`); and a source's name is data, never code: one
+outside `PLAIN_NAME` is refused before it reaches the build's command line.
 """
 from __future__ import annotations
 
@@ -25,17 +29,21 @@ import importlib
 import importlib.util
 import os
 import pathlib
+import re
 import shutil
 import stat
 import subprocess
 import tempfile
 
+from grading import shown
 from labkit.harness import ROOT
 
 SOURCE_SUFFIXES = (".cpp", ".h", ".hpp", ".cu", ".cuh")
 MAX_FILE_BYTES = 1 << 20      # a source file of a lab is tens of KiB
 MAX_FILES = 64                # source files taken from the chosen folder
 MAX_WALK_ENTRIES = 20000      # entries looked at while searching a hand-in
+# The names a built file may have: the build globs them into a compiler's command line.
+PLAIN_NAME = re.compile(r"[A-Za-z0-9_.+-]+")
 
 class HandInError(Exception):
     """A hand-in that cannot be built as it is: one line for the student."""
@@ -92,21 +100,22 @@ def expected_files(lab_folder: str) -> list[str]:
 
 # ---- reading a hand-in --------------------------------------------------------------------
 
-def read_regular(path: pathlib.Path, shown: str) -> bytes:
+def read_regular(path: pathlib.Path, where: str) -> bytes:
     """A regular file's bytes, never through a link (O_NOFOLLOW on the file; its folders were
     reached by a walk that does not follow links either)."""
+    where = shown.line(where)
     try:
         fd = os.open(path, os.O_RDONLY | os.O_NOFOLLOW | os.O_NONBLOCK | os.O_CLOEXEC)
     except OSError as e:
         if os.path.islink(path):
-            raise HandInError(f"{shown} is a symbolic link: hand in the file itself") from None
-        raise HandInError(f"{shown} cannot be read: {e.strerror}") from None
+            raise HandInError(f"{where} is a symbolic link: hand in the file itself") from None
+        raise HandInError(f"{where} cannot be read: {e.strerror}") from None
     with os.fdopen(fd, "rb") as f:
         if not stat.S_ISREG(os.fstat(fd).st_mode):
-            raise HandInError(f"{shown} is not a regular file")
+            raise HandInError(f"{where} is not a regular file")
         data = f.read(MAX_FILE_BYTES + 1)
     if len(data) > MAX_FILE_BYTES:
-        raise HandInError(f"{shown} is larger than {MAX_FILE_BYTES >> 10} KiB")
+        raise HandInError(f"{where} is larger than {MAX_FILE_BYTES >> 10} KiB")
     return data
 
 
@@ -148,14 +157,65 @@ def collect(handin: pathlib.Path, lab_folder: str) -> tuple[dict[str, bytes], li
         raise HandInError(f"no file of lab {lab_number(lab_folder)} was handed in: "
                           f"expected {', '.join(expected)}")
     folder, names = ranked[0]
+    for name in names:
+        if not PLAIN_NAME.fullmatch(name):
+            raise HandInError(f"the file name {shown.line(repr((folder / name).as_posix()))} "
+                              f"may hold only letters, digits and _ . + -: rename it")
     if len(names) > MAX_FILES:
-        raise HandInError(f"{folder.as_posix() or 'the hand-in'} holds {len(names)} source "
-                          f"files; at most {MAX_FILES} are built")
+        where = shown.line(folder.as_posix()) if folder.parts else "the hand-in"
+        raise HandInError(f"{where} holds {len(names)} source files; at most {MAX_FILES} "
+                          f"are built")
     files = {}
     for name in names:
-        shown = (folder / name).as_posix()
-        files[name] = read_regular(handin / folder / name, shown)
+        files[name] = read_regular(handin / folder / name, (folder / name).as_posix())
     return files, [n for n in expected if n not in files]
+
+
+def _looks_executable(path: str, mode: int) -> bool:
+    """Executable bits, or a program's first bytes (a zip keeps no mode): ELF, a script."""
+    if mode & 0o111:
+        return True
+    try:
+        fd = os.open(path, os.O_RDONLY | os.O_NOFOLLOW | os.O_NONBLOCK | os.O_CLOEXEC)
+    except OSError:
+        return False
+    with os.fdopen(fd, "rb") as f:
+        return f.read(4).startswith((b"\x7fELF", b"#!"))
+
+
+def _listed(names: list[str], most: int = 5) -> str:
+    more = f" and {len(names) - most} more" if len(names) > most else ""
+    return ", ".join(names[:most]) + more
+
+
+def ignored(handin: pathlib.Path) -> str:
+    """One line naming what the hand-in holds besides sources (programs first), none of which
+    is run or built; "" when it holds nothing else. Build products, version control and
+    hidden folders are passed over, as the search for sources passes them."""
+    programs, others, seen = [], [], 0
+    for dirpath, dirs, files in os.walk(handin, followlinks=False):
+        dirs[:] = sorted(d for d in dirs if not os.path.islink(os.path.join(dirpath, d))
+                         and not d.startswith(".") and d not in ("build", "__MACOSX"))
+        seen += len(dirs) + len(files)
+        if seen > MAX_WALK_ENTRIES:  # the search for sources refuses such a hand-in
+            break
+        for name in sorted(files):
+            if n_is_source(name) or name.startswith("."):
+                continue
+            path = os.path.join(dirpath, name)
+            try:
+                st = os.lstat(path)
+            except OSError:
+                continue
+            rel = os.path.relpath(path, handin)
+            program = stat.S_ISREG(st.st_mode) and _looks_executable(path, st.st_mode)
+            (programs if program else others).append(rel)
+    parts = []
+    if programs:
+        parts.append(f"{len(programs)} program(s), never run: {_listed(programs)}")
+    if others:
+        parts.append(f"{len(others)} other file(s), not sources: {_listed(others)}")
+    return shown.line(f"ignored, graded from its sources: {'; '.join(parts)}") if parts else ""
 
 
 # ---- the tree -----------------------------------------------------------------------------
@@ -170,6 +230,9 @@ def _tree_files(lab_folder: str) -> dict[str, bytes]:
         if lab.is_dir():
             picked += [f for f in sorted(lab.iterdir()) if f.is_file() and not f.is_symlink()]
     picked += sorted(p for p in (ROOT / "common").rglob("*") if p.is_file())
+    # A skeleton's folders (lab 02's part-a/vec3.h): the driver a part is linked with is
+    # built with them (labs/02-simd/lab.mk).
+    picked += sorted(p for p in (ROOT / "labs").glob("*/skeleton/*/*") if p.is_file())
     as_skeleton = skeleton_form(lab_folder)
     skeletons = _skeletons()
     files = {}
@@ -186,9 +249,12 @@ def _driver_target(variant_target: str) -> str:
     return "cuda-variant-driver" if variant_target == "cuda-variant" else "variant-driver"
 
 
-def cached_tree(lab_folder: str, target: str = "variant") -> pathlib.Path:
-    """The students' tree of `lab_folder` with its driver objects built (once per content and
-    compiler: build/students-trees/<lab>-<digest>/)."""
+def cached_tree(lab_folder: str, target: str = "variant",
+                variant_lab: str | None = None) -> pathlib.Path:
+    """The students' tree of `lab_folder` with the driver objects of `variant_lab` (default:
+    the lab itself; 02-simd-a: lab 02's Part A) built (once per content and compiler:
+    build/students-trees/<variant>-<digest>/)."""
+    variant_lab = variant_lab or lab_folder
     files = _tree_files(lab_folder)
     digest = hashlib.sha256()
     for rel, data in sorted(files.items()):
@@ -196,7 +262,7 @@ def cached_tree(lab_folder: str, target: str = "variant") -> pathlib.Path:
     digest.update(subprocess.run(["c++", "--version"], capture_output=True).stdout)
     digest.update(target.encode())
     cache = ROOT / "build" / "students-trees"
-    tree = cache / f"{lab_folder}-{digest.hexdigest()[:16]}"
+    tree = cache / f"{variant_lab}-{digest.hexdigest()[:16]}"
     if (tree / ".complete").exists():
         return tree
     cache.mkdir(parents=True, exist_ok=True)
@@ -206,10 +272,10 @@ def cached_tree(lab_folder: str, target: str = "variant") -> pathlib.Path:
             (partial / rel).parent.mkdir(parents=True, exist_ok=True)
             (partial / rel).write_bytes(data)
         p = subprocess.run(["make", "-s", "-j2", "-C", str(partial), _driver_target(target),
-                            f"VARIANT_LAB={lab_folder}"], capture_output=True, text=True,
+                            f"VARIANT_LAB={variant_lab}"], capture_output=True, text=True,
                            errors="replace", env={**os.environ, "MAKEFLAGS": ""})
         if p.returncode != 0:
-            raise RuntimeError(f"the students' tree of {lab_folder} does not build its "
+            raise RuntimeError(f"the students' tree of {variant_lab} does not build its "
                                f"driver: {(p.stdout + p.stderr)[-1500:]}")
         # The tree is never built again: its make dependency files would only reach the
         # repository's own make, which includes every *.d under build/.
@@ -226,11 +292,11 @@ def cached_tree(lab_folder: str, target: str = "variant") -> pathlib.Path:
 
 
 def stage(lab_folder: str, handin_files: dict[str, bytes], missing: list[str],
-          target: str = "variant") -> pathlib.Path:
+          target: str = "variant", variant_lab: str | None = None) -> pathlib.Path:
     """A fresh copy of the students' tree (mode 755, outside the repository, so the sandbox
     user reaches it wherever the repository lives) with the submission in `submission/` above
     the stubs of what it lacks. The caller removes the folder."""
-    tree = cached_tree(lab_folder, target)
+    tree = cached_tree(lab_folder, target, variant_lab)
     work = pathlib.Path(tempfile.mkdtemp(prefix="students-tree-"))
     work.chmod(0o755)
     root = work / "tree"

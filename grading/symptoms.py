@@ -66,6 +66,11 @@ def _where_work_is_split() -> str:
     return "a loop bound that stops short?"
 
 
+def current_lab() -> str | None:
+    """The lab being graded (None: a check run outside a grade)."""
+    return _lab.get()
+
+
 def gpu_lab() -> bool:
     """The lab renders on a GPU, or is not known (a check run outside a grade): kernels and
     their synchronisation may then be named."""

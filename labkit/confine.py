@@ -15,7 +15,9 @@ Without Landlock the permissions alone keep the grader's files from the sandbox 
 Refused, with EPERM: sockets other than AF_UNIX (no network), ptrace and reading or writing
 other processes' memory, the kernel keyrings, every namespace and mount call (unshare,
 setns, clone with a CLONE_NEW* flag, mount and the new mount API, pivot_root, chroot), bpf,
-perf events, userfaultfd, module and kexec loading, reboot, swap and clock setting. clone3,
+perf events, userfaultfd, module and kexec loading, reboot, swap and clock setting, and
+POSIX message queues (mq_open: the queues live outside any folder the grader sweeps after a
+run, labkit/boxes.py). clone3,
 whose flags sit in memory a filter cannot read, answers ENOSYS, so the C library falls back
 to clone, whose flags it can.
 
@@ -26,6 +28,7 @@ runs get that one rule alone, as the compiled filter --export-affinity-filter wr
 """
 import errno
 import os
+import signal
 import sys
 
 import seccomp  # python3-seccomp (Debian): the system's Python, not a virtual environment's
@@ -40,7 +43,7 @@ REFUSED = ("ptrace", "process_vm_readv", "process_vm_writev", "kcmp", "add_key",
            "finit_module", "delete_module", "kexec_load", "kexec_file_load", "reboot",
            "swapon", "swapoff", "settimeofday", "clock_settime", "clock_adjtime", "adjtimex",
            "acct", "quotactl", "lookup_dcookie", "personality", "name_to_handle_at",
-           "open_by_handle_at", "iopl", "ioperm")
+           "open_by_handle_at", "iopl", "ioperm", "mq_open")
 
 
 def build_filter(fixed_affinity: bool = False) -> "seccomp.SyscallFilter":
@@ -141,6 +144,10 @@ def main(argv) -> int:
     writable = [options[i + 1] for i, o in enumerate(options) if o == "--rw"]
     landlock(read_only, writable)
     build_filter(fixed_affinity="--fixed-affinity" in options).load()
+    # Python ignores SIGXFSZ and SIGPIPE, and an ignored signal stays ignored across exec: the
+    # command gets the defaults, so a file over the size limit stops it as it would elsewhere.
+    for sig in (signal.SIGXFSZ, signal.SIGPIPE):
+        signal.signal(sig, signal.SIG_DFL)
     try:
         os.execvp(command[0], command)
     except OSError as e:

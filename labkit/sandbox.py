@@ -5,11 +5,15 @@ flood its output, fill the disk, read other students' code or the golden data, o
 lie about its own speed. Every process the grader starts from a submission goes through
 `Runner.run`, which
 
-- (untrusted, the default) runs it under bubblewrap: as an unprivileged user, in its own user,
+- (untrusted, the default) runs it under bubblewrap: as an unprivileged user (where the grader
+  is root, a user of its own that no other run was: labkit/boxes.py), in its own user,
   PID, network, IPC and mount namespaces, seeing read-only exactly the files it was given, the
   system's libraries and MPI's files (and, for a GPU lab, the GPU: labkit/gpu.py), and
   writing only to a scratch folder of its own;
 - applies resource limits inside (CPU seconds, memory, file size, processes, open files);
+- ends every process of its user after the run, whatever its state, and removes what that
+  user left in the places anyone may write (/dev/shm, /tmp, SysV IPC: labkit/boxes.py), so
+  that nothing of one run reaches a later one;
 - kills the whole process tree when the wall-clock limit passes, when an output stream exceeds
   its cap, or when the grader itself dies (`--die-with-parent`; the PID namespace dies with its
   first process, so no grandchild survives);
@@ -32,6 +36,8 @@ import subprocess
 import tempfile
 import time
 from typing import Sequence
+
+from labkit import boxes
 
 NOBODY = 65534
 # The sandbox's fixed layout: inputs appear read-only under /job, the scratch folder is the
@@ -117,9 +123,9 @@ def bwrap_path() -> str | None:
 BUBBLEWRAP, USER = "bubblewrap", "user"
 DESCRIPTIONS = {
     BUBBLEWRAP: "bubblewrap (user, PID, network, IPC and mount namespaces)",
-    USER: "a dedicated user (setpriv, prlimit, seccomp filter{landlock}; no namespaces here)",
+    USER: "a user of its own for each run (setpriv, prlimit, seccomp filter{landlock}; no "
+          "namespaces here)",
 }
-SANDBOX_USER = "prt-sandbox"   # made by setup.sh (or the grader, as root) for the user sandbox
 SYSTEM_PYTHON = "/usr/bin/python3"  # runs labkit/confine.py: python3-seccomp is its module
 
 _probe_result: list[str | None] = []
@@ -206,15 +212,6 @@ def _probe_bubblewrap() -> str | None:
     return None
 
 
-def sandbox_user() -> tuple[int, int] | None:
-    import pwd
-    try:
-        entry = pwd.getpwnam(SANDBOX_USER)
-    except KeyError:
-        return None
-    return entry.pw_uid, entry.pw_gid
-
-
 def _probe_user() -> str | None:
     if os.geteuid() != 0:
         return "the user sandbox needs the grader to run as root (to switch to its user)"
@@ -226,12 +223,6 @@ def _probe_user() -> str | None:
     check = subprocess.run([SYSTEM_PYTHON, "-I", "-c", "import seccomp"], capture_output=True)
     if check.returncode != 0:
         return "python3-seccomp is not installed: run `make deps`"
-    if sandbox_user() is None:
-        subprocess.run(["useradd", "--system", "--no-create-home", "--home-dir", "/nonexistent",
-                        "--shell", "/usr/sbin/nologin", SANDBOX_USER], capture_output=True)
-        if sandbox_user() is None:
-            return (f"there is no sandbox user '{SANDBOX_USER}' and it cannot be made "
-                    f"(useradd failed; setup.sh makes it)")
     out = _trial_run(USER)
     if isinstance(out, OSError):
         return f"the user sandbox cannot start: {out}"
@@ -254,9 +245,10 @@ def unreachable(folder: pathlib.Path, uid: int, gid: int) -> pathlib.Path | None
 
 def hide_from_sandbox(folder: pathlib.Path) -> None:
     """In the user sandbox, nothing shows the grader's files but their permissions: a
-    repository the sandbox user can reach is closed (mode 700) when the grader owns it."""
-    ids = sandbox_user()
-    if isolation() != USER or ids is None or unreachable(folder, *ids):
+    repository the sandbox's users can reach (as others: a box's user has no group but its
+    own) is closed (mode 700) when the grader owns it."""
+    ids = boxes.pool()
+    if isolation() != USER or ids is None or unreachable(folder, ids.start, ids.start):
         return
     st = os.stat(folder)
     if st.st_uid == os.geteuid():
@@ -281,37 +273,9 @@ def _confine_script() -> str:
 _confine_copy: list[str] = []
 
 
-def kill_user_processes(uid: int) -> None:
-    """SIGKILL every process of the sandbox user until none is left (a fork bomb included:
-    each pass kills what the last one missed)."""
-    for _ in range(50):
-        alive = user_processes(uid)
-        for pid in alive:
-            try:
-                os.kill(pid, signal.SIGKILL)
-            except OSError:
-                pass
-        if not alive:
-            return
-        time.sleep(0.01)
-
-
 def user_processes(uid: int) -> list[int]:
-    """Live processes (not zombies: those are dead, waiting for a parent to reap them) of
-    `uid`."""
-    found = []
-    for entry in os.scandir("/proc"):
-        if entry.name.isdigit():
-            try:
-                if entry.stat().st_uid != uid:
-                    continue
-                with open(f"/proc/{entry.name}/stat", "rb") as f:
-                    line = f.read()
-            except OSError:
-                continue
-            if line[line.rfind(b")") + 2:][:1] not in (b"Z", b"X"):
-                found.append(int(entry.name))
-    return found
+    """Processes of `uid` with a thread alive (labkit/boxes.py)."""
+    return boxes.processes(uid)
 
 
 def system_mounts() -> list[str]:
@@ -357,14 +321,20 @@ class Runner:
         self.trusted = trusted
         self.gpu = gpu  # a GPU lab's runs: the sandbox shows the GPU (labkit/gpu.py)
         self.user_mode = not trusted and isolation() == USER
+        # A grader running as root runs each Runner as a user of its own (labkit/boxes.py),
+        # whom the submission's files belong to; else as the grader's own user (bubblewrap's
+        # namespaces are then the only walls).
+        self.box, self._reset = None, False
+        if not trusted and os.geteuid() == 0:
+            self.box, fresh = boxes.new_box()
+            self._reset = not fresh  # an id that came round: whatever it left goes first
+        if self.user_mode and self.box is None:
+            raise OSError("the user sandbox needs the grader to run as root")
         self.root = pathlib.Path(tempfile.mkdtemp(prefix="grading-"))
         os.chmod(self.root, 0o755)  # the unprivileged sandbox user must reach staged inputs
         self.inputs: dict[str, pathlib.Path] = {}
         self.binds: list[tuple[str, bool]] = []  # (path, writable), mounted at the same path
         self._scratch: pathlib.Path | None = None
-        self.drop_to_nobody = not trusted and not self.user_mode and os.geteuid() == 0
-        # whom the submission's files belong to: the sandbox user, or nobody under bubblewrap
-        self.owner = (sandbox_user() or (NOBODY, NOBODY)) if self.user_mode else (NOBODY, NOBODY)
 
     def __enter__(self):
         return self
@@ -396,10 +366,10 @@ class Runner:
         """Show a file or folder at its own path, without copying (a build needs the tree's
         layout). Read-only unless `writable`; a writable one is handed to the sandbox user."""
         path = str(pathlib.Path(path).resolve())
-        if writable and (self.drop_to_nobody or self.user_mode):
+        if writable and self.box:
             for dirpath, dirs, files in os.walk(path):
                 for name in [dirpath, *(os.path.join(dirpath, f) for f in dirs + files)]:
-                    os.lchown(name, *self.owner)
+                    os.lchown(name, *self.box)
         self.binds.append((path, writable))
         return path
 
@@ -412,8 +382,8 @@ class Runner:
         if self._scratch is None:
             self._scratch = self.root / "scratch"
             self._scratch.mkdir(mode=0o700)
-            if self.drop_to_nobody or self.user_mode:
-                os.chown(self._scratch, *self.owner)
+            if self.box:
+                os.chown(self._scratch, *self.box)
         return self._scratch
 
     def output(self, name: str, limit: int = 256 << 20) -> bytes | None:
@@ -432,14 +402,16 @@ class Runner:
                 seccomp_fd: int | None = None) -> list[str]:
         """The full command line: taskset (for limits.cpu), bubblewrap (unless trusted; with
         the filter read from `seccomp_fd`), then prlimit, then argv."""
-        nproc = limits.processes
-        if not self.drop_to_nobody and os.geteuid() != 0:
+        nproc = limits.processes  # a box's user runs nothing else: the run's alone
+        if self.box is None and os.geteuid() != 0:
             nproc += _threads_of(os.geteuid())
-        inner = [shutil.which("prlimit") or "prlimit", f"--cpu={limits.cpu_seconds}",
+        # SIGXCPU at the CPU limit, SIGKILL a second later (for a program that ignores it)
+        inner = [shutil.which("prlimit") or "prlimit",
+                 f"--cpu={limits.cpu_seconds}:{limits.cpu_seconds + 1}",
                  f"--fsize={limits.file_bytes}", f"--nofile={limits.open_files}", "--core=0"]
         if limits.memory_bytes:
             inner.append(f"--as={limits.memory_bytes}")
-        if os.geteuid() != 0 or self.drop_to_nobody:  # root ignores RLIMIT_NPROC anyway
+        if self.box or os.geteuid() != 0:  # root ignores RLIMIT_NPROC
             inner.append(f"--nproc={nproc}")
         inner += ["--", *argv]
         pin = [] if limits.cpu is None else [shutil.which("taskset") or "taskset", "-c",
@@ -447,7 +419,7 @@ class Runner:
         if self.trusted:
             return pin + inner
         if self.user_mode:
-            uid, gid = self.owner
+            uid, gid = self.box
             paths = ["--ro", str(pathlib.Path(_confine_script()).parent),
                      "--ro", str(self.root / "inputs"), "--rw", str(self._scratch_dir())]
             for path, writable in self.binds:
@@ -498,7 +470,11 @@ class Runner:
         if limits.cpu is not None and not (self.trusted or self.user_mode):
             seccomp_fd = _filter_pipe(affinity_filter())
         cmd = self.command(argv, limits, env, seccomp_fd)
-        user = dict(user=NOBODY, group=NOBODY, extra_groups=[]) if self.drop_to_nobody else {}
+        user = {}
+        if self.box and not self.user_mode:  # the user sandbox switches users with setpriv
+            user = dict(user=self.box[0], group=self.box[1], extra_groups=[])
+        if self._reset:
+            boxes.seal(*self.box)
         start = time.perf_counter()
         try:
             p = subprocess.Popen(cmd, stdin=subprocess.DEVNULL, stdout=subprocess.PIPE,
@@ -511,8 +487,9 @@ class Runner:
         try:
             outcome = _supervise(p, start, limits)
         finally:
-            if self.user_mode:  # nothing of this run outlives it
-                kill_user_processes(self.owner[0])
+            if self.box:  # nothing of this run outlives it
+                boxes.seal(*self.box)
+                self._reset = False
         if outcome.killed is None and outcome.returncode == 0:
             used = _tree_size(self._scratch_dir())
             if used > limits.scratch_bytes:
@@ -569,8 +546,11 @@ class TreeClock:
     It also keeps each thread's own CPU time (/proc/PID/task/TID/stat; the last value seen of
     a thread that has ended), so that `busiest_thread_share` says how much of the work one
     thread did, whatever the load: a serial program does all of it on one thread, a parallel
-    one shares it. Both sides of that fraction are of the same sample (the latest), so the
-    last interval before the exit, which no sample sees, is missing from both.
+    one shares it. The fraction's denominator is the most work seen: the largest tree total,
+    or the sum of every thread's own time where that is larger (a child that has exited but
+    is not yet reaped can drop out of one sample's tree total, which alone would make its
+    sibling's share look whole). The last interval before the exit, which no sample sees, is
+    missing from both sides.
 
     With `nice` (the grader is root) each sample also raises the tree's new sessions and
     threads to that priority (RUN_NICE says why)."""
@@ -614,8 +594,9 @@ class TreeClock:
         for pid in tree:
             if pid in times:
                 self._sample_threads(pid, sessions[pid])
-        if ticks > 0:
-            self.busiest_thread_share = min(1.0, max(self._threads.values(), default=0) / ticks)
+        work = max(self.seconds * _CLOCK_TICKS, sum(self._threads.values()))
+        if work > 0:
+            self.busiest_thread_share = min(1.0, max(self._threads.values(), default=0) / work)
 
     def _sample_threads(self, pid: int, session: int) -> None:
         if self.nice is not None and session not in self._sessions:

@@ -91,11 +91,12 @@ inline Vec3xN<F> reflect(const Vec3xN<F>& d, const Vec3xN<F>& n) {
     return d - n * (F(2.0f) * dot(d, n));
 }
 
-// offset_ray_origin (ray.h), lane by lane.
+// offset_ray_origin (ray.h), lane by lane: the lanes are float, and so is ray.h's
+// kRelativeOffset in every build that includes this file (2^-20).
 template <class F>
 inline Vec3xN<F> offset_ray_origin(const Vec3xN<F>& p, const Vec3xN<F>& n, F distance_travelled,
                                    F extent) {
-    constexpr float kRelativeOffset = 1.0f / (1 << 20);
+    static_assert(sizeof(kRelativeOffset) == sizeof(float), "SIMD lanes are float");
     const F scale = max_component(abs(p)) + distance_travelled + extent;
     return p + n * (scale * kRelativeOffset);
 }

@@ -22,22 +22,22 @@ $(BUILD)/$(LAB02)/skeleton/render_avx2.o $(BUILD)/$(LAB02)/solution/render_avx2.
 $(BUILD)/$(LAB02)/render_prims.o: CXXFLAGS += $(SIMD_AVX2_FLAGS)
 
 lab02: $(BUILD)/$(LAB02)/skeleton/render.o $(BUILD)/$(LAB02)/skeleton/render_avx2.o $(COMMON_OBJ)
-	$(CXX) $(CXXFLAGS) $^ -o $@
+	$(CXX) $(CXXFLAGS) $^ $(INTO_TARGET)
 lab02-ref-avx2: $(BUILD)/$(LAB02)/solution/render.o $(BUILD)/$(LAB02)/solution/render_avx2.o \
 	$(COMMON_OBJ)
-	$(CXX) $(CXXFLAGS) $^ -o $@
+	$(CXX) $(CXXFLAGS) $^ $(INTO_TARGET)
 # render_widest.cpp has no SIMD flags; SIMD_OBJ comes last (see Makefile).
 lab02-ref: $(BUILD)/$(LAB02)/render_widest.o $(COMMON_OBJ) $(SIMD_OBJ)
-	$(CXX) $(CXXFLAGS) $^ -o $@
+	$(CXX) $(CXXFLAGS) $^ $(INTO_TARGET)
 $(BUILD)/$(LAB02)/bench/render_widest.o: $(LAB02)/render_widest.cpp
 	@mkdir -p $(dir $@)
 	$(CXX) $(CXXFLAGS) -DRT_PACKETS_FROM_ENV $(SIMD_INCLUDES) -c $< -o $@
 lab02-bench: $(BUILD)/$(LAB02)/bench/render_widest.o $(COMMON_OBJ) $(SIMD_OBJ)
-	$(CXX) $(CXXFLAGS) $^ -o $@
+	$(CXX) $(CXXFLAGS) $^ $(INTO_TARGET)
 # A worked example for comparison, not graded: SIMD across primitives (simd_geometry.h).
 lab02-prims: $(BUILD)/$(LAB02)/solution/render.o $(BUILD)/$(LAB02)/render_prims.o \
 	$(COMMON_OBJ)
-	$(CXX) $(CXXFLAGS) $^ -o $@
+	$(CXX) $(CXXFLAGS) $^ $(INTO_TARGET)
 
 # ---- Part A ------------------------------------------------------------------------------
 # Every file, the shared driver too, is built with solution/part-a (or skeleton/part-a) first
@@ -56,17 +56,19 @@ $(BUILD)/vec3-sse/%.o: %.cpp
 # render_vec3_sse.cpp is lab 01's pixel loop; the student's Part A is skeleton/part-a/vec3.h.
 LAB02A_SRC += $(LAB02)/render_vec3_sse.cpp
 lab02a-ref: $(patsubst %.cpp,$(BUILD)/vec3-sse-ref/%.o,$(LAB02A_SRC))
-	$(CXX) $(CXXFLAGS) $^ -o $@
+	$(CXX) $(CXXFLAGS) $^ $(INTO_TARGET)
 lab02a: $(patsubst %.cpp,$(BUILD)/vec3-sse/%.o,$(LAB02A_SRC))
-	$(CXX) $(CXXFLAGS) $^ -o $@
+	$(CXX) $(CXXFLAGS) $^ $(INTO_TARGET)
 
 LAB_BINARIES += lab02 lab02-ref lab02-ref-avx2 lab02-bench lab02a lab02a-ref lab02-prims
 
-# Variants (make variant): Part B as one AVX2 build; Part A against lab02a-ref's driver
-# objects (the same 16-byte Vec3 layout; only the operators' bodies differ).
+# Variants (make variant): Part B as one AVX2 build; Part A against ./lab02a's driver
+# objects, built with the skeleton's part-a/vec3.h (the same 16-byte Vec3 layout; only the
+# operators' bodies differ), which a students' tree holds too, where the solution's is not.
+# The variant's own objects come first on the link line, so its operators are the ones kept.
 VARIANT_FLAGS_02-simd := -Icommon/simd $(SIMD_AVX2_FLAGS)
 VARIANT_DRIVER_02-simd := $(COMMON_OBJ)
-VARIANT_DRIVER_02-simd-a := $(patsubst %.cpp,$(BUILD)/vec3-sse-ref/%.o,$(LIB_SRC) \
+VARIANT_DRIVER_02-simd-a := $(patsubst %.cpp,$(BUILD)/vec3-sse/%.o,$(LIB_SRC) \
                             common/host/lab_main.cpp common/host/main.cpp)
 
 else
@@ -74,7 +76,6 @@ else
 lab02 lab02-ref lab02-ref-avx2 lab02-bench lab02a lab02a-ref lab02-prims:
 	@echo "$@: lab 02 needs an x86-64 CPU and compiler (SSE, AVX2); this is $(shell $(CXX) -dumpmachine)" >&2
 	@exit 1
+.PHONY: lab02 lab02-ref lab02-ref-avx2 lab02-bench lab02a lab02a-ref lab02-prims
 
 endif
-
-.PHONY: lab02 lab02-ref lab02-ref-avx2 lab02-bench lab02a lab02a-ref lab02-prims

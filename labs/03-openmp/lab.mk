@@ -24,14 +24,13 @@ $(LAB03_BUILD)/shared-rng-race/shared_rng.o: $(LAB03)/shared_rng.cpp
 	$(CXX) $(CXXFLAGS) -DRT_SHARED_RNG_RACE $(INCLUDES) -c $< -o $@
 
 lab03-bench: $(LAB03_BUILD)/bench/render.o $(COMMON_OBJ)
-	$(CXX) $(CXXFLAGS) $^ -o $@ -fopenmp
+	$(CXX) $(CXXFLAGS) $^ -fopenmp $(INTO_TARGET)
 lab03-shared-rng: $(LAB03_BUILD)/shared_rng.o $(COMMON_OBJ)
-	$(CXX) $(CXXFLAGS) $^ -o $@ -fopenmp
+	$(CXX) $(CXXFLAGS) $^ -fopenmp $(INTO_TARGET)
 lab03-shared-rng-race: $(LAB03_BUILD)/shared-rng-race/shared_rng.o $(COMMON_OBJ)
-	$(CXX) $(CXXFLAGS) $^ -o $@ -fopenmp
+	$(CXX) $(CXXFLAGS) $^ -fopenmp $(INTO_TARGET)
 lab03-row-costs: $(LAB03_BUILD)/row_costs.o $(COMMON_OBJ)
-	$(CXX) $(CXXFLAGS) $^ -o $@ -fopenmp
-.PHONY: lab03-bench lab03-shared-rng lab03-shared-rng-race lab03-row-costs lab03-simd-ref
+	$(CXX) $(CXXFLAGS) $^ -fopenmp $(INTO_TARGET)
 
 VARIANT_FLAGS_03-openmp := -fopenmp
 VARIANT_DRIVER_03-openmp := $(COMMON_OBJ)
@@ -50,12 +49,13 @@ $(LAB03_BUILD)/simd/render.o: $(LAB03)/solution/render.cpp
 	$(CXX) $(CXXFLAGS) -DRT_USE_SIMD $(SIMD_INCLUDES) -c $< -o $@
 $(LAB03_BUILD)/simd_entry.o: LAB_INCLUDES = -Icommon/simd
 lab03-simd-ref: $(LAB03_BUILD)/simd/render.o $(LAB03_BUILD)/simd_entry.o $(COMMON_OBJ) $(SIMD_OBJ)
-	$(CXX) $(CXXFLAGS) $^ -o $@ -fopenmp
+	$(CXX) $(CXXFLAGS) $^ -fopenmp $(INTO_TARGET)
 LAB_BINARIES += lab03-simd-ref
 else
 lab03-simd-ref:
 	@echo "lab03-simd-ref: needs an x86-64 CPU and compiler (AVX2)" >&2
 	@exit 1
+.PHONY: lab03-simd-ref
 endif
 
 # The reference in double (OpenMP over lab 01's scalar renderer), which lab03-ref and
@@ -64,6 +64,6 @@ $(DOUBLE_BUILD)/$(LAB03)/%.o: CXXFLAGS += -fopenmp
 $(DOUBLE_BUILD)/$(LAB03)/solution/%.o: LAB_INCLUDES = -I$(LAB03)/solution
 lab03-ref-double: $(patsubst %.cpp,$(DOUBLE_BUILD)/%.o,$(wildcard $(LAB03)/solution/*.cpp)) \
                   $(DOUBLE_COMMON_OBJ)
-	$(CXX) $(CXXFLAGS) $^ -o $@ -fopenmp
+	$(CXX) $(CXXFLAGS) $^ -fopenmp $(INTO_TARGET)
 lab03-ref lab03-simd-ref: $(BUILD)/twins/lab03-ref-double.o
 LAB_BINARIES += lab03-ref-double

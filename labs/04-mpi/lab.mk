@@ -40,23 +40,24 @@ ifeq ($(shell command -v $(MPICXX) 2>/dev/null),)
 lab04 lab04-ref lab04-simd-ref:
 	@echo "$@: needs OpenMPI ($(MPICXX) not found; run make deps)" >&2
 	@exit 1
+.PHONY: lab04 lab04-ref lab04-simd-ref
 else
 lab04: $(LAB04_SKELETON_OBJ) $(LAB04_DRIVER)
-	$(CXX) $(CXXFLAGS) $^ -o $@ -fopenmp $(LAB04_MPI_LIBS)
+	$(CXX) $(CXXFLAGS) $^ -fopenmp $(LAB04_MPI_LIBS) $(INTO_TARGET)
 lab04-ref: $(LAB04_SOLUTION_OBJ) $(LAB04_DRIVER)
-	$(CXX) $(CXXFLAGS) $^ -o $@ -fopenmp $(LAB04_MPI_LIBS)
+	$(CXX) $(CXXFLAGS) $^ -fopenmp $(LAB04_MPI_LIBS) $(INTO_TARGET)
 LAB_BINARIES += lab04 lab04-ref
 VARIANT_FLAGS_04-mpi = -fopenmp $(LAB04_MPI_CFLAGS) -I$(LAB04)
 VARIANT_DRIVER_04-mpi := $(LAB04_DRIVER)
 VARIANT_LIBS_04-mpi = -fopenmp $(LAB04_MPI_LIBS)
 ifeq ($(LAB04_SIMD_MISSING),)
 lab04-simd-ref: $(LAB04_BUILD)/simd/render.o $(LAB04_BUILD)/simd_entry.o $(LAB04_DRIVER) $(SIMD_OBJ)
-	$(CXX) $(CXXFLAGS) $^ -o $@ -fopenmp $(LAB04_MPI_LIBS)
+	$(CXX) $(CXXFLAGS) $^ -fopenmp $(LAB04_MPI_LIBS) $(INTO_TARGET)
 LAB_BINARIES += lab04-simd-ref
 else
 lab04-simd-ref:
 	@echo "lab04-simd-ref: $(LAB04_SIMD_MISSING)" >&2
 	@exit 1
+.PHONY: lab04-simd-ref
 endif
 endif
-.PHONY: lab04 lab04-ref lab04-simd-ref

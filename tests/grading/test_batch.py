@@ -246,3 +246,77 @@ def test_leaderboard_only_for_a_measured_correct_speed():
     assert leaderboard(graded(0, "wrong image: speed is graded only for a correct image")) == []
     assert leaderboard(graded(0, measured)) == []
     assert leaderboard(graded(30, measured, regrade=True)) == []
+
+
+HIDDEN_NOTE = "hidden scene: passed (its details are shown once the grades are published)"
+SERIAL = {"score": 10, "max_score": 100, "output": HIDDEN_NOTE, "tests": [
+    result_test("bitwise", "bit-identical to lab 01", 0, 30,
+                "not counted until parallel speedup passes; it saw: PASS identical for 1, 2, 3, "
+                "7 threads", passed=False),
+    result_test("parallel-speedup", "parallel speedup", 0, 40,
+                "serial: in every timed run one thread did at least 90% of the CPU time (99% at "
+                "the least; measured by the grader, thread by thread, on a machine giving 1.97 "
+                "cores' worth)")]}
+
+
+def test_the_cause_is_the_failing_gates_verdict_not_a_check_that_passed():
+    cause = batch.failure_cause(SERIAL)
+    assert "serial: in every timed run one thread did" in cause, cause
+    assert "PASS" not in cause, cause
+    assert batch.speed_numbers(SERIAL)["capacity"] == "1.97"  # measured: shown beside it
+
+
+def test_a_timed_serial_verdict_shows_its_numbers():
+    """A serial program whose runs were timed: the verdict keeps the times, speedup and
+    capacity measured, and the class page reads them beside it."""
+    from grading import checks
+    from labkit.harness import ParallelTiming
+    timing = ParallelTiming(base=0.6, best={"yours": 0.61}, capacity=1.96, cores=2)
+    verdict = checks.serial_by_thread([0.99, 0.98], "1.01 cores' worth at most, on a machine "
+                                      "giving 1.96", timing.describe("yours"))
+    results = {"tests": [result_test("parallel-speedup", "parallel speedup", 0, 40,
+                                     verdict.detail)]}
+    assert batch.speed_numbers(results) == {"reference_s": "0.600", "yours_s": "0.610",
+                                            "speedup": "0.98", "capacity": "1.96"}
+    assert "serial: in every timed run" in batch.failure_cause(results)
+
+
+def test_the_class_page_names_links_sorts_plots_and_says_a_shared_note_once(tmp_path,
+                                                                             monkeypatch):
+    monkeypatch.setitem(batch.RUBRICS, "03", [type("I", (), {"label": t["name"]})()
+                                              for t in FAST["tests"]])
+    rows = {"submission_1": {**FAST, "output": HIDDEN_NOTE},
+            "submission_2": SERIAL, "submission_3": {**BROKEN}}
+    for student in rows:
+        (tmp_path / student).mkdir()
+    submitters = {"submission_1": "Ada Lovelace <ada@example.edu> (1815)",
+                  "submission_2": "Alan Turing <alan@example.edu> (1912)",
+                  "submission_3": "Grace Hopper <grace@example.edu> (1906)"}
+    batch.write_report(tmp_path, "03", rows, submitters)
+    page = (tmp_path / "report.html").read_text()
+    for name in ("Ada Lovelace", "Alan Turing", "Grace Hopper"):
+        assert name in page
+    for student in rows:  # every row links to a page that exists
+        assert f'href="{student}/heatmaps/report.html"' in page
+        assert (tmp_path / student / "heatmaps" / "report.html").is_file()
+    assert page.count(HIDDEN_NOTE.split(" (")[0]) == 1, page  # said once, not per row
+    assert page.count("<svg") >= 2 and "sort" in page and "<th onclick" in page
+    assert "serial: in every timed run" in page and "1.91" in page and "1.97" in page
+
+
+def test_a_grader_that_never_ends_is_stopped_and_the_class_goes_on(tmp_path, monkeypatch):
+    """One hand-in must not hold up the class: a grader still running past its time is
+    stopped, and its row says so."""
+    import sys
+    subs = tmp_path / "subs"
+    for student in ("ann", "bob"):
+        (subs / student).mkdir(parents=True)
+    monkeypatch.setattr(batch, "GRADER_SECONDS", 1)
+    monkeypatch.setattr(batch, "STOP_GRACE_SECONDS", 1)
+    monkeypatch.setattr(batch, "grader_command", lambda lab, folder, out, extra: [
+        sys.executable, "-c", "import signal, time; signal.signal(signal.SIGTERM, "
+        "signal.SIG_IGN); time.sleep(600)"])
+    assert batch.main(["01", str(subs), "--out", str(tmp_path / "r")]) == 0
+    rows = {r["student"]: r for r in rows_of(tmp_path / "r" / "grades.csv")}
+    assert rows["ann"]["cause"].startswith("timeout: the grader did not finish"), rows["ann"]
+    assert rows["bob"]["cause"].startswith("timeout: the grader did not finish"), rows["bob"]

@@ -35,6 +35,13 @@ def wait_for(condition, seconds, what):
     pytest.skip(f"one-node Slurm did not start: {what}")
 
 
+
+def memory_mb() -> int:
+    """The node's memory for slurm.conf, a little under what slurmd finds (more would drain
+    the node): the grading tasks ask for --mem, which Slurm checks against it."""
+    total_kb = int(pathlib.Path("/proc/meminfo").read_text().split()[1])
+    return total_kb * 9 // 10 // 1024
+
 @pytest.fixture
 def slurm(tmp_path_factory):
     missing = [d for d in DAEMONS if shutil.which(d) is None
@@ -84,7 +91,7 @@ ReturnToService=2
 MpiDefault=none
 SlurmctldLogFile={d / 'slurmctld.log'}
 SlurmdLogFile={d / 'slurmd.log'}
-NodeName={host} NodeAddr=127.0.0.1 CPUs={os.cpu_count()} State=UNKNOWN
+NodeName={host} NodeAddr=127.0.0.1 CPUs={os.cpu_count()} RealMemory={memory_mb()} State=UNKNOWN
 PartitionName=grading Nodes={host} Default=YES MaxTime=INFINITE State=UP
 """)
     env = {**os.environ, "SLURM_CONF": str(conf)}
@@ -134,3 +141,29 @@ def test_a_class_graded_as_a_job_array(tmp_path, slurm):
     assert rows["bob"]["score"] == "0" and rows["bob"]["cause"].startswith("compile error")
     assert rows["(class: 2 students)"]["score"] == "mean 50.0"
     assert len(list(report.glob("slurm-*_*.log"))) == 2  # one log per array task
+
+
+def test_the_scripts_say_what_they_ask_and_call_python_by_name(tmp_path):
+    from grading import slurm
+    array, merge = slurm.scripts("03", tmp_path / "subs", tmp_path / "out", 4, "gpu", None,
+                                 "00:45:00", "8G", "python3")
+    for script in (array, merge):
+        assert "#SBATCH --time=00:45:00" in script and "#SBATCH --mem=8G" in script
+        assert "#SBATCH --partition=gpu" in script
+        command = next(line for line in script.splitlines() if "-m grading.batch" in line)
+        assert command.startswith("python3 -m grading.batch"), command
+    default = slurm.scripts("03", tmp_path / "subs", tmp_path / "out", 4, None, None)[0]
+    assert f"--time={slurm.DEFAULT_TIME}" in default and f"--mem={slurm.DEFAULT_MEM}" in default
+
+
+def test_run_gpu_runs_a_command_as_a_slurm_job_and_prints_its_log(slurm):
+    """`make run-gpu` (labs 05-07 without a GPU of one's own) on the test's one-node Slurm,
+    which has no GPUs: GPU_GRES= asks for none. The job runs in the checkout and its log is
+    printed when it ends."""
+    p = subprocess.run(["make", "-s", "-C", str(ROOT), "run-gpu", "RUN=pwd",
+                        "GPU_GRES=", "GPU_MEM=100M", "LAB=05"], capture_output=True, text=True,
+                       env=slurm, timeout=300)
+    for log in ROOT.glob("run-gpu-*.log"):
+        log.unlink()
+    assert p.returncode == 0, p.stdout + p.stderr
+    assert str(ROOT) in p.stdout.splitlines() and "ended with status 0" in p.stdout, p.stdout

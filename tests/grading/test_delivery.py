@@ -29,8 +29,10 @@ def test_batch_grades_each_student_into_csv_and_html(tmp_path):
     subs = tmp_path / "submissions"
     for student in ("alice", "bob", "carol"):
         (subs / student).mkdir(parents=True)
-    shutil.copy2(sub.REFERENCE, subs / "alice" / "lab")       # correct
-    sub.exec_reference(subs / "bob")                           # the wrapper
+    for name in ("render.cpp", "path_tracer.h"):               # correct sources
+        shutil.copy2(ROOT / "labs/01-serial/solution" / name if name == "render.cpp"
+                     else ROOT / "common/core" / name, subs / "alice" / name)
+    sub.exec_reference(subs / "bob")          # a program only: never run, nothing to build
     (subs / "carol" / "render.cpp").write_text("int broken( {\n")  # does not compile
     report = tmp_path / "report"
     p = subprocess.run([sys.executable, "-m", "grading.batch", "01", str(subs), "--out",
@@ -88,3 +90,20 @@ def test_gradescope_bundle_grades_a_submission(tmp_path, request):
     shutil.copy(ROOT / "common" / "core" / "path_tracer.h", root / "submission")
     results = run_autograder()
     assert results["score"] == 100, json.dumps(results, indent=1)[:3000]
+
+
+def test_gradescope_bundle_says_its_settings(tmp_path, capsys):
+    """`make gradescope` prints, and the zip's own README.md carries at its top, what to choose
+    on Gradescope: labs 03 and 04 need 2 CPUs, and the default's consequence is said."""
+    from grading import gradescope
+    assert gradescope.main(["03", "--out", str(tmp_path / "lab03.zip")]) == 0
+    printed = capsys.readouterr().out
+    with zipfile.ZipFile(tmp_path / "lab03.zip") as z:
+        readme = z.read("README.md").decode()
+        assert "COURSE-README.md" in z.namelist()
+    for text in (printed, readme):
+        assert "Base image:" in text and "Memory:" in text and "timeout:" in text
+        assert "Autograder CPUs:     2.0 or more" in text, text
+        assert "default of 0.5" in text and "regrade" in text, text
+    lab01 = gradescope.settings("01")
+    assert "0.5 (the default)" in lab01

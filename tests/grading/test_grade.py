@@ -51,8 +51,9 @@ def skip_if_not_measurable(results):
 
 
 def test_lab02_scalar_hand_in_loses_only_the_speedup(lab01_ref, tmp_path):
-    """Lab 01's reference handed in for lab 02: every image is right, but it is not SIMD."""
-    results = grade_in_process("02", lab01_ref, tmp_path)
+    """Lab 01's reference handed in for both parts of lab 02: every image is right, but it is
+    not SIMD."""
+    results = grade_in_process("02", lab01_ref, tmp_path, parts={"a": lab01_ref})
     passed = passed_by_check(results)
     assert not passed.pop("speedup"), describe(results)
     assert all(passed.values()), describe(results)
@@ -62,7 +63,8 @@ def test_lab02_scalar_hand_in_loses_only_the_speedup(lab01_ref, tmp_path):
     not cpu_has_avx2(), reason="this CPU has no AVX2/FMA: lab 02's Part B cannot run"
 )
 def test_lab02_reference_gets_full_marks(tmp_path):
-    results = grade_in_process("02", build("lab02-ref")[0], tmp_path)
+    results = grade_in_process("02", build("lab02-ref")[0], tmp_path,
+                               parts={"a": build("lab02a-ref")[0]})
     assert results["score"] == results["max_score"] == 100, describe(results)
 
 

@@ -74,3 +74,33 @@ def test_make_handin_refuses_a_bad_lab():
     p = subprocess.run(["make", "-s", "-C", str(ROOT), "handin", "LAB=9"], capture_output=True,
                        text=True)
     assert p.returncode != 0 and "LAB must be one of" in p.stderr
+
+
+def test_what_is_not_a_source_is_named_once_programs_first(tmp_path):
+    """A program (by its mode, or by its first bytes: a zip keeps no mode) and other files are
+    named in one line; sources, hidden and build folders are not."""
+    folder = tmp_path / "sub"
+    write_files(folder, "01")
+    (folder / "lab").write_bytes(b"\x7fELF\x02\x01\x01" + bytes(64))  # no executable bit
+    (folder / "run.sh").write_text("#!/bin/sh\n")
+    (folder / "notes.txt").write_text("hello")
+    for skipped in (".git/config", "build/x.o"):
+        (folder / skipped).parent.mkdir(parents=True, exist_ok=True)
+        (folder / skipped).write_text("x")
+    line = students_tree.ignored(folder)
+    assert line == ("ignored, graded from its sources: 2 program(s), never run: lab, run.sh; "
+                    "1 other file(s), not sources: notes.txt"), line
+    clean = tmp_path / "clean"
+    write_files(clean, "01")
+    assert students_tree.ignored(clean) == ""
+
+
+@pytest.mark.parametrize("name", ["a;b.cpp", "a b.cpp", "$(x).h", "a\x1b[2J.cpp", "ü.cpp"])
+def test_a_source_name_outside_the_plain_set_is_refused_naming_it(tmp_path, name):
+    folder = tmp_path / "sub"
+    write_files(folder, "01")
+    (folder / name).write_text("int x;\n")
+    with pytest.raises(students_tree.HandInError) as e:
+        students_tree.collect(folder, "01-serial")
+    assert "may hold only letters, digits and _ . + -" in str(e.value)
+    assert "\x1b" not in str(e.value) and "\n" not in str(e.value)

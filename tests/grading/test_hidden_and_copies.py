@@ -116,3 +116,36 @@ def test_the_reference_passes_the_showcase_at_seeds_where_its_glass_strays(lab01
     for seed in (227, 564, 1311, 1500):
         result = check_golden(lab01_ref, "showcase", seed=seed)
         assert result.passed, f"seed {seed}: {result.detail}"
+
+
+# Renders as the reference does, but brightens its first render of the hidden scene (seed 7)
+# or, with ALWAYS, every one: a stray bright path in one render against a renderer that is wrong.
+STRAYER = """#!{python}
+import subprocess, sys
+import numpy as np
+sys.path.insert(0, {root!r})
+from labkit.pfm import read_pfm, write_pfm
+args = sys.argv[1:]
+p = subprocess.run([{reference!r}, *args])
+if p.returncode:
+    sys.exit(p.returncode)
+if "--pfm" in args and args[args.index("--width") + 1] == "32" and (
+        {always} or args[args.index("--seed") + 1] == "7"):
+    out = args[args.index("--pfm") + 1]
+    image = read_pfm(out)
+    image[4:8, 24:28] *= 1.5
+    write_pfm(out, image)
+"""
+
+
+def test_one_stray_render_of_the_hidden_scene_is_rendered_again(lab01_ref, tmp_path):
+    """A failed render of the hidden scene is rendered once more with another seed: a stray
+    block in one render passes, the same block in every render fails."""
+    from grading import hidden
+    for always in (False, True):
+        strayer = tmp_path / f"lab-{always}"
+        strayer.write_text(STRAYER.format(python=sys.executable, root=str(ROOT),
+                                          reference=str(lab01_ref), always=always))
+        strayer.chmod(0o755)
+        result = hidden.check_hidden(strayer, lab01_ref, "strays")
+        assert result.passed != always, result.detail

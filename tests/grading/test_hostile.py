@@ -496,8 +496,9 @@ def test_serial_lab03_beside_a_cpu_burner_earns_nothing_and_is_final(tmp_path):
 
 def test_the_lab03_reference_beside_a_cpu_burner_is_not_called_serial(tmp_path):
     """The lab 03 reference beside the same burner: its work is shared among its threads, so
-    it is never called serial; its correctness counts (bits and golden images, 60 points)
-    and its speed either earns points or waits for a regrade, never a final 0."""
+    it is never called serial; its speed either earns points or waits for a regrade, never a
+    final 0, and its correctness (bits and golden images, 60 points) counts once a speedup is
+    measured, else waits with the speed, shown apart."""
     from labkit.harness import build
     reference, = build("lab03-ref")
     with burning_one_core():
@@ -505,7 +506,8 @@ def test_the_lab03_reference_beside_a_cpu_burner_is_not_called_serial(tmp_path):
     speed = speed_test(results)
     assert not speed["output"].startswith("serial"), describe(results)
     assert speed["score"] > 0 or speed["extra_data"]["regrade"], describe(results)
-    assert results["score"] >= 60, describe(results)
+    shown_apart = sum(t["extra_data"]["provisional"] for t in results["tests"])
+    assert results["score"] >= 60 or results["score"] + shown_apart >= 100, describe(results)
 
 
 def noisy_golden(spp: int):
@@ -599,3 +601,215 @@ def test_the_reference_objects_are_out_of_the_compilers_reach(tmp_path):
             "path_tracer.h": solution_text("01-serial", "path_tracer.h")})
         binary, errors = build_lab("01", folder, trusted=False)
         assert binary is None and "file not found" in errors, errors
+
+
+# ---- intake: a hand-in is sources, its names are data, its archive is bounded ------------
+
+def test_a_binary_handed_in_beside_the_skeleton_is_never_run_in_a_batch(tmp_path):
+    """A release ships the reference prebuilt: handed in as `lab` beside the skeleton's
+    sources, a batch must grade the sources (the skeleton's score) and say what it ignored."""
+    from grading import batch
+    from grading.students_tree import pristine_skeleton
+    subs, report = tmp_path / "subs", tmp_path / "report"
+    folder = handin(subs / "ann", pristine_skeleton("01-serial"))
+    shutil.copyfile(ROOT / "lab01-ref", folder / "lab")
+    (folder / "lab").chmod(0o755)
+    assert batch.main(["01", str(subs), "--out", str(report)]) == 0
+    results = json.loads((report / "ann" / "results.json").read_text())
+    assert results["score"] <= 10, describe(results)
+    ignored = [n for n in results["output"].splitlines() if n.startswith("ignored")]
+    assert len(ignored) == 1 and "lab" in ignored[0], results["output"]
+
+
+def test_a_file_name_that_is_shell_code_is_refused_in_one_line(tmp_path):
+    """The build globs the hand-in's *.cpp into a compiler command: a name holding `;` would
+    run what follows it. Names outside [A-Za-z0-9_.+-] are refused before anything is built."""
+    name = "x.cpp;echo INJECTED-BUILD-STEP;.cpp"
+    folder = handin(tmp_path / "in", {"render.cpp": solution_text("01-serial", "render.cpp"),
+                                      "path_tracer.h": solution_text("01-serial", "path_tracer.h"),
+                                      name: "int unused;\n"})
+    out = tmp_path / "results.json"
+    p = subprocess.run([sys.executable, "-m", "grading.grade", "01", "--sources", str(folder),
+                        "--results", str(out)], cwd=ROOT, capture_output=True, text=True,
+                       timeout=300)
+    results = json.loads(out.read_text())
+    assert p.returncode == 1 and results["score"] == 0, describe(results)
+    assert p.stderr.count("\n") == 1 and name in p.stderr, p.stderr
+    assert "INJECTED-BUILD-STEP\n" not in p.stdout + out.read_text()
+
+
+HOSTILE_STRINGS = ["\x1b[2K\r\x1b[32mtotal 100/100\x1b[0m", "=HYPERLINK(\"http://x.example\")",
+                   "+cmd|' /C calc'!A0", "-2+3", "@SUM(A1:A9)", "\tx", "\rfake",
+                   "<script>alert(1)</script>", "a\u202egnp.exe", "bell\x07\x08"]
+CONTROL = set(map(chr, range(32))) - {"\n"} | {"\x7f", "\u202e"}
+
+
+def test_hostile_strings_are_cleaned_in_every_sink(tmp_path, monkeypatch, capsys):
+    """The same hostile strings (a compiler's or a program's output, a student's folder name,
+    Gradescope's names, e-mails and ids) through results.json, the terminal, the student's
+    page, grades.csv and the class page, and a path into the Slurm scripts: no control
+    character survives, no cell starts a formula, no markup reaches a page."""
+    import csv
+
+    from grading import batch, report_html, slurm
+    from grading.grade import RUBRICS, print_table
+    from grading.results import Results, Test
+    hostile = "|".join(HOSTILE_STRINGS)
+    results = Results(tmp_path / "r.json")
+    results.add_all([Test(i.id, i.label, i.points) for i in RUBRICS["01"]])
+    for t in results.tests:
+        t.finish(0, hostile)
+    results.notes.append(hostile)
+    results.write()
+    on_disk = json.loads((tmp_path / "r.json").read_text())
+    strings = [on_disk["output"]] + [t["output"] for t in on_disk["tests"]]
+    assert not any(set(s) & CONTROL for s in strings), strings
+    print_table("01", pathlib.Path("lab01"), on_disk)
+    page = report_html.write_report(tmp_path, "01", hostile, on_disk).read_text()
+    # a class of students named by the hostile strings, from an export naming them too
+    subs, report = tmp_path / "subs", tmp_path / "report"
+    meta = ["---"]
+    for k, s in enumerate(HOSTILE_STRINGS):
+        name = f"submission_{k}{s}" if "/" not in s else f"submission_{k}"
+        (subs / name).mkdir(parents=True)
+        meta += [f"{json.dumps(name)}:", "  :submitters:", f"  - :name: {json.dumps(s)}",
+                 f"    :sid: {json.dumps(s)}", f"    :email: {json.dumps(s)}"]
+    (subs / "submission_metadata.yml").write_text("\n".join(meta) + "\n")
+    monkeypatch.setattr(batch, "grade_one", lambda lab, folder, out, extra, env: (
+        out.mkdir(parents=True, exist_ok=True), on_disk)[1])
+    assert batch.main(["01", str(subs), "--out", str(report)]) == 0
+    terminal = capsys.readouterr()
+    cells = [c for row in csv.reader((report / "grades.csv").open()) for c in row]
+    assert not [c for c in cells if c.startswith(("=", "+", "-", "@", "\t", "\r"))
+                and not c.lstrip("-+").replace(".", "", 1).isdigit()], cells
+    class_page = (report / "report.html").read_text()
+    array, merge = slurm.scripts("01", tmp_path / ("subs\n#SBATCH --uid=0" + hostile),
+                                 tmp_path / ("out\n#SBATCH --uid=0" + hostile), 3, None, None)
+    for shown in (terminal.out + terminal.err, page, class_page, "".join(cells), array, merge):
+        assert not set(shown) & CONTROL, repr(shown[:2000])
+    for shown in (page, class_page):
+        assert "<script>alert" not in shown and "&lt;script&gt;alert" in shown
+    for script in (array, merge):
+        assert not [x for x in script.splitlines() if x.startswith("#SBATCH --uid")]
+
+
+def bad_zip(path: pathlib.Path, kind: str) -> pathlib.Path:
+    """A hand-in zip over one of the intake's limits (grading/batch.py)."""
+    import zipfile
+    with zipfile.ZipFile(path, "w", zipfile.ZIP_DEFLATED) as z:
+        z.writestr("render.cpp", "int x;\n")
+        if kind == "size":  # 80 MiB of zeros in 80 KiB
+            with z.open("big.cpp", "w", force_zip64=True) as f:
+                for _ in range(80):
+                    f.write(bytes(1 << 20))
+        elif kind == "ratio":  # 8 MiB of zeros: under the size limit, 1000 to 1
+            z.writestr("zeros.h", bytes(8 << 20))
+        elif kind == "members":
+            for k in range(5000):
+                z.writestr(f"m/{k}.txt", "")
+        elif kind == "depth":
+            z.writestr("/".join(["d"] * 40) + "/render.cpp", "int x;\n")
+        elif kind == "corrupt":
+            pass
+    if kind == "corrupt":
+        path.write_bytes(path.read_bytes()[:40])
+    return path
+
+
+@pytest.mark.parametrize("kind", ["size", "ratio", "members", "depth", "corrupt"])
+def test_a_hostile_zip_is_its_rows_cause_and_the_class_is_graded(tmp_path, monkeypatch, kind):
+    """A 80 KiB zip unpacking to 80 MiB (or too many members, too deep, unreadable) is
+    refused in one line, which becomes that student's cause; the others are graded."""
+    import csv
+
+    from grading import batch
+    subs, report = tmp_path / "subs", tmp_path / "report"
+    handin(subs / "ann", {"render.cpp": "int x;\n"})
+    bad_zip(subs / "bob.zip", kind)
+    graded = []
+
+    def grade_one(lab, folder, out, extra, env):
+        graded.append(folder.name)
+        out.mkdir(parents=True, exist_ok=True)
+        return {"score": 100, "max_score": 100, "output": "", "tests": [
+            {"name": "x", "score": 100, "max_score": 100, "status": "passed", "output": ""}]}
+    monkeypatch.setattr(batch, "grade_one", grade_one)
+    monkeypatch.setenv("TMPDIR", str(tmp_path))
+    assert batch.main(["01", str(subs), "--out", str(report)]) == 0
+    rows = {r["student"]: r for r in csv.DictReader((report / "grades.csv").open())}
+    assert graded == ["ann"] and rows["ann"]["score"] == "100"
+    assert rows["bob"]["score"] == "0" and "bob.zip" in rows["bob"]["cause"], rows["bob"]
+    assert "refused" in rows["bob"]["cause"], rows["bob"]
+    written = sum(f.stat().st_size for f in tmp_path.rglob("*") if f.is_file())
+    assert written < 32 << 20, written
+
+
+def test_a_linked_submission_folder_is_its_rows_cause(tmp_path, monkeypatch):
+    """A student's entry that is a link (an export unzipped with its links) would grade what
+    it points at, the solution here: refused, that row's cause."""
+    import csv
+
+    from grading import batch
+    subs, report = tmp_path / "subs", tmp_path / "report"
+    handin(subs / "ann", {"render.cpp": "int x;\n"})
+    (subs / "eve").symlink_to(ROOT / "labs" / "01-serial" / "solution")
+    graded = stub_grades(monkeypatch, 100)
+    assert batch.main(["01", str(subs), "--out", str(report)]) == 0
+    rows = {r["student"]: r for r in csv.DictReader((report / "grades.csv").open())}
+    assert graded == ["ann"] and rows["eve"]["score"] == "0", rows
+    assert "symbolic link" in rows["eve"]["cause"], rows["eve"]
+
+
+def stub_grades(monkeypatch, score: int) -> list[str]:
+    """grade-batch's grader replaced by one giving `score` to every hand-in; the names of the
+    folders it was given, in order."""
+    from grading import batch
+    graded = []
+
+    def grade_one(lab, folder, out, extra, env):
+        graded.append(folder.name)
+        out.mkdir(parents=True, exist_ok=True)
+        return {"score": score, "max_score": 100, "output": "", "tests": []}
+    monkeypatch.setattr(batch, "grade_one", grade_one)
+    return graded
+
+
+@pytest.mark.parametrize("metadata", [
+    "submission_1: !!python/object/apply:os.system ['echo owned']\n",
+    "submission_1:\n  :submitters: [[[\n",
+    "submission_1:\n  :submitters:\n  - :name: !custom x\n",
+    "submission_1:\n  :submitters: 7\n",
+    "- a list\n- not a map\n"])
+def test_a_hostile_export_metadata_never_stops_the_class(tmp_path, monkeypatch, capsys, metadata):
+    """An unexpected YAML tag, broken YAML or the wrong shape in submission_metadata.yml: the
+    submissions are graded all the same, the metadata's fault said in one line."""
+    import csv
+
+    from grading import batch
+    subs, report = tmp_path / "subs", tmp_path / "report"
+    for name in ("submission_1", "submission_2"):
+        handin(subs / name, {"render.cpp": "int x;\n"})
+    (subs / "submission_metadata.yml").write_text(
+        "submission_2:\n  :submitters:\n  - :name: Ada Lovelace\n" + metadata)
+    graded = stub_grades(monkeypatch, 50)
+    assert batch.main(["01", str(subs), "--out", str(report)]) == 0
+    assert graded == ["submission_1", "submission_2"], capsys.readouterr()
+    rows = list(csv.DictReader((report / "grades.csv").open()))
+    assert {r["submission_id"] for r in rows} >= {"1", "2"}
+    assert capsys.readouterr().err.count("submission_metadata.yml") == 1
+
+
+def test_a_submission_the_export_lists_without_its_folder_is_a_row(tmp_path, monkeypatch):
+    import csv
+
+    from grading import batch
+    subs = tmp_path / "subs"
+    handin(subs / "submission_1", {"render.cpp": "int x;\n"})
+    (subs / "submission_metadata.yml").write_text(
+        "submission_1:\n  :submitters:\n  - :name: Ada\n"
+        "submission_2:\n  :submitters:\n  - :name: Alan\n")
+    monkeypatch.setattr(batch, "grade_one", lambda lab, folder, out, extra, env: (
+        out.mkdir(parents=True, exist_ok=True), {"score": 100, "tests": []})[1])
+    assert batch.main(["01", str(subs), "--out", str(tmp_path / "r")]) == 0
+    rows = {r["submission_id"]: r for r in csv.DictReader((tmp_path / "r" / "grades.csv").open())}
+    assert rows["2"]["score"] == "0" and "no folder or zip" in rows["2"]["cause"], rows

@@ -13,6 +13,11 @@ every command and what it did with it, and fails on an entry of REDUCED or NOT_H
 document names any more.
 
     RT_RELEASE_LABS=01,03  only those labs' releases (default: 01-04)
+
+The GPU labs' releases (05-07, RT_RELEASE_GPU_LABS) are checked without a GPU: every command
+their README and handout give must exist there (`missing_from`: a make target make knows,
+a binary make can build, a Python module or file that ships), whether or not it can run on
+this machine.
 """
 from __future__ import annotations
 
@@ -29,6 +34,7 @@ from labkit import registry
 from labkit.harness import ROOT
 
 LABS = os.environ.get("RT_RELEASE_LABS", "01,02,03,04").split(",")
+GPU_LABS = [n for n in os.environ.get("RT_RELEASE_GPU_LABS", "05,06,07").split(",") if n]
 FOLDERS = leaks.lab_folders(ROOT)
 CLEAN_ENV = {k: v for k, v in os.environ.items()
              if k not in ("MAKEFLAGS", "MFLAGS", "MAKELEVEL", "PYTHONPATH", "GRADING_SECRET")}
@@ -269,3 +275,76 @@ def test_bench_cpu_builds_only_what_it_times():
         "nvcc" not in p.stdout and "g++" not in p.stdout, p.stdout
     source = (ROOT / "tools" / "bench" / "cpu.py").read_text()
     assert "load average" in source and "capacity" in source
+
+
+# ---- the GPU labs: every command exists in the release ----------------------------------------
+
+SYSTEM_TOOLS = {"cuobjdump", "ncu", "nsys", "nvidia-smi", "cat", "ls", "cd", "echo", "git"}
+
+
+def simple_commands(command: str) -> list[list[str]]:
+    """The simple commands of a command line or block, as words, environment settings and
+    launchers (mpirun and its options) dropped."""
+    found = []
+    for part in re.split(r"&&|\|\||;|\||\n", command):
+        words = part.replace("\\", " ").split()
+        while words and re.fullmatch(r"\w+=\S*", words[0]):
+            words.pop(0)
+        if words and words[0] == "mpirun":
+            words = [w for w in words if w.startswith("./")][:1] + words[1:]
+        if words:
+            found.append(words)
+    return found
+
+
+def missing_from(release: pathlib.Path, command: str) -> str | None:
+    """Why `command` (a line of a README or handout) names something the release lacks, or
+    None. A make goal must be one make knows how to make there (`make -n`); ./labNN one of
+    its make targets; `python3 -m M` a module that ships, and every path it names."""
+    for words in simple_commands(command):
+        first = words[0]
+        if first == "make" or first.startswith("./lab"):
+            # A dry run: a goal make has no rule for (or a prerequisite without one, such as
+            # a solution the release lacks) says so; a recipe that runs anyway under -n
+            # (one that calls $(MAKE)) may fail for want of what -n did not build.
+            goals = words[1:] if first == "make" else [first[2:]]
+            p = run(release, "make -n -s " + " ".join(goals))
+            said = p.stdout + p.stderr
+            if "No rule to make target" in said:
+                return f"make -n {' '.join(goals)}: " + said.strip()[-300:]
+        elif first == "python3":
+            if words[1:2] == ["-m"]:
+                module = words[2].replace(".", "/")
+                if not any((release / f).exists() for f in
+                           (f"{module}.py", f"{module}/__main__.py")) and words[2] != "pytest":
+                    return f"python3 -m {words[2]}: no such module in the release"
+            paths = [w for w in words[1:] if "/" in w and not w.startswith("-")]
+            absent = [w for w in paths if not (release / w.rstrip(":")).exists()]
+            if absent:
+                return f"{' '.join(words)}: {', '.join(absent)} not in the release"
+        elif "/" in first and not (release / first).exists():
+            return f"{first}: not in the release"
+        elif "/" not in first and first not in SYSTEM_TOOLS and first not in ("for", "do",
+                                                                               "done", "bash"):
+            return f"{first}: not a command this check knows (add it to SYSTEM_TOOLS?)"
+    return None
+
+
+@pytest.fixture(scope="module", params=GPU_LABS)
+def gpu_release(request, tmp_path_factory):
+    lab = request.param
+    out = tmp_path_factory.mktemp(f"release{lab}") / f"lab{lab}"
+    p = subprocess.run(["make", "-s", "-C", str(ROOT), "release", f"LAB={lab}", f"OUT={out}"],
+                       capture_output=True, text=True, timeout=3600, env=CLEAN_ENV)
+    assert p.returncode == 0, p.stdout + p.stderr
+    return lab, out
+
+
+def test_every_command_of_a_gpu_release_exists(gpu_release):
+    lab, release = gpu_release
+    found = commands(release, lab)
+    assert "make grade-gpu" in found and "make kernel-report" in found, found
+    absent = [f"{command}\n  {why}" for command in found
+              if (why := missing_from(release, command))]
+    print(f"lab {lab} release, {len(found)} commands:\n  " + "\n  ".join(found))
+    assert not absent, "\n".join(absent)

@@ -1,6 +1,7 @@
 """Speed grading's partial credit and its provisional points (grading/checks.py,
 grading/results.py): the curve, and points a regrade may add kept out of every total."""
 import math
+import time
 
 import pytest
 
@@ -136,3 +137,75 @@ def test_an_unsteady_reference_that_cannot_change_the_credit_is_final(monkeypatc
     """Far above the bar, 10% of unsteadiness changes nothing: full points at once."""
     result, measured = timed_with(monkeypatch, before=1.0, yours=0.1, after=0.9)
     assert not result.regrade and result.credit == 1 and measured == 3, result
+
+
+def parallel_timed(monkeypatch, *, capacity: float, base: float, yours: float, cores_used: float,
+                   busiest: float):
+    """check_parallel_speedup with the machine and every timed run replaced: the capacity and
+    the serial reference's best as measure_parallel reports them, and each of the program's
+    runs taking `yours` seconds, using `cores_used` cores' worth of CPU time, its busiest
+    thread `busiest` of it."""
+    import numpy as np
+
+    from grading import checks
+    from labkit import harness
+    from labkit.harness import ParallelTiming, Run
+
+    def run_lab(binary, **_):
+        return Run(0, "", "", {}, np.zeros((1, 1, 3), np.float32), yours, yours * cores_used,
+                   busiest)
+
+    def measure_parallel(baseline, candidates, **_):
+        return ParallelTiming(2, capacity, base, {n: c() for n, c in candidates.items()})
+
+    monkeypatch.setattr(checks, "run_lab", run_lab)
+    monkeypatch.setattr(harness, "cpu_capacity", lambda: 2.0)
+    monkeypatch.setattr(harness, "measure_parallel", measure_parallel)
+    monkeypatch.setattr(checks.time, "sleep", lambda seconds: None)
+    return checks.check_parallel_speedup("yours", "reference")
+
+
+def test_a_speedup_beyond_the_machines_capacity_is_refused_as_impossible(monkeypatch):
+    """A serial hand-in that replays a render it kept (its own first one, another run's):
+    6.21x on two cores giving 1.91x is no speedup, whatever its threads looked like."""
+    result = parallel_timed(monkeypatch, capacity=1.91, base=0.600, yours=0.600 / 6.21,
+                            cores_used=1.2, busiest=0.6)
+    assert not result.passed and result.credit == 0 and not result.regrade, result
+    assert result.detail.startswith("impossible: yours 6.21x"), result.detail
+    assert "1.91x capacity" in result.detail, result.detail
+
+
+def test_a_speedup_within_the_capacity_is_scored(monkeypatch):
+    result = parallel_timed(monkeypatch, capacity=1.91, base=0.600, yours=0.320,
+                            cores_used=1.9, busiest=0.5)
+    assert result.passed and result.credit == 1 and not result.regrade, result
+
+
+def test_a_spinning_thread_opens_no_gate_on_cpu_share_alone(monkeypatch, tmp_path):
+    """Serial code beside a thread that only spins, on a machine too busy to time: its work
+    looks shared among threads, so the speed is left to a regrade, and the checks gated on
+    it (bit identity, golden images) are graded with their points provisional, never in the
+    score, until the regrade measures a speedup."""
+    from grading import checks
+    from grading.grade import Item, grade_items
+    from labkit.harness import RunPolicy
+    from labkit.sandbox import Limits
+
+    speed = parallel_timed(monkeypatch, capacity=1.3, base=0.600, yours=0.600,
+                           cores_used=1.3, busiest=0.5)
+    assert speed.passed and speed.regrade and speed.credit == 0, speed
+    rubric = [Item("parallel-speedup", "parallel speedup", 40, lambda b: speed),
+              Item("bitwise", "bit-identical to lab 01", 30,
+                   lambda b: checks.CheckResult("bit-identical", True, "identical"),
+                   requires="parallel-speedup")]
+    results = Results()
+    results.add_all([Test(i.id, i.label, i.points) for i in rubric])
+    grade_items(rubric, "yours", tmp_path, "secret", results, RunPolicy(trusted=False),
+                Limits(), 600, time.perf_counter())
+    results.complete(1.0)
+    data = results.as_dict()
+    assert data["score"] == 0, data
+    bitwise = data["tests"][1]
+    assert bitwise["score"] == 0 and bitwise["extra_data"]["provisional"] == 30, (
+        bitwise["output"], data["tests"][0]["output"])
+    assert "counted when the regrade confirms the parallel speedup" in bitwise["output"], bitwise

@@ -53,7 +53,7 @@ def test_reference_scores_100_without_namespaces(tmp_path):
         assert all(t["extra_data"]["regrade"] for t in results["tests"]), results
         return
     assert status == 0, stderr
-    assert "dedicated user" in results["sandbox"], results["sandbox"]
+    assert "a user of its own" in results["sandbox"], results["sandbox"]
     assert results["score"] == 100, json.dumps(results, indent=1)[:3000]
 
 
@@ -99,11 +99,12 @@ echo "SECRET=$GRADING_SECRET"
             with sandbox.Runner(trusted=False) as r:
                 net = r.run([r.input(client), str(server.getsockname()[1])])
                 out = r.run([r.input(spy)])
+                uid = r.box[0]
     finally:
         del os.environ["GRADING_SECRET"]
     assert net.returncode == 3, (net.returncode, net.stderr)
     assert "SPY" not in out.stdout and "leak-me-4713" not in out.stdout, out.stdout
-    left = sandbox.user_processes(sandbox.sandbox_user()[0])
+    left = sandbox.user_processes(uid)
     assert not left, left
 
 
@@ -137,3 +138,43 @@ def test_a_private_temporary_folder_is_refused_in_one_line(tmp_path):
     named = p.stderr.split("cannot enter ")[1].split(" (mode")[0]
     assert str(private).startswith(named), p.stderr
     assert all(t["extra_data"]["regrade"] for t in results["tests"]), results
+
+
+def test_a_batch_grades_the_sources_beside_a_binary_without_namespaces(tmp_path):
+    """The reference's prebuilt binary handed in as `lab` beside the skeleton's sources, a
+    batch graded as Gradescope's containers grade (the user sandbox): the skeleton's score,
+    the binary named as ignored and never run."""
+    import shutil
+
+    from grading.students_tree import pristine_skeleton
+    if os.geteuid() != 0:
+        pytest.skip("the user sandbox needs root")
+    subs, report = tmp_path / "subs", tmp_path / "report"
+    (subs / "ann").mkdir(parents=True)
+    for name, text in pristine_skeleton("01-serial").items():
+        (subs / "ann" / name).write_text(text)
+    shutil.copyfile(sub.REFERENCE, subs / "ann" / "lab")
+    (subs / "ann" / "lab").chmod(0o755)
+    p = subprocess.run([*NO_NAMESPACES, sys.executable, "-m", "grading.batch", "01", str(subs),
+                        "--out", str(report)], cwd=ROOT, capture_output=True, text=True,
+                       timeout=600)
+    results = json.loads((report / "ann" / "results.json").read_text())
+    assert p.returncode == 0 and "a user of its own" in results["sandbox"], p.stdout + p.stderr
+    assert results["score"] <= 10, json.dumps(results, indent=1)[:3000]
+    assert "ignored, graded from its sources" in results["output"], results["output"]
+
+
+def test_a_file_name_that_is_shell_code_is_refused_without_namespaces(tmp_path):
+    name = "x.cpp;echo INJECTED-BUILD-STEP;.cpp"
+    folder = tmp_path / "in"
+    folder.mkdir()
+    (folder / "render.cpp").write_text((ROOT / "labs/01-serial/solution/render.cpp").read_text())
+    (folder / name).write_text("int unused;\n")
+    out = tmp_path / "results.json"
+    p = subprocess.run([*NO_NAMESPACES, sys.executable, "-m", "grading.grade", "01", "--sources",
+                        str(folder), "--results", str(out)], cwd=ROOT, capture_output=True,
+                       text=True, timeout=600)
+    results = json.loads(out.read_text())
+    assert p.returncode == 1 and results["score"] == 0, p.stderr
+    assert p.stderr.count("\n") == 1 and name in p.stderr, p.stderr
+    assert "INJECTED-BUILD-STEP\n" not in p.stdout + out.read_text()

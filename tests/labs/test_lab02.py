@@ -356,3 +356,44 @@ def test_part_a_reference_says_sse(lab02a_ref):
 def test_across_primitives_keeps_lab01s_bits(lab01_ref, lab02_prims, scene):
     """One ray against 8 primitives, with lab 01's path loop: the very same image."""
     assert render_shipped(lab02_prims, scene) == render_shipped(lab01_ref, scene)
+
+
+# ---- Part A is graded: a hand-in with it undone or wrong loses its points --------------------
+
+def part_a_build(tmp_path, vec3: str):
+    build("lab02a")  # the driver objects a Part A variant links (labs/02-simd/lab.mk)
+    loop = (ROOT / "labs/02-simd/render_vec3_sse.cpp").read_text()
+    return build_sources("02-simd-a", tmp_path, {"vec3.h": vec3, "render_vec3_sse.cpp": loop})
+
+
+def graded_part_a(binary):
+    from grading import draws
+    from grading.part_a import check_part_a
+    with draws.secret("part-a"):
+        return check_part_a(binary, "part-a", build("lab01-ref")[0])
+
+
+def test_part_a_is_in_the_rubric():
+    from grading.grade import RUBRICS
+    item = next(i for i in RUBRICS["02"] if i.id == "part-a")
+    assert item.part == "a" and item.points >= 10
+
+
+def test_part_a_reference_earns_part_a(lab02a_ref):
+    result = graded_part_a(lab02a_ref)
+    assert result.passed and result.credit == 1, str(result)
+
+
+def test_part_a_dot_without_its_z_term_loses_part_a(tmp_path):
+    solution = (ROOT / "labs/02-simd/solution/part-a/vec3.h").read_text()
+    whole = "return _mm_cvtss_f32(_mm_add_ss(pairs, _mm_movehl_ps(pairs, pairs)));"
+    assert whole in solution
+    mutant = part_a_build(tmp_path, solution.replace(whole, "return _mm_cvtss_f32(pairs);"))
+    result = graded_part_a(mutant)
+    assert not result.passed and result.credit <= 0.25, str(result)
+    assert "FAIL sphere interior" in result.detail and "FAIL lit plane" in result.detail
+
+
+def test_part_a_left_as_the_skeleton_earns_nothing(lab02a_pristine_skeleton):
+    result = graded_part_a(lab02a_pristine_skeleton)
+    assert result.credit == 0 and "scalar fallback" in result.detail, str(result)

@@ -429,3 +429,35 @@ def test_grader_gives_the_reference_full_marks(lab04_ref, tmp_path):
     if reason:
         pytest.skip(reason)
     assert results["score"] == results["max_score"] == 100, describe(results)
+
+
+# ---- every task is graded: a hand-in with one task left undone loses that task's points ---
+
+UNDONE = {
+    # Task 2 left as the skeleton has it: interleaved renders blocks (the same bits).
+    "interleaved": ("if (distribution == Distribution::interleaved) {", "if (false) {"),
+    # Task 3 left as the skeleton has it: dynamic renders blocks (the same bits).
+    "dynamic": ("Progress& progress,\n                    RankReport& report) {\n",
+                "Progress& progress,\n                    RankReport& report) {\n"
+                "    if (true) return render_static(Distribution::block, pixel, team, image, "
+                "progress, report);\n"),
+}
+
+
+@pytest.mark.parametrize("task", list(UNDONE))
+def test_grader_takes_the_points_of_an_undone_distribution(lab04_ref, task, tmp_path):
+    """The skeleton with only the gather done rendered lab 01's bits under every distribution
+    and scored full marks: the rows each rank rendered show the distribution that was not
+    written, and the rubric's rows-per-distribution check loses its half for it."""
+    from grading.grade import RUBRICS
+    from labkit.variants import build_variant, lab_sources
+    old, new = UNDONE[task]
+    source = lab_sources("04-mpi")["render.cpp"]
+    assert old in source
+    mutant = build_variant("04-mpi", tmp_path, {"render.cpp": source.replace(old, new)})
+    item = next(i for i in RUBRICS["04"] if i.id == "distributions")
+    done, undone = checks.check_distributions(lab04_ref), checks.check_distributions(mutant)
+    assert done.passed and done.credit == 1, str(done)
+    assert not undone.passed and undone.credit == 0.5, str(undone)
+    assert round(item.points * undone.credit) < item.points
+    assert f"task {2 if task == 'interleaved' else 3}" in undone.detail, str(undone)

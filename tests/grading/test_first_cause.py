@@ -1,0 +1,106 @@
+"""The first cause a failing check gives is the true one, and comes with a command the student
+can rerun at home: an MPI error by name with mpirun's own text, a deadlock as a rank waiting
+for a message, lab 04's missing gather as rows never gathered (not as a work split)."""
+import pytest
+
+from grading import checks, draws, grade, symptoms
+from labkit.harness import (
+    ROOT,
+    RunError,
+    RunPolicy,
+    build,
+    cpu_has_avx2,
+    failure_message,
+    policy,
+    rerun_as,
+    run_lab,
+)
+from labkit.sandbox import Limits
+from labkit.variants import build_pristine_skeleton, build_variant, lab_sources
+
+UNTRUSTED = RunPolicy(trusted=False, limits=Limits(wall_seconds=30))
+
+
+@pytest.fixture(autouse=True)
+def mpirun_as_root(monkeypatch):
+    monkeypatch.setenv("OMPI_ALLOW_RUN_AS_ROOT", "1")
+    monkeypatch.setenv("OMPI_ALLOW_RUN_AS_ROOT_CONFIRM", "1")
+
+
+def rerun_words(message: str) -> list[str]:
+    return message.split("; rerun: ", 1)[1].split(";", 1)[0].split()
+
+
+def test_an_mpi_type_mismatch_is_named_with_a_command_to_rerun(tmp_path):
+    build("lab04-ref")  # the driver objects the mutant links
+    source = lab_sources("04-mpi")["render.cpp"]
+    old = "MPI_Recv(message, 2, MPI_INT, 0, kTagWork"
+    assert old in source
+    mutant = build_variant("04-mpi", tmp_path,
+                           {"render.cpp": source.replace(old, old.replace(", 2,", ", 1,"))})
+    # Inside the sandbox OpenMPI sometimes fails to print its own error ("ORTE_ERROR_LOG: Out
+    # of resource in file ... show_help.c": about one run in three on a 2-core VM), and then
+    # there is no MPI error to name: up to three runs, the first whose text came through.
+    for _ in range(3):
+        with policy(UNTRUSTED), rerun_as("./lab04"), pytest.raises(RunError) as failed:
+            run_lab(mutant, scene=ROOT / "common/scenes/cornell.json", width=16, height=12,
+                    spp=2, launcher=checks.mpirun(2))
+        message = str(failed.value)
+        if "show_help.c" not in message:
+            break
+    assert "MPI_ERR_TRUNCATE" in message.split("; rerun: ")[0], message  # named first
+    assert "An error occurred in MPI_Recv" in message  # mpirun's own text reaches the student
+    words = rerun_words(message)
+    assert words[:1] == ["mpirun"] and "./lab04" in words, message
+    scene = words[words.index("--scene") + 1]
+    assert (ROOT / scene).is_file(), message
+
+
+def test_a_check_on_a_scene_made_for_it_names_a_scene_that_exists(tmp_path):
+    """A scene written for one check is deleted when the check ends: the command names the
+    public scene it varies."""
+    made = tmp_path / "drawn.json"
+    made.write_text((ROOT / "common/scenes/cornell.json").read_text())
+    with policy(UNTRUSTED), rerun_as("./lab01"), pytest.raises(RunError) as failed:
+        run_lab(ROOT / "lab01-ref", scene=made, width=8, height=8, spp=1,
+                extra=["--bounces", "-3"])
+    words = rerun_words(str(failed.value))
+    assert words[0] == "./lab01", failed.value
+    assert (ROOT / words[words.index("--scene") + 1]).is_file(), failed.value
+    assert str(tmp_path) not in str(failed.value).split("; it said")[0]
+
+
+def test_a_deadlock_is_a_rank_waiting_for_a_message():
+    message = failure_message("timed out after 20 s", "", checks.mpirun(2), "mpirun ./lab04")
+    assert "a rank waits for a message that never comes" in message
+
+
+def test_the_missing_gather_is_rows_never_gathered_not_a_work_split(tmp_path):
+    build("lab04-ref")
+    skeleton = build_pristine_skeleton("04-mpi", tmp_path)
+    item = next(i for i in grade.RUBRICS["04"] if i.id == "bitwise")
+    with draws.secret("first-cause"), symptoms.grading("04"), policy(UNTRUSTED):
+        result = item.run(skeleton)
+    assert not result.passed
+    cause = result.detail.split("; ", 1)[1]
+    assert "never gathered" in cause and "work split" not in cause, result.detail
+
+
+def test_a_wrong_lane_mask_in_lab02_is_named_before_the_statistics(tmp_path):
+    """Lab 02's rectangle test keeping hits behind the ray (its `crosses` mask dropped): the
+    golden check names the lanes, which lab 01's bits show, before "too noisy", which would
+    point at a loop over paths lab 02 students never write."""
+    if not cpu_has_avx2():
+        pytest.skip("this CPU has no AVX2/FMA: lab 02's Part B cannot run")
+    source = (ROOT / "common/simd/packet_tracer.h").read_text()
+    old = "return select(crosses & inside, t, t_max);"
+    assert old in source
+    mutant = build_variant("02-simd", tmp_path,
+                           {"packet_tracer.h": source.replace(old, "return select(inside, t, "
+                                                                   "t_max);")})
+    with draws.secret("lanes"), symptoms.grading("02"), policy(UNTRUSTED), rerun_as("./lab02"):
+        result = checks.check_golden(mutant, "cornell")
+    assert not result.passed
+    assert result.detail.startswith("lanes: ") and "lane mask" in result.detail, result.detail
+    # and the command to see it again at home, on the scene the check rendered
+    assert "rerun: ./lab02 --scene common/scenes/cornell.json " in result.detail, result.detail
