@@ -69,7 +69,7 @@ struct Walls {
 const Walls& walls() {
     static const Walls w = [] {
         Walls out;
-        out.rects = cornell().rects;
+        out.rects = cornell().of<AxisRect>();
         for (const AxisRect& r : out.rects) {
             Vec3 c[4];
             rect_corners(r, c);
@@ -128,7 +128,7 @@ void BM_intersect_sphere(benchmark::State& state) {
     const std::vector<Ray> rays = sample_rays(4096);
     size_t i = 0;
     for (auto _ : state) {
-        benchmark::DoNotOptimize(intersect_sphere(rays[i++ & 4095], scene.spheres[0], 1e30f));
+        benchmark::DoNotOptimize(intersect_sphere(rays[i++ & 4095], scene.of<Sphere>()[0], 1e30f));
     }
     state.SetItemsProcessed(state.iterations());
 }

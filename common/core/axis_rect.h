@@ -11,6 +11,10 @@
 // the upper corner and what shading reads. u and v are the two axes other than `axis`, in
 // index order (x before y before z).
 struct alignas(16) AxisRect {
+    // What the scene report calls this kind: one of them (plural: +"s"), its --json key.
+    static constexpr const char* kName = "rectangle";
+    static constexpr const char* kReportKey = "rects";
+
     real plane;       // the coordinate on `axis` of every point
     real lo_u, lo_v;  // the lower bounds on axes u and v
     real extent;      // largest |coordinate| of the corners: bounds the hit's rounding error

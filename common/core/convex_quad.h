@@ -13,6 +13,10 @@
 // rounded once, so an edge shared with a triangle or another quad has the same float
 // endpoints on both sides.
 struct alignas(16) ConvexQuad {
+    // What the scene report calls this kind: one of them (plural: +"s"), its --json key.
+    static constexpr const char* kName = "convex quad";
+    static constexpr const char* kReportKey = "quads";
+
     Vec3 normal;        // unit normal of the fitted plane; the front side as a triangle's
     real plane_offset;  // the plane is dot(normal, p) == plane_offset
     Vec3 v0;            // vertices, counter-clockwise seen from the front

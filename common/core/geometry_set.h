@@ -5,39 +5,72 @@
 // loops (`if constexpr` in path_tracer.h), with the same arithmetic for every primitive it
 // does test, so the same bits.
 //
-// Each set is a type, chosen once per render by dispatch on geometry_kinds(scene).
+// A set names its kinds (Kinds<Sphere, AxisRect>, kinds.h), drawn from AllPrimitives
+// (primitive_kinds.h); each set is a type, chosen once per render by dispatch on
+// geometry_kinds(scene).
 #pragma once
 
+#include <primitive_kinds.h>
 #include <scene_view.h>
 
-template <bool kWithSpheres, bool kWithTriangles, bool kWithQuads, bool kWithRects>
-struct GeometrySet {
-    static constexpr bool kSpheres = kWithSpheres;
-    static constexpr bool kTriangles = kWithTriangles;
-    static constexpr bool kQuads = kWithQuads;  // planar convex quads (convex_quad.h)
-    static constexpr bool kRects = kWithRects;  // axis-aligned rectangles (axis_rect.h)
-    static constexpr bool kSheared = kWithTriangles || kWithQuads;  // need the RayShear
+// What a Hit names (path_tracer.h): nothing, or a primitive of one kind, numbered by its
+// position in AllPrimitives from 1 (primitive_kind<Sphere> is 1).
+enum class PrimitiveKind : int { None = 0 };
+
+template <class K>
+struct PrimitiveKindOf {
+    static_assert(has_kind<AllPrimitives, K>, "a primitive kind is one of AllPrimitives");
+    static constexpr PrimitiveKind value =
+        static_cast<PrimitiveKind>(kind_index<AllPrimitives, K> + 1);
 };
+template <class K>
+constexpr PrimitiveKind primitive_kind = PrimitiveKindOf<K>::value;
 
-// What a Hit names (path_tracer.h): nothing, or a primitive of one kind.
-enum class PrimitiveKind : int { None, Sphere, Triangle, Quad, Rect };
+using AnyGeometry = AllPrimitives;             // every scene: the default
+using BoxGeometry = Kinds<Sphere, AxisRect>;   // spheres and rectangles (Cornell)
 
-using AnyGeometry = GeometrySet<true, true, true, true>;     // every scene: the default
-using BoxGeometry = GeometrySet<true, false, false, true>;   // spheres and rectangles (Cornell)
+// Whether a set holds a kind whose test shears the ray (RayShear, triangle.h): the loops
+// build the shear once per ray for all of them.
+template <class Set>
+constexpr bool needs_shear = has_kind<Set, Triangle> || has_kind<Set, ConvexQuad>;
 
-// The kinds of primitive a scene holds (has_specular_material's twin).
+// The kinds of primitive a scene holds (has_specular_material's twin): one flag per kind of
+// AllPrimitives, in its order.
 struct GeometryKinds {
-    bool spheres, triangles, quads, rects;
+    bool present[AllPrimitives::kCount];
+
+    template <class K>
+    RT_HD bool has() const {
+        return present[kind_index<AllPrimitives, K>];
+    }
 
     // Whether a renderer compiled for `Set` renders every primitive of the scene.
     template <class Set>
     RT_HD bool fits() const {
-        return (Set::kSpheres || !spheres) && (Set::kTriangles || !triangles) &&
-               (Set::kQuads || !quads) && (Set::kRects || !rects);
+        bool fits = true;
+        for_each_kind(AllPrimitives{}, [&](auto kind) {
+            using K = typename decltype(kind)::type;
+            fits = fits && (has_kind<Set, K> || !has<K>());
+        });
+        return fits;
     }
 };
 
+// The kinds of a scene that holds exactly Set's kinds (for tests and benchmarks).
+template <class Set>
+RT_HD GeometryKinds geometry_kinds_of() {
+    GeometryKinds kinds{};
+    for_each_kind(Set{}, [&](auto kind) {
+        kinds.present[kind_index<AllPrimitives, typename decltype(kind)::type>] = true;
+    });
+    return kinds;
+}
+
 RT_HD inline GeometryKinds geometry_kinds(const SceneView& scene) {
-    return {scene.num_spheres > 0, scene.num_triangles > 0, scene.num_quads > 0,
-            scene.num_rects > 0};
+    GeometryKinds kinds{};
+    for_each_kind(AllPrimitives{}, [&](auto kind) {
+        using K = typename decltype(kind)::type;
+        kinds.present[kind_index<AllPrimitives, K>] = scene.of<K>().count > 0;
+    });
+    return kinds;
 }

@@ -3,13 +3,41 @@
 
 #include <cmath>
 
+#include <kinds.h>
 #include <real.h>
 #include <vec3.h>
 
-enum class MaterialType : int { Diffuse = 0, Mirror = 1, Glass = 2 };
+// The material kinds, declared here once: AllMaterials lists them, a material's type is its
+// kind's position in the list, and every set a renderer is compiled for names its kinds
+// (material_set.h). kName: what the scene report calls one; kReportKey: its --json key.
+struct Diffuse {  // Lambertian: albedo / pi
+    static constexpr const char* kName = "diffuse";
+    static constexpr const char* kReportKey = "diffuse";
+};
+struct Mirror {  // perfect specular reflection, tinted by the albedo
+    static constexpr const char* kName = "mirror";
+    static constexpr const char* kReportKey = "mirrors";
+};
+struct Glass {  // smooth dielectric: Fresnel reflection or refraction by the ior
+    static constexpr const char* kName = "glass";
+    static constexpr const char* kReportKey = "glass";
+};
+
+using AllMaterials = Kinds<Diffuse, Mirror, Glass>;
+
+// A material's kind: its position in AllMaterials (material_type<Glass> is 2).
+enum class MaterialType : int {};
+
+template <class K>
+struct MaterialTypeOf {
+    static_assert(has_kind<AllMaterials, K>, "a material kind is one of AllMaterials");
+    static constexpr MaterialType value = static_cast<MaterialType>(kind_index<AllMaterials, K>);
+};
+template <class K>
+constexpr MaterialType material_type = MaterialTypeOf<K>::value;
 
 struct Material {
-    MaterialType type;  // which BSDF
+    MaterialType type;  // which BSDF: material_type<K> for a kind K of AllMaterials
     Vec3 albedo;        // diffuse reflectance or mirror tint (unused by glass)
     real ior;           // index of refraction inside glass (unused otherwise)
 };

@@ -5,29 +5,28 @@
 // and refraction push the megakernel past its register budget into spills). A renderer
 // instantiated for the scene's own set carries only what the scene uses.
 //
-// Each set is a type, so the choice is made once per render by dispatch (has_specular_material) and
-// the compiler removes the unused branches (`if constexpr` in bounce_step).
+// A set names its kinds (Kinds<Diffuse>, kinds.h), drawn from AllMaterials (material.h); each
+// is a type, so the choice is made once per render by dispatch (has_specular_material) and the
+// compiler removes the unused branches (`if constexpr` in bounce_step).
 #pragma once
 
+#include <kinds.h>
 #include <material.h>
 #include <rt_hd.h>
 
-template <bool kWithMirror, bool kWithGlass>
-struct MaterialSet {
-    static constexpr bool kMirror = kWithMirror;
-    static constexpr bool kGlass = kWithGlass;
-    static constexpr bool kSpecular = kWithMirror || kWithGlass;  // anything but diffuse
-};
+using AnyMaterial = AllMaterials;  // every scene: the default
+using DiffuseOnly = Kinds<Diffuse>;  // scenes without mirrors or glass
 
-using AnyMaterial = MaterialSet<true, true>;  // every scene: the default
-using DiffuseOnly = MaterialSet<false, false>;  // scenes without mirrors or glass
+// Whether a set holds any kind but the diffuse one: the bounce step's specular branch.
+template <class Set>
+constexpr bool has_specular = Set::kCount > (has_kind<Set, Diffuse> ? 1 : 0);
 
 // What a scene's material table holds: whether a renderer for DiffuseOnly may render it.
 // (A table entry that no primitive uses counts too: the check stays one loop over a short
 // table, and a set too large costs speed, never correctness.)
 RT_HD inline bool has_specular_material(const Material* materials, int count) {
     for (int i = 0; i < count; ++i) {
-        if (materials[i].type != MaterialType::Diffuse) return true;
+        if (materials[i].type != material_type<Diffuse>) return true;
     }
     return false;
 }

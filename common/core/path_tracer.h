@@ -52,19 +52,19 @@ struct SurfacePoint {
 template <class Primitives = AnyGeometry>
 RT_HD inline SurfacePoint surface_at(const SceneView& scene, const Ray& ray, const Hit& hit) {
     const Vec3 p = ray.at(hit.t);
-    if (Primitives::kSpheres && hit.kind == PrimitiveKind::Sphere) {
-        const Sphere& s = scene.spheres[hit.index];
+    if (has_kind<Primitives, Sphere> && hit.kind == primitive_kind<Sphere>) {
+        const Sphere& s = scene.of<Sphere>()[hit.index];
         return {p, normalize(p - s.center), sphere_extent(s), s.material};
     }
-    if (Primitives::kRects && hit.kind == PrimitiveKind::Rect) {
-        const AxisRect& r = scene.rects[hit.index];
+    if (has_kind<Primitives, AxisRect> && hit.kind == primitive_kind<AxisRect>) {
+        const AxisRect& r = scene.of<AxisRect>()[hit.index];
         return {p, rect_normal(r), r.extent, r.material};
     }
-    if (Primitives::kQuads && hit.kind == PrimitiveKind::Quad) {
-        const ConvexQuad& q = scene.quads[hit.index];
+    if (has_kind<Primitives, ConvexQuad> && hit.kind == primitive_kind<ConvexQuad>) {
+        const ConvexQuad& q = scene.of<ConvexQuad>()[hit.index];
         return {p, q.normal, q.extent, q.material};
     }
-    const Triangle& tri = scene.triangles[hit.index];
+    const Triangle& tri = scene.of<Triangle>()[hit.index];
     return {p, tri.normal, tri.extent, tri.material};
 }
 
@@ -75,29 +75,31 @@ template <class Primitives = AnyGeometry>
 RT_HD inline Hit closest_hit(const SceneView& scene, const Ray& ray) {
     Hit hit;
     // BEGIN SOLUTION
-    if constexpr (Primitives::kSpheres) {
-        for (int i = 0; i < scene.num_spheres; ++i) {
-            const real t = intersect_sphere(ray, scene.spheres[i], hit.t);
-            if (t < hit.t) hit = {t, PrimitiveKind::Sphere, i};
+    if constexpr (has_kind<Primitives, Sphere>) {
+        for (int i = 0; i < scene.of<Sphere>().count; ++i) {
+            const real t = intersect_sphere(ray, scene.of<Sphere>()[i], hit.t);
+            if (t < hit.t) hit = {t, primitive_kind<Sphere>, i};
         }
     }
-    if constexpr (Primitives::kSheared) {
-        if (scene.num_triangles > 0 || scene.num_quads > 0) {  // the same for every ray
+    if constexpr (needs_shear<Primitives>) {
+        // The same for every ray.
+        if (scene.of<Triangle>().count > 0 || scene.of<ConvexQuad>().count > 0) {
             const RayShear shear(ray.direction);
-            for (int i = 0; Primitives::kTriangles && i < scene.num_triangles; ++i) {
-                const real t = intersect_triangle(ray, shear, scene.triangles[i], hit.t);
-                if (t < hit.t) hit = {t, PrimitiveKind::Triangle, i};
+            for (int i = 0; has_kind<Primitives, Triangle> && i < scene.of<Triangle>().count; ++i) {
+                const real t = intersect_triangle(ray, shear, scene.of<Triangle>()[i], hit.t);
+                if (t < hit.t) hit = {t, primitive_kind<Triangle>, i};
             }
-            for (int i = 0; Primitives::kQuads && i < scene.num_quads; ++i) {
-                const real t = intersect_quad(ray, shear, scene.quads[i], hit.t);
-                if (t < hit.t) hit = {t, PrimitiveKind::Quad, i};
+            for (int i = 0; has_kind<Primitives, ConvexQuad> && i < scene.of<ConvexQuad>().count;
+                 ++i) {
+                const real t = intersect_quad(ray, shear, scene.of<ConvexQuad>()[i], hit.t);
+                if (t < hit.t) hit = {t, primitive_kind<ConvexQuad>, i};
             }
         }
     }
-    if constexpr (Primitives::kRects) {
-        for (int i = 0; i < scene.num_rects; ++i) {
-            const real t = intersect_rect(ray, scene.rects[i], hit.t);
-            if (t < hit.t) hit = {t, PrimitiveKind::Rect, i};
+    if constexpr (has_kind<Primitives, AxisRect>) {
+        for (int i = 0; i < scene.of<AxisRect>().count; ++i) {
+            const real t = intersect_rect(ray, scene.of<AxisRect>()[i], hit.t);
+            if (t < hit.t) hit = {t, primitive_kind<AxisRect>, i};
         }
     }
     // SKELETON
@@ -105,9 +107,9 @@ RT_HD inline Hit closest_hit(const SceneView& scene, const Ray& ray) {
     //> // order, keeping the nearest hit: the triangles and the quads (build one RayShear per
     //> // ray, then intersect_triangle and intersect_quad), then the axis-aligned rectangles
     //> // (intersect_rect: the Cornell box's walls). Each hit records its kind and index.
-    //> for (int i = 0; Primitives::kSpheres && i < scene.num_spheres; ++i) {
-    //>     const real t = intersect_sphere(ray, scene.spheres[i], hit.t);
-    //>     if (t < hit.t) hit = {t, PrimitiveKind::Sphere, i};
+    //> for (int i = 0; has_kind<Primitives, Sphere> && i < scene.of<Sphere>().count; ++i) {
+    //>     const real t = intersect_sphere(ray, scene.of<Sphere>()[i], hit.t);
+    //>     if (t < hit.t) hit = {t, primitive_kind<Sphere>, i};
     //> }
     // END SOLUTION
     return hit;
@@ -121,28 +123,29 @@ RT_HD inline bool occluded(const SceneView& scene, const Ray& ray, real t_max) {
     // On a GPU every lane tests every primitive and the answer comes after the loops: an exit
     // at the first blocker would only split the warp (kConvergedTests, rt_hd.h).
     bool blocked = false;
-    if constexpr (Primitives::kSpheres) {
-        for (int i = 0; i < scene.num_spheres; ++i) {
-            blocked |= intersect_sphere(ray, scene.spheres[i], t_max) < t_max;
+    if constexpr (has_kind<Primitives, Sphere>) {
+        for (int i = 0; i < scene.of<Sphere>().count; ++i) {
+            blocked |= intersect_sphere(ray, scene.of<Sphere>()[i], t_max) < t_max;
             if (!kConvergedTests && blocked) return true;
         }
     }
-    if constexpr (Primitives::kSheared) {
-        if (scene.num_triangles > 0 || scene.num_quads > 0) {
+    if constexpr (needs_shear<Primitives>) {
+        if (scene.of<Triangle>().count > 0 || scene.of<ConvexQuad>().count > 0) {
             const RayShear shear(ray.direction);
-            for (int i = 0; Primitives::kTriangles && i < scene.num_triangles; ++i) {
-                blocked |= intersect_triangle(ray, shear, scene.triangles[i], t_max) < t_max;
+            for (int i = 0; has_kind<Primitives, Triangle> && i < scene.of<Triangle>().count; ++i) {
+                blocked |= intersect_triangle(ray, shear, scene.of<Triangle>()[i], t_max) < t_max;
                 if (!kConvergedTests && blocked) return true;
             }
-            for (int i = 0; Primitives::kQuads && i < scene.num_quads; ++i) {
-                blocked |= intersect_quad(ray, shear, scene.quads[i], t_max) < t_max;
+            for (int i = 0; has_kind<Primitives, ConvexQuad> && i < scene.of<ConvexQuad>().count;
+                 ++i) {
+                blocked |= intersect_quad(ray, shear, scene.of<ConvexQuad>()[i], t_max) < t_max;
                 if (!kConvergedTests && blocked) return true;
             }
         }
     }
-    if constexpr (Primitives::kRects) {
-        for (int i = 0; i < scene.num_rects; ++i) {
-            blocked |= rect_blocks(ray, scene.rects[i], t_max);
+    if constexpr (has_kind<Primitives, AxisRect>) {
+        for (int i = 0; i < scene.of<AxisRect>().count; ++i) {
+            blocked |= rect_blocks(ray, scene.of<AxisRect>()[i], t_max);
             if (!kConvergedTests && blocked) return true;
         }
     }
@@ -161,12 +164,12 @@ RT_HD inline bool occluded(const SceneView& scene, const Ray& ray, real t_max) {
 // convex_quad.h, axis_rect.h); zero on a sphere, which has none.
 template <class Primitives = AnyGeometry>
 RT_HD inline Vec3 step_off_hit_edges(const SceneView& scene, const Hit& hit, Vec3 p, real margin) {
-    if (Primitives::kTriangles && hit.kind == PrimitiveKind::Triangle)
-        return step_off_edges(scene.triangles[hit.index], p, margin);
-    if (Primitives::kQuads && hit.kind == PrimitiveKind::Quad)
-        return step_off_edges(scene.quads[hit.index], p, margin);
-    if (Primitives::kRects && hit.kind == PrimitiveKind::Rect)
-        return step_off_edges(scene.rects[hit.index], p, margin);
+    if (has_kind<Primitives, Triangle> && hit.kind == primitive_kind<Triangle>)
+        return step_off_edges(scene.of<Triangle>()[hit.index], p, margin);
+    if (has_kind<Primitives, ConvexQuad> && hit.kind == primitive_kind<ConvexQuad>)
+        return step_off_edges(scene.of<ConvexQuad>()[hit.index], p, margin);
+    if (has_kind<Primitives, AxisRect> && hit.kind == primitive_kind<AxisRect>)
+        return step_off_edges(scene.of<AxisRect>()[hit.index], p, margin);
     return Vec3(0.0f);
 }
 
@@ -274,7 +277,7 @@ RT_HD RT_FORCE_INLINE bool bounce_step(const SceneView& scene, const Hit& hit, c
     const int bounce = path.bounce++;
     path.alive = path.bounce < max_bounces;
 
-    if (!Materials::kSpecular || material.type == MaterialType::Diffuse) {
+    if (!has_specular<Materials> || material.type == material_type<Diffuse>) {
         const bool lit = scene.has_light && sample_light(scene, surface.position, above, facing,
                                                          material.albedo, shadow);
         if (lit) shadow.radiance = path.throughput * shadow.radiance;
@@ -285,7 +288,7 @@ RT_HD RT_FORCE_INLINE bool bounce_step(const SceneView& scene, const Hit& hit, c
         }
         return lit;
     }
-    if constexpr (Materials::kSpecular) {
+    if constexpr (has_specular<Materials>) {
         if (!path.alive) return false;
         // A specular path may bounce 64 times inside a closed mirror or glass room, and must
         // stay inside: its origin also steps off any edge of the triangle, quad
@@ -295,7 +298,8 @@ RT_HD RT_FORCE_INLINE bool bounce_step(const SceneView& scene, const Hit& hit, c
         // sphere). refract() normalises already.
         const Vec3 off_edges = step_off_hit_edges<Primitives>(
             scene, hit, surface.position, ray_offset(surface.position, hit.t, surface.extent));
-        if (!Materials::kGlass || (Materials::kMirror && material.type == MaterialType::Mirror)) {
+        if (!has_kind<Materials, Glass> ||
+            (has_kind<Materials, Mirror> && material.type == material_type<Mirror>)) {
             path.throughput *= material.albedo;
             path.ray = {above + off_edges, normalize(reflect(incoming, facing))};
         } else {  // glass: reflect or refract, chosen with the Fresnel reflectance

@@ -4,11 +4,8 @@
 
 #include <cstdint>
 
-#include <axis_rect.h>
-#include <convex_quad.h>
 #include <material.h>
-#include <sphere.h>
-#include <triangle.h>
+#include <primitive_kinds.h>
 
 struct PointLight {
     Vec3 position;   // world space
@@ -24,19 +21,30 @@ struct RenderSettings {
     uint64_t seed = 0;  // RNG seed
 };
 
-// Non-owning view of a scene's arrays.
+// One kind's primitives in a scene: where they lie and how many.
+template <class K>
+struct KindSpan {
+    const K* items = nullptr;
+    int count = 0;
+
+    RT_HD const K& operator[](int i) const { return items[i]; }
+};
+
+// Non-owning view of a scene's arrays: one per kind of AllPrimitives (of<Sphere>(), ...).
 struct SceneView {
-    const Sphere* spheres;
-    int num_spheres;
-    const Triangle* triangles;
-    int num_triangles;
-    const ConvexQuad* quads;  // planar convex quads of the scene file
-    int num_quads;
-    const AxisRect* rects;  // its axis-aligned rectangles
-    int num_rects;
+    PerKind<KindSpan, AllPrimitives> primitives;
     const Material* materials;
     int num_materials;
     PointLight light;
     bool has_light;
     Vec3 background;  // radiance of every ray that escapes
+
+    template <class K>
+    RT_HD const KindSpan<K>& of() const {
+        return primitives.of<K>();
+    }
+    template <class K>
+    RT_HD KindSpan<K>& of() {
+        return primitives.of<K>();
+    }
 };

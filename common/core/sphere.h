@@ -8,6 +8,10 @@
 // 16-byte aligned, centre and radius in the first row: the intersection test reads them with
 // one vector load on a GPU (see Triangle).
 struct alignas(16) Sphere {
+    // What the scene report calls this kind: one of them (plural: +"s"), its --json key.
+    static constexpr const char* kName = "sphere";
+    static constexpr const char* kReportKey = "spheres";
+
     Vec3 center;    // world-space centre
     real radius;    // > 0
     int material;   // index into the scene's material table

@@ -11,6 +11,10 @@
 // loads: the megakernel is bound by instruction issue), and a CPU finds the whole triangle
 // in one 64-byte cache line.
 struct alignas(16) Triangle {
+    // What the scene report calls this kind: one of them (plural: +"s"), its --json key.
+    static constexpr const char* kName = "triangle";
+    static constexpr const char* kReportKey = "triangles";
+
     Vec3 normal;         // unit geometric normal, or zero for a degenerate triangle
     real plane_offset;   // dot(normal, v0): the plane is dot(normal, p) == plane_offset
     Vec3 v0;             // vertices; the front side is where (v1-v0) x (v2-v0) points

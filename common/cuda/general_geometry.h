@@ -27,35 +27,38 @@ class SceneInForm {
 public:
     SceneInForm(const SceneView& scene, GeometryForm form) : view(scene) {
         if (form == GeometryForm::AsLoaded) return;
-        quads_.assign(scene.quads, scene.quads + scene.num_quads);
-        for (int i = 0; i < scene.num_rects; ++i) {
+        quads_.assign(scene.of<ConvexQuad>().items,
+                      scene.of<ConvexQuad>().items + scene.of<ConvexQuad>().count);
+        for (int i = 0; i < scene.of<AxisRect>().count; ++i) {
             Vec3 v[4];
-            rect_corners(scene.rects[i], v);
-            quads_.push_back(make_convex_quad(v[0], v[1], v[2], v[3], scene.rects[i].material));
+            rect_corners(scene.of<AxisRect>()[i], v);
+            quads_.push_back(
+                make_convex_quad(v[0], v[1], v[2], v[3], scene.of<AxisRect>()[i].material));
             // The rectangle's own normal. make_convex_quad's equals it but for the signs of its
             // zeros (the cross product can give -0), and the sign of a zero component picks
             // the tangent frame of cosine sampling (sample_cosine_hemisphere): with a -0 every
             // bounce off that wall would draw other directions from the same random numbers.
-            quads_.back().normal = rect_normal(scene.rects[i]);
+            quads_.back().normal = rect_normal(scene.of<AxisRect>()[i]);
         }
-        view.rects = nullptr;
-        view.num_rects = 0;
+        view.of<AxisRect>().items = nullptr;
+        view.of<AxisRect>().count = 0;
         if (form == GeometryForm::Triangles) {
-            triangles_.assign(scene.triangles, scene.triangles + scene.num_triangles);
+            triangles_.assign(scene.of<Triangle>().items,
+                              scene.of<Triangle>().items + scene.of<Triangle>().count);
             for (size_t k = 0; k < quads_.size(); ++k) {
                 const ConvexQuad& q = quads_[k];
                 triangles_.push_back(make_triangle(q.v0, q.v1, q.v2, q.material));
                 triangles_.push_back(make_triangle(q.v0, q.v2, q.v3, q.material));
                 // A rectangle's two triangles: its normal too, as above.
-                if (k >= static_cast<size_t>(scene.num_quads))
+                if (k >= static_cast<size_t>(scene.of<ConvexQuad>().count))
                     triangles_.end()[-2].normal = triangles_.end()[-1].normal = q.normal;
             }
             quads_.clear();
-            view.triangles = triangles_.data();
-            view.num_triangles = static_cast<int>(triangles_.size());
+            view.of<Triangle>().items = triangles_.data();
+            view.of<Triangle>().count = static_cast<int>(triangles_.size());
         }
-        view.quads = quads_.empty() ? nullptr : quads_.data();
-        view.num_quads = static_cast<int>(quads_.size());
+        view.of<ConvexQuad>().items = quads_.empty() ? nullptr : quads_.data();
+        view.of<ConvexQuad>().count = static_cast<int>(quads_.size());
     }
     SceneInForm(const SceneInForm&) = delete;
     SceneInForm& operator=(const SceneInForm&) = delete;

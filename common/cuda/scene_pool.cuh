@@ -1,6 +1,6 @@
-// The scene as one block of 16-byte words (materials, then spheres, triangles, convex quads and
-// axis-aligned rectangles), so that
-// a single copy puts it in any of the GPU's memories, and the SceneView the shared core reads
+// The scene as one block of 16-byte words (materials, then each primitive kind's array in the
+// order of AllPrimitives, primitive_kinds.h), so that a single copy puts it in any of the GPU's
+// memories, and the SceneView the shared core reads
 // from it wherever it lies: global memory, the constant bank or a block's shared memory.
 #pragma once
 
@@ -20,15 +20,31 @@ enum class SceneMemory {
     Shared,    // copied into each block's shared memory at its start: up to the block limit
 };
 
+// Where one kind's array lies in the pool and how many primitives it holds.
+template <class K>
+struct KindPlace {
+    int count = 0;
+    int word = 0;  // its first 16-byte word
+};
+
 // Where each array starts in the pool, in 16-byte words, and the scene's small fields.
 struct SceneLayout {
-    int num_spheres = 0, num_triangles = 0, num_quads = 0, num_rects = 0, num_materials = 0;
-    int material_word = 0, sphere_word = 0, triangle_word = 0, quad_word = 0,
-        rect_word = 0;  // in this order
+    int num_materials = 0;
+    int material_word = 0;  // first; then each kind of AllPrimitives in the list's order
+    PerKind<KindPlace, AllPrimitives> primitives;
     int words = 0;  // the whole pool
     PointLight light{};
     bool has_light = false;
     Vec3 background{0.0f};
+
+    template <class K>
+    __host__ __device__ KindPlace<K>& of() {
+        return primitives.of<K>();
+    }
+    template <class K>
+    __host__ __device__ const KindPlace<K>& of() const {
+        return primitives.of<K>();
+    }
 
     size_t bytes() const { return static_cast<size_t>(words) * sizeof(float4); }
 
@@ -36,19 +52,17 @@ struct SceneLayout {
     // into the kernel, the compiler sees where the pointers came from and uses that memory's
     // own load instructions (LDC for constant, LDS for shared).
     __host__ __device__ SceneView view(const float4* pool) const {
-        return {reinterpret_cast<const Sphere*>(pool + sphere_word),
-                num_spheres,
-                reinterpret_cast<const Triangle*>(pool + triangle_word),
-                num_triangles,
-                reinterpret_cast<const ConvexQuad*>(pool + quad_word),
-                num_quads,
-                reinterpret_cast<const AxisRect*>(pool + rect_word),
-                num_rects,
-                reinterpret_cast<const Material*>(pool + material_word),
-                num_materials,
-                light,
-                has_light,
-                background};
+        SceneView v{{},
+                    reinterpret_cast<const Material*>(pool + material_word),
+                    num_materials,
+                    light,
+                    has_light,
+                    background};
+        for_each_kind(AllPrimitives{}, [&](auto kind) {
+            using K = typename decltype(kind)::type;
+            v.primitives.of<K>() = {reinterpret_cast<const K*>(pool + of<K>().word), of<K>().count};
+        });
+        return v;
     }
 };
 
@@ -57,17 +71,15 @@ inline int words_for(size_t bytes) { return static_cast<int>((bytes + 15) / 16);
 // The layout of a scene's pool (`scene`: its arrays on the host).
 inline SceneLayout layout_of(const SceneView& scene) {
     SceneLayout l;
-    l.num_spheres = scene.num_spheres;
-    l.num_triangles = scene.num_triangles;
-    l.num_quads = scene.num_quads;
-    l.num_rects = scene.num_rects;
     l.num_materials = scene.num_materials;
     l.material_word = 0;
-    l.sphere_word = l.material_word + words_for(scene.num_materials * sizeof(Material));
-    l.triangle_word = l.sphere_word + words_for(scene.num_spheres * sizeof(Sphere));
-    l.quad_word = l.triangle_word + words_for(scene.num_triangles * sizeof(Triangle));
-    l.rect_word = l.quad_word + words_for(scene.num_quads * sizeof(ConvexQuad));
-    l.words = l.rect_word + words_for(scene.num_rects * sizeof(AxisRect));
+    int word = l.material_word + words_for(scene.num_materials * sizeof(Material));
+    for_each_kind(AllPrimitives{}, [&](auto kind) {
+        using K = typename decltype(kind)::type;
+        l.of<K>() = {scene.of<K>().count, word};
+        word += words_for(scene.of<K>().count * sizeof(K));
+    });
+    l.words = word;
     l.light = scene.light;
     l.has_light = scene.has_light;
     l.background = scene.background;
@@ -81,10 +93,10 @@ inline std::vector<float4> pack(const SceneView& scene, const SceneLayout& l) {
         if (bytes) std::memcpy(pool.data() + word, data, bytes);
     };
     put(l.material_word, scene.materials, scene.num_materials * sizeof(Material));
-    put(l.sphere_word, scene.spheres, scene.num_spheres * sizeof(Sphere));
-    put(l.triangle_word, scene.triangles, scene.num_triangles * sizeof(Triangle));
-    put(l.quad_word, scene.quads, scene.num_quads * sizeof(ConvexQuad));
-    put(l.rect_word, scene.rects, scene.num_rects * sizeof(AxisRect));
+    for_each_kind(AllPrimitives{}, [&](auto kind) {
+        using K = typename decltype(kind)::type;
+        put(l.of<K>().word, scene.of<K>().items, scene.of<K>().count * sizeof(K));
+    });
     return pool;
 }
 

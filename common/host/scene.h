@@ -59,12 +59,15 @@ struct CameraSpec {
 struct WrittenCoordinates {
     bool present = false;
     WrittenPoint light_position;
-    std::vector<WrittenPoint> sphere_centres;     // parallel to Scene::spheres
-    std::vector<double> sphere_radii;             // parallel to Scene::spheres
-    std::vector<WrittenPoint> triangle_vertices;  // 3 per entry of Scene::triangles
-    std::vector<WrittenPoint> quad_vertices;      // 4 per entry of Scene::quads
-    std::vector<WrittenPoint> rect_vertices;      // 4 per entry of Scene::rects, as written
+    std::vector<WrittenPoint> sphere_centres;     // parallel to Scene::of<Sphere>()
+    std::vector<double> sphere_radii;             // parallel to Scene::of<Sphere>()
+    std::vector<WrittenPoint> triangle_vertices;  // 3 per entry of Scene::of<Triangle>()
+    std::vector<WrittenPoint> quad_vertices;      // 4 per entry of Scene::of<ConvexQuad>()
+    std::vector<WrittenPoint> rect_vertices;  // 4 per entry of Scene::of<AxisRect>(), as written
 };
+
+template <class K>
+using KindVector = std::vector<K>;
 
 struct Scene {
     std::string name;  // file stem, for messages
@@ -74,33 +77,35 @@ struct Scene {
     PointLight light{};
     std::vector<Material> materials;
     std::vector<std::string> material_names;  // parallel to materials
-    std::vector<Sphere> spheres;
-    // The file's triangles, then the two triangles (v0 v1 v2), (v0 v2 v3) of each quad that is
-    // not planar and convex; the other quads are one primitive each (scene_loader.h).
-    std::vector<Triangle> triangles;
-    std::vector<ConvexQuad> quads;  // planar convex quads that are not axis-aligned rectangles
-    std::vector<AxisRect> rects;    // axis-aligned rectangles
-    RenderSettings render;            // the file's settings, or the defaults
-    WrittenCoordinates written;       // the file's points in double, for centre_scene
+    // One array per kind of AllPrimitives (of<Sphere>(), ...). of<Triangle>(): the file's
+    // triangles, then the two triangles (v0 v1 v2), (v0 v2 v3) of each quad that is not planar
+    // and convex; the other quads are one primitive each, a convex quad (ConvexQuad) or an
+    // axis-aligned rectangle (AxisRect) (scene_loader.h).
+    PerKind<KindVector, AllPrimitives> primitives;
+    RenderSettings render;  // the file's settings, or the defaults
+    WrittenCoordinates written;  // the file's points in double, for centre_scene
     // Why float cannot place this scene (scene_limits.h), "/pointer: what"; empty when it can
     // or when the scene was not loaded from a file. Set in both builds: the double build says
     // why it was needed (lab_main.cpp).
     std::string float_refusal;
     int t_junction_pieces = 0;  // primitives added by splitting at T-junctions (t_junctions.h)
 
+    template <class K>
+    std::vector<K>& of() {
+        return primitives.of<K>();
+    }
+    template <class K>
+    const std::vector<K>& of() const {
+        return primitives.of<K>();
+    }
+
     SceneView view() const {
-        return {spheres.data(),
-                static_cast<int>(spheres.size()),
-                triangles.data(),
-                static_cast<int>(triangles.size()),
-                quads.data(),
-                static_cast<int>(quads.size()),
-                rects.data(),
-                static_cast<int>(rects.size()),
-                materials.data(),
-                static_cast<int>(materials.size()),
-                light,
-                has_light,
-                background};
+        SceneView v{{},    materials.data(), static_cast<int>(materials.size()),
+                    light, has_light,        background};
+        for_each_kind(AllPrimitives{}, [&](auto kind) {
+            using K = typename decltype(kind)::type;
+            v.primitives.of<K>() = {of<K>().data(), static_cast<int>(of<K>().size())};
+        });
+        return v;
     }
 };

@@ -40,30 +40,30 @@ struct ExactPoints {
     const Scene& scene;
     bool sized() const {
         return scene.written.present &&
-               scene.written.sphere_centres.size() == scene.spheres.size() &&
-               scene.written.triangle_vertices.size() == 3 * scene.triangles.size() &&
-               scene.written.quad_vertices.size() == 4 * scene.quads.size() &&
-               scene.written.rect_vertices.size() == 4 * scene.rects.size();
+               scene.written.sphere_centres.size() == scene.of<Sphere>().size() &&
+               scene.written.triangle_vertices.size() == 3 * scene.of<Triangle>().size() &&
+               scene.written.quad_vertices.size() == 4 * scene.of<ConvexQuad>().size() &&
+               scene.written.rect_vertices.size() == 4 * scene.of<AxisRect>().size();
     }
     WrittenPoint sphere(size_t i) const {
         return pick(sized(), sized() ? scene.written.sphere_centres[i] : WrittenPoint{},
-                    scene.spheres[i].center);
+                    scene.of<Sphere>()[i].center);
     }
     // The radius as rendered (which keeps every centre as it was), unless `real` cannot hold
     // it: a radius past float's range is placed by the file's number (scene_limits.h then
     // says float cannot render it).
     double sphere_radius(size_t i) const {
-        const bool have = sized() && scene.written.sphere_radii.size() == scene.spheres.size();
-        const real own = scene.spheres[i].radius;
+        const bool have = sized() && scene.written.sphere_radii.size() == scene.of<Sphere>().size();
+        const real own = scene.of<Sphere>()[i].radius;
         return have && !std::isfinite(own) ? scene.written.sphere_radii[i] : double(own);
     }
     WrittenPoint vertex(size_t i, int k) const {
-        const Triangle& t = scene.triangles[i];
+        const Triangle& t = scene.of<Triangle>()[i];
         return pick(sized(), sized() ? scene.written.triangle_vertices[3 * i + k] : WrittenPoint{},
                     k == 0 ? t.v0 : (k == 1 ? t.v1 : t.v2));
     }
     WrittenPoint quad_vertex(size_t i, int k) const {
-        const ConvexQuad& q = scene.quads[i];
+        const ConvexQuad& q = scene.of<ConvexQuad>()[i];
         const Vec3 own[4] = {q.v0, q.v1, q.v2, q.v3};
         return pick(sized(), sized() ? scene.written.quad_vertices[4 * i + k] : WrittenPoint{},
                     own[k]);
@@ -74,7 +74,7 @@ struct ExactPoints {
     // corner": a floor whose corners wobble by 1e-10 about 1e6 + 2^-5, a tie in float, rounds
     // them apart, and was then placed from those corners, off by up to 0.04.
     WrittenPoint rect_vertex(size_t i, int k) const {
-        const AxisRect& r = scene.rects[i];
+        const AxisRect& r = scene.of<AxisRect>()[i];
         bool written_stand = sized();
         if (written_stand) {
             const WrittenPoint* w = &scene.written.rect_vertices[4 * i];
@@ -103,15 +103,15 @@ struct ExactPoints {
 void centre_of_bounds(const Scene& scene, double centre[3]) {
     const ExactPoints points{scene};
     BoundsD box;
-    for (size_t i = 0; i < scene.spheres.size(); ++i)
+    for (size_t i = 0; i < scene.of<Sphere>().size(); ++i)
         box.add(points.sphere(i), points.sphere_radius(i));
-    for (size_t i = 0; i < scene.triangles.size(); ++i) {
+    for (size_t i = 0; i < scene.of<Triangle>().size(); ++i) {
         for (int k = 0; k < 3; ++k) box.add(points.vertex(i, k));
     }
-    for (size_t i = 0; i < scene.quads.size(); ++i) {
+    for (size_t i = 0; i < scene.of<ConvexQuad>().size(); ++i) {
         for (int k = 0; k < 4; ++k) box.add(points.quad_vertex(i, k));
     }
-    for (size_t i = 0; i < scene.rects.size(); ++i) {
+    for (size_t i = 0; i < scene.of<AxisRect>().size(); ++i) {
         for (int k = 0; k < 4; ++k) box.add(points.rect_vertex(i, k));
     }
     for (int axis = 0; axis < 3; ++axis)
@@ -151,17 +151,17 @@ Scene centre_scene(Scene scene) {
     WrittenCoordinates moved;
     moved.present = true;
     moved.sphere_radii = scene.written.sphere_radii;
-    for (size_t i = 0; i < scene.spheres.size(); ++i)
+    for (size_t i = 0; i < scene.of<Sphere>().size(); ++i)
         moved.sphere_centres.push_back(minus(points.sphere(i), centre));
-    for (size_t i = 0; i < scene.triangles.size(); ++i) {
+    for (size_t i = 0; i < scene.of<Triangle>().size(); ++i) {
         for (int k = 0; k < 3; ++k)
             moved.triangle_vertices.push_back(minus(points.vertex(i, k), centre));
     }
-    for (size_t i = 0; i < scene.quads.size(); ++i) {
+    for (size_t i = 0; i < scene.of<ConvexQuad>().size(); ++i) {
         for (int k = 0; k < 4; ++k)
             moved.quad_vertices.push_back(minus(points.quad_vertex(i, k), centre));
     }
-    for (size_t i = 0; i < scene.rects.size(); ++i) {
+    for (size_t i = 0; i < scene.of<AxisRect>().size(); ++i) {
         for (int k = 0; k < 4; ++k)
             moved.rect_vertices.push_back(minus(points.rect_vertex(i, k), centre));
     }
@@ -169,25 +169,26 @@ Scene centre_scene(Scene scene) {
     const WrittenPoint camera_look_at = minus(points.camera_look_at(), centre);
     moved.light_position = minus(points.light(), centre);
 
-    for (size_t i = 0; i < scene.spheres.size(); ++i)
-        scene.spheres[i].center = rounded(moved.sphere_centres[i]);
-    for (size_t i = 0; i < scene.triangles.size(); ++i) {
+    for (size_t i = 0; i < scene.of<Sphere>().size(); ++i)
+        scene.of<Sphere>()[i].center = rounded(moved.sphere_centres[i]);
+    for (size_t i = 0; i < scene.of<Triangle>().size(); ++i) {
         const WrittenPoint* v = &moved.triangle_vertices[3 * i];
-        scene.triangles[i] =
-            make_triangle(rounded(v[0]), rounded(v[1]), rounded(v[2]), scene.triangles[i].material);
+        scene.of<Triangle>()[i] = make_triangle(rounded(v[0]), rounded(v[1]), rounded(v[2]),
+                                                scene.of<Triangle>()[i].material);
     }
     // Each quad and rectangle keeps its kind: the loader chose it on these very points
     // (scene_loader.cpp), so a rectangle's corners still share their coordinates exactly.
-    for (size_t i = 0; i < scene.quads.size(); ++i) {
+    for (size_t i = 0; i < scene.of<ConvexQuad>().size(); ++i) {
         const WrittenPoint* v = &moved.quad_vertices[4 * i];
-        scene.quads[i] = make_convex_quad(rounded(v[0]), rounded(v[1]), rounded(v[2]),
-                                          rounded(v[3]), scene.quads[i].material);
+        scene.of<ConvexQuad>()[i] =
+            make_convex_quad(rounded(v[0]), rounded(v[1]), rounded(v[2]), rounded(v[3]),
+                             scene.of<ConvexQuad>()[i].material);
     }
-    for (size_t i = 0; i < scene.rects.size(); ++i) {
+    for (size_t i = 0; i < scene.of<AxisRect>().size(); ++i) {
         const WrittenPoint* v = &moved.rect_vertices[4 * i];
         const Vec3 corners[4] = {rounded(v[0]), rounded(v[1]), rounded(v[2]), rounded(v[3])};
-        scene.rects[i] =
-            make_axis_rect(corners, rect_axis(scene.rects[i]), scene.rects[i].material);
+        scene.of<AxisRect>()[i] = make_axis_rect(corners, rect_axis(scene.of<AxisRect>()[i]),
+                                                 scene.of<AxisRect>()[i].material);
     }
     scene.camera.position = rounded(camera_position);
     scene.camera.look_at = rounded(camera_look_at);

@@ -215,14 +215,14 @@ void read_light(const SceneReader& r, const json& root, Scene& scene) {
 Material read_material(const SceneReader& r, const json& m, const std::string& p) {
     if (!m.is_object()) r.fail(p, "expected an object, found " + SceneReader::type_of(m));
     const json& type = r.require(m, p, "type");
-    Material mat{MaterialType::Diffuse, Vec3(0.0f), 1.0f};
+    Material mat{material_type<Diffuse>, Vec3(0.0f), 1.0f};
     if (type == "diffuse" || type == "mirror") {
         r.check_keys(m, p, {"type", "albedo"});
-        mat.type = type == "diffuse" ? MaterialType::Diffuse : MaterialType::Mirror;
+        mat.type = type == "diffuse" ? material_type<Diffuse> : material_type<Mirror>;
         mat.albedo = r.albedo(r.require(m, p, "albedo"), p + "/albedo");
     } else if (type == "glass") {
         r.check_keys(m, p, {"type", "ior"});
-        mat.type = MaterialType::Glass;
+        mat.type = material_type<Glass>;
         mat.ior = r.number(r.require(m, p, "ior"), p + "/ior");
         if (!(mat.ior >= 1.0f && mat.ior <= 5.0f))
             r.fail(p + "/ior", "expected an index of refraction in [1, 5]");
@@ -308,7 +308,7 @@ void read_spheres(const SceneReader& r, const PrimitiveReader& prims, Scene& sce
         if (!(radius > 0.0)) r.fail(p + "/radius", "expected a radius > 0");
         s.radius = static_cast<real>(radius);
         s.material = prims.material(spheres[i], p);
-        scene.spheres.push_back(s);
+        scene.of<Sphere>().push_back(s);
         scene.written.sphere_centres.push_back(centre);
         scene.written.sphere_radii.push_back(radius);
     }
@@ -322,7 +322,7 @@ void read_triangles(const SceneReader& r, const PrimitiveReader& prims, Scene& s
         const std::string p = "/triangles/" + std::to_string(i);
         r.check_keys(triangles[i], p, {"vertices", "material"});
         const auto v = prims.vertices(triangles[i], p, 3);
-        scene.triangles.push_back(
+        scene.of<Triangle>().push_back(
             read_triangle(triangles[i], v, 0, 1, 2, prims.material(triangles[i], p), scene));
     }
     const json& quads = prims.list("quads");
@@ -331,8 +331,8 @@ void read_triangles(const SceneReader& r, const PrimitiveReader& prims, Scene& s
         r.check_keys(quads[i], p, {"vertices", "material"});
         const auto v = prims.vertices(quads[i], p, 4);
         const int m = prims.material(quads[i], p);
-        scene.triangles.push_back(read_triangle(quads[i], v, 0, 1, 2, m, scene));
-        scene.triangles.push_back(read_triangle(quads[i], v, 0, 2, 3, m, scene));
+        scene.of<Triangle>().push_back(read_triangle(quads[i], v, 0, 1, 2, m, scene));
+        scene.of<Triangle>().push_back(read_triangle(quads[i], v, 0, 2, 3, m, scene));
     }
 }
 
@@ -388,9 +388,9 @@ EdgeKey edge_key(Vec3 p, Vec3 q) {
 void classify_quads(Scene& scene, size_t file_triangles) {
     enum Kind { kRect, kQuad, kTriangles };
     const WrittenPoint centre = centring_centre(scene);
-    const size_t count = (scene.triangles.size() - file_triangles) / 2;
-    const std::vector<Triangle> halves(scene.triangles.begin() + file_triangles,
-                                       scene.triangles.end());
+    const size_t count = (scene.of<Triangle>().size() - file_triangles) / 2;
+    const std::vector<Triangle> halves(scene.of<Triangle>().begin() + file_triangles,
+                                       scene.of<Triangle>().end());
     const std::vector<WrittenPoint> written(
         scene.written.triangle_vertices.begin() + 3 * file_triangles,
         scene.written.triangle_vertices.end());
@@ -432,7 +432,7 @@ void classify_quads(Scene& scene, size_t file_triangles) {
         }
     }
 
-    scene.triangles.resize(file_triangles);
+    scene.of<Triangle>().resize(file_triangles);
     scene.written.triangle_vertices.resize(3 * file_triangles);
     for (size_t i = 0; i < count; ++i) {
         const Triangle& first = halves[2 * i];  // v0 v1 v2; the second is v0 v2 v3
@@ -441,15 +441,15 @@ void classify_quads(Scene& scene, size_t file_triangles) {
         const WrittenPoint w[4] = {written[6 * i], written[6 * i + 1], written[6 * i + 2],
                                    written[6 * i + 5]};
         if (kind[i] == kRect) {
-            scene.rects.push_back(make_axis_rect(loaded, axis[i], first.material));
+            scene.of<AxisRect>().push_back(make_axis_rect(loaded, axis[i], first.material));
             scene.written.rect_vertices.insert(scene.written.rect_vertices.end(), w, w + 4);
         } else if (kind[i] == kQuad) {
-            scene.quads.push_back(
+            scene.of<ConvexQuad>().push_back(
                 make_convex_quad(loaded[0], loaded[1], loaded[2], loaded[3], first.material));
             scene.written.quad_vertices.insert(scene.written.quad_vertices.end(), w, w + 4);
         } else {
-            scene.triangles.push_back(first);
-            scene.triangles.push_back(second);
+            scene.of<Triangle>().push_back(first);
+            scene.of<Triangle>().push_back(second);
             scene.written.triangle_vertices.insert(scene.written.triangle_vertices.end(),
                                                    written.begin() + 6 * i,
                                                    written.begin() + 6 * i + 6);

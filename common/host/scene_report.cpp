@@ -32,40 +32,36 @@ double longest_edge(const AxisRect& r) {
     return std::max(double(r.hi_u) - r.lo_u, double(r.hi_v) - r.lo_v);
 }
 
+// A primitive's size as a detail (0: it shows nothing) and its largest |coordinate|.
+double detail_size(const Sphere& s) { return s.radius; }
+template <class K>
+double detail_size(const K& primitive) {
+    return longest_edge(primitive);
+}
+double extent_of(const Sphere& s) { return sphere_extent(s); }
+template <class K>
+double extent_of(const K& primitive) {
+    return primitive.extent;
+}
+
 }  // namespace
 
 SceneUse scene_use(const Scene& scene) {
     SceneUse use;
-    use.spheres = static_cast<int>(scene.spheres.size());
-    use.triangles = static_cast<int>(scene.triangles.size());
-    use.quads = static_cast<int>(scene.quads.size());
-    use.rects = static_cast<int>(scene.rects.size());
     use.split_pieces = scene.t_junction_pieces;
-    for (const Material& m : scene.materials) {
-        use.diffuse += m.type == MaterialType::Diffuse;
-        use.mirrors += m.type == MaterialType::Mirror;
-        use.glass += m.type == MaterialType::Glass;
-    }
+    for (const Material& m : scene.materials) ++use.materials[static_cast<int>(m.type)];
     use.light = scene.has_light;
     use.background = !is_black(scene.background);
     double smallest = INFINITY;
-    for (const Sphere& s : scene.spheres) {
-        smallest = std::min(smallest, static_cast<double>(s.radius));
-        use.extent = std::max(use.extent, static_cast<double>(sphere_extent(s)));
-    }
-    for (const Triangle& t : scene.triangles) {
-        const double edge = longest_edge(t);
-        if (edge > 0) smallest = std::min(smallest, edge);  // a zero-area triangle shows nothing
-        use.extent = std::max(use.extent, static_cast<double>(t.extent));
-    }
-    for (const ConvexQuad& q : scene.quads) {
-        smallest = std::min(smallest, longest_edge(q));
-        use.extent = std::max(use.extent, static_cast<double>(q.extent));
-    }
-    for (const AxisRect& r : scene.rects) {
-        smallest = std::min(smallest, longest_edge(r));
-        use.extent = std::max(use.extent, static_cast<double>(r.extent));
-    }
+    for_each_kind(AllPrimitives{}, [&](auto kind) {
+        using K = typename decltype(kind)::type;
+        use.primitives[kind_index<AllPrimitives, K>] = static_cast<int>(scene.of<K>().size());
+        for (const K& p : scene.of<K>()) {
+            const double size = detail_size(p);
+            if (size > 0) smallest = std::min(smallest, size);  // zero area shows nothing
+            use.extent = std::max(use.extent, extent_of(p));
+        }
+    });
     use.smallest = std::isfinite(smallest) ? smallest : 0.0;
     return use;
 }
@@ -75,18 +71,19 @@ std::string describe(const SceneUse& use) {
     const auto add = [&](int n, const char* kind) {
         if (n) materials += (materials.empty() ? "" : ", ") + std::to_string(n) + " " + kind;
     };
-    add(use.diffuse, "diffuse");
-    add(use.mirrors, "mirror");
-    add(use.glass, "glass");
+    for_each_kind(AllMaterials{}, [&](auto kind) {
+        using K = typename decltype(kind)::type;
+        add(use.materials_of<K>(), K::kName);
+    });
     // The kinds the scene has, by count: "1 sphere, 5 rectangles".
     std::string primitives;
     const auto count = [&](int n, const char* one, const char* many) {
         if (n) primitives += (primitives.empty() ? "" : ", ") + plural(n, one, many);
     };
-    count(use.spheres, "sphere", "spheres");
-    count(use.triangles, "triangle", "triangles");
-    count(use.quads, "convex quad", "convex quads");
-    count(use.rects, "rectangle", "rectangles");
+    for_each_kind(AllPrimitives{}, [&](auto kind) {
+        using K = typename decltype(kind)::type;
+        count(use.primitives_of<K>(), K::kName, (std::string(K::kName) + "s").c_str());
+    });
     if (use.split_pieces > 0)
         primitives += " (splitting at T-junctions added " + std::to_string(use.split_pieces) + ")";
     std::string line =
@@ -110,14 +107,23 @@ std::string scale_warning(const SceneUse& use) {
 }
 
 std::string to_json(const SceneUse& use) {
-    return "{\"spheres\": " + std::to_string(use.spheres) +
-           ", \"triangles\": " + std::to_string(use.triangles) +
-           ", \"quads\": " + std::to_string(use.quads) +
-           ", \"rects\": " + std::to_string(use.rects) +
-           ", \"diffuse\": " + std::to_string(use.diffuse) +
-           ", \"mirrors\": " + std::to_string(use.mirrors) +
-           ", \"glass\": " + std::to_string(use.glass) +
-           ", \"light\": " + (use.light ? "true" : "false") +
+    // Each kind's count under its key, and the keys of each family in its list's order (what
+    // a scene must hold to use every kind: the hidden scene's test reads them).
+    std::string counts, primitive_keys, material_keys;
+    const auto add = [&](std::string& keys, const char* key, int n) {
+        counts += "\"" + std::string(key) + "\": " + std::to_string(n) + ", ";
+        keys += (keys.empty() ? "\"" : ", \"") + std::string(key) + "\"";
+    };
+    for_each_kind(AllPrimitives{}, [&](auto kind) {
+        using K = typename decltype(kind)::type;
+        add(primitive_keys, K::kReportKey, use.primitives_of<K>());
+    });
+    for_each_kind(AllMaterials{}, [&](auto kind) {
+        using K = typename decltype(kind)::type;
+        add(material_keys, K::kReportKey, use.materials_of<K>());
+    });
+    return "{" + counts + "\"primitive_kinds\": [" + primitive_keys + "], \"material_kinds\": [" +
+           material_keys + "], \"light\": " + (use.light ? "true" : "false") +
            ", \"background\": " + (use.background ? "true" : "false") +
            ", \"smallest\": " + number(use.smallest) + ", \"extent\": " + number(use.extent) +
            ", \"warning\": " + (scale_warning(use).empty() ? "false" : "true") + "}";

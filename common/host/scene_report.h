@@ -14,13 +14,22 @@
 #include <scene.h>
 
 struct SceneUse {
-    int spheres = 0, triangles = 0, quads = 0, rects = 0;  // geometry_kinds(scene), counted
+    int primitives[AllPrimitives::kCount] = {};  // per kind, in the list's order
     int split_pieces = 0;  // of those, how many more the splitting at T-junctions made
-    int diffuse = 0, mirrors = 0, glass = 0;  // the material table's entries by kind
+    int materials[AllMaterials::kCount] = {};  // the material table's entries by kind
     bool light = false;
     bool background = false;  // a background that is not black
     double smallest = 0;  // the smallest radius or longest edge (0: no primitive)
     double extent = 0;  // the largest |coordinate| of any primitive, after centring
+
+    template <class K>
+    int primitives_of() const {
+        return primitives[kind_index<AllPrimitives, K>];
+    }
+    template <class K>
+    int materials_of() const {
+        return materials[kind_index<AllMaterials, K>];
+    }
 };
 
 // A detail is resolved while it spans at least 16 ray offsets of a ray that crossed the scene

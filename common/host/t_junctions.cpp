@@ -370,9 +370,9 @@ constexpr int kMaxPasses = 32;
 
 int split_t_junctions(Scene& scene) {
     const WrittenCoordinates& w = scene.written;
-    if (!w.present || w.triangle_vertices.size() != 3 * scene.triangles.size() ||
-        w.quad_vertices.size() != 4 * scene.quads.size() ||
-        w.rect_vertices.size() != 4 * scene.rects.size())
+    if (!w.present || w.triangle_vertices.size() != 3 * scene.of<Triangle>().size() ||
+        w.quad_vertices.size() != 4 * scene.of<ConvexQuad>().size() ||
+        w.rect_vertices.size() != 4 * scene.of<AxisRect>().size())
         return 0;  // a scene built in code: no written points to split on
     const WrittenPoint centre = centring_centre(scene);
     std::vector<Piece> pieces;
@@ -389,13 +389,13 @@ int split_t_junctions(Scene& scene) {
         }
         pieces.push_back(p);
     };
-    for (size_t i = 0; i < scene.triangles.size(); ++i)
-        add(Kind::kTriangle, 3, &w.triangle_vertices[3 * i], scene.triangles[i].material, -1);
-    for (size_t i = 0; i < scene.quads.size(); ++i)
-        add(Kind::kQuad, 4, &w.quad_vertices[4 * i], scene.quads[i].material, -1);
-    for (size_t i = 0; i < scene.rects.size(); ++i)
-        add(Kind::kRect, 4, &w.rect_vertices[4 * i], scene.rects[i].material,
-            rect_axis(scene.rects[i]));
+    for (size_t i = 0; i < scene.of<Triangle>().size(); ++i)
+        add(Kind::kTriangle, 3, &w.triangle_vertices[3 * i], scene.of<Triangle>()[i].material, -1);
+    for (size_t i = 0; i < scene.of<ConvexQuad>().size(); ++i)
+        add(Kind::kQuad, 4, &w.quad_vertices[4 * i], scene.of<ConvexQuad>()[i].material, -1);
+    for (size_t i = 0; i < scene.of<AxisRect>().size(); ++i)
+        add(Kind::kRect, 4, &w.rect_vertices[4 * i], scene.of<AxisRect>()[i].material,
+            rect_axis(scene.of<AxisRect>()[i]));
     const size_t before = pieces.size();
 
     bool changed = false;
@@ -403,9 +403,9 @@ int split_t_junctions(Scene& scene) {
     if (!changed) return 0;  // every bit as loaded
 
     // Rebuilt from the written points, rounded once, as the loader builds the file's own.
-    scene.triangles.clear();
-    scene.quads.clear();
-    scene.rects.clear();
+    scene.of<Triangle>().clear();
+    scene.of<ConvexQuad>().clear();
+    scene.of<AxisRect>().clear();
     WrittenCoordinates& out = scene.written;
     out.triangle_vertices.clear();
     out.quad_vertices.clear();
@@ -414,13 +414,13 @@ int split_t_junctions(Scene& scene) {
         Vec3 v[4];
         for (int k = 0; k < p.corners; ++k) v[k] = rounded(p.written[k]);
         if (p.kind == Kind::kTriangle) {
-            scene.triangles.push_back(make_triangle(v[0], v[1], v[2], p.material));
+            scene.of<Triangle>().push_back(make_triangle(v[0], v[1], v[2], p.material));
             out.triangle_vertices.insert(out.triangle_vertices.end(), p.written, p.written + 3);
         } else if (p.kind == Kind::kQuad) {
-            scene.quads.push_back(make_convex_quad(v[0], v[1], v[2], v[3], p.material));
+            scene.of<ConvexQuad>().push_back(make_convex_quad(v[0], v[1], v[2], v[3], p.material));
             out.quad_vertices.insert(out.quad_vertices.end(), p.written, p.written + 4);
         } else {
-            scene.rects.push_back(make_axis_rect(v, p.axis, p.material));
+            scene.of<AxisRect>().push_back(make_axis_rect(v, p.axis, p.material));
             out.rect_vertices.insert(out.rect_vertices.end(), p.written, p.written + 4);
         }
     }

@@ -303,19 +303,20 @@ inline HitPacket<F> closest_hit(const SceneView& scene, const RayPacket<F>& ray,
         hit.kind = select(nearer, I(static_cast<int>(kind)), hit.kind);
         hit.index = select(nearer, I(i), hit.index);
     };
-    for (int i = 0; i < scene.num_spheres; ++i)
-        keep(intersect_sphere(ray, scene.spheres[i], hit.t), PrimitiveKind::Sphere, i);
-    if (scene.num_triangles > 0 || scene.num_quads > 0) {
+    for (int i = 0; i < scene.of<Sphere>().count; ++i)
+        keep(intersect_sphere(ray, scene.of<Sphere>()[i], hit.t), primitive_kind<Sphere>, i);
+    if (scene.of<Triangle>().count > 0 || scene.of<ConvexQuad>().count > 0) {
         const RayShearN<F> shear(ray);
-        for (int i = 0; i < scene.num_triangles; ++i) {
-            keep(intersect_triangle(ray, shear, scene.triangles[i], hit.t), PrimitiveKind::Triangle,
-                 i);
+        for (int i = 0; i < scene.of<Triangle>().count; ++i) {
+            keep(intersect_triangle(ray, shear, scene.of<Triangle>()[i], hit.t),
+                 primitive_kind<Triangle>, i);
         }
-        for (int i = 0; i < scene.num_quads; ++i)
-            keep(intersect_quad(ray, shear, scene.quads[i], hit.t), PrimitiveKind::Quad, i);
+        for (int i = 0; i < scene.of<ConvexQuad>().count; ++i)
+            keep(intersect_quad(ray, shear, scene.of<ConvexQuad>()[i], hit.t),
+                 primitive_kind<ConvexQuad>, i);
     }
-    for (int i = 0; i < scene.num_rects; ++i)
-        keep(intersect_rect(ray, scene.rects[i], hit.t), PrimitiveKind::Rect, i);
+    for (int i = 0; i < scene.of<AxisRect>().count; ++i)
+        keep(intersect_rect(ray, scene.of<AxisRect>()[i], hit.t), primitive_kind<AxisRect>, i);
     return hit;
 }
 
@@ -333,20 +334,21 @@ inline MaskOf<F> occluded(const SceneView& scene, const RayPacket<F>& ray, F t_m
         limit = select(blocked, F(0.0f), limit);
         return false;
     };
-    for (int i = 0; i < scene.num_spheres; ++i) {
-        if (block(intersect_sphere(ray, scene.spheres[i], limit))) return blocked;
+    for (int i = 0; i < scene.of<Sphere>().count; ++i) {
+        if (block(intersect_sphere(ray, scene.of<Sphere>()[i], limit))) return blocked;
     }
-    if (scene.num_triangles > 0 || scene.num_quads > 0) {
+    if (scene.of<Triangle>().count > 0 || scene.of<ConvexQuad>().count > 0) {
         const RayShearN<F> shear(ray);
-        for (int i = 0; i < scene.num_triangles; ++i) {
-            if (block(intersect_triangle(ray, shear, scene.triangles[i], limit))) return blocked;
+        for (int i = 0; i < scene.of<Triangle>().count; ++i) {
+            if (block(intersect_triangle(ray, shear, scene.of<Triangle>()[i], limit)))
+                return blocked;
         }
-        for (int i = 0; i < scene.num_quads; ++i) {
-            if (block(intersect_quad(ray, shear, scene.quads[i], limit))) return blocked;
+        for (int i = 0; i < scene.of<ConvexQuad>().count; ++i) {
+            if (block(intersect_quad(ray, shear, scene.of<ConvexQuad>()[i], limit))) return blocked;
         }
     }
-    for (int i = 0; i < scene.num_rects; ++i) {
-        if (block(intersect_rect(ray, scene.rects[i], limit))) return blocked;
+    for (int i = 0; i < scene.of<AxisRect>().count; ++i) {
+        if (block(intersect_rect(ray, scene.of<AxisRect>()[i], limit))) return blocked;
     }
     return blocked;
 }
@@ -388,10 +390,10 @@ inline SurfacePacket<F> surface_at(const SceneView& scene, const RayPacket<F>& r
         s.extent = select(lanes, extent, s.extent);
         s.material = select(lanes, material, s.material);
     };
-    const auto on_sphere = mask & hit.on(PrimitiveKind::Sphere);
+    const auto on_sphere = mask & hit.on(primitive_kind<Sphere>);
     if (any(on_sphere)) {
         constexpr int kS = stride_of<Sphere>();
-        const Sphere& s0 = scene.spheres[0];
+        const Sphere& s0 = scene.of<Sphere>()[0];
         const Vec3xN<F> center(gather(s0.center.x, kS, hit.index, on_sphere),
                                gather(s0.center.y, kS, hit.index, on_sphere),
                                gather(s0.center.z, kS, hit.index, on_sphere));
@@ -413,12 +415,12 @@ inline SurfacePacket<F> surface_at(const SceneView& scene, const RayPacket<F>& r
              gather(first->extent, kT, hit.index, lanes),
              gather(first->material, kT, hit.index, lanes));
     };
-    take_flat(PrimitiveKind::Triangle, scene.triangles);
-    take_flat(PrimitiveKind::Quad, scene.quads);
-    const auto on_rect = mask & hit.on(PrimitiveKind::Rect);
+    take_flat(primitive_kind<Triangle>, scene.of<Triangle>().items);
+    take_flat(primitive_kind<ConvexQuad>, scene.of<ConvexQuad>().items);
+    const auto on_rect = mask & hit.on(primitive_kind<AxisRect>);
     if (any(on_rect)) {  // rect_normal (axis_rect.h), lane by lane
         constexpr int kR = stride_of<AxisRect>();
-        const AxisRect& r0 = scene.rects[0];
+        const AxisRect& r0 = scene.of<AxisRect>()[0];
         const I axis_side = gather(r0.axis_side, kR, hit.index, on_rect);
         const I axis = axis_side & 3;
         const F side = select(axis_side == axis, F(1.0f), F(-1.0f));  // bit 2: faces -axis
@@ -463,15 +465,15 @@ inline Vec3xN<F> specular_edge_step(const SceneView& scene, const HitPacket<F>& 
                                     const SurfacePacket<F>& surface, MaskOf<F> specular) {
     using I = IntOf<F>;
     Vec3xN<F> step(Vec3(0.0f));
-    const auto on_triangle = specular & hit.on(PrimitiveKind::Triangle);
-    const auto on_quad = specular & hit.on(PrimitiveKind::Quad);
-    const auto on_rect = specular & hit.on(PrimitiveKind::Rect);
+    const auto on_triangle = specular & hit.on(primitive_kind<Triangle>);
+    const auto on_quad = specular & hit.on(primitive_kind<ConvexQuad>);
+    const auto on_rect = specular & hit.on(primitive_kind<AxisRect>);
     if (none(on_triangle | on_quad | on_rect)) return step;
     // ray_offset (ray.h), lane by lane
     const F margin =
         (max_component(abs(surface.position)) + hit.t + surface.extent) * F(1.0f / (1 << 20));
     if (any(on_triangle)) {
-        const Triangle& t0 = scene.triangles[0];
+        const Triangle& t0 = scene.of<Triangle>()[0];
         const Vec3xN<F> v0 = gather_vertex(t0, t0.v0, hit, on_triangle);
         const Vec3xN<F> v1 = gather_vertex(t0, t0.v1, hit, on_triangle);
         const Vec3xN<F> v2 = gather_vertex(t0, t0.v2, hit, on_triangle);
@@ -482,7 +484,7 @@ inline Vec3xN<F> specular_edge_step(const SceneView& scene, const HitPacket<F>& 
         step = select(on_triangle, s, step);
     }
     if (any(on_quad)) {
-        const ConvexQuad& q0 = scene.quads[0];
+        const ConvexQuad& q0 = scene.of<ConvexQuad>()[0];
         const Vec3xN<F> v0 = gather_vertex(q0, q0.v0, hit, on_quad);
         const Vec3xN<F> v1 = gather_vertex(q0, q0.v1, hit, on_quad);
         const Vec3xN<F> v2 = gather_vertex(q0, q0.v2, hit, on_quad);
@@ -496,7 +498,7 @@ inline Vec3xN<F> specular_edge_step(const SceneView& scene, const HitPacket<F>& 
     }
     if (any(on_rect)) {  // step_off_edges (axis_rect.h), lane by lane
         constexpr int kR = stride_of<AxisRect>();
-        const AxisRect& r0 = scene.rects[0];
+        const AxisRect& r0 = scene.of<AxisRect>()[0];
         const I axis = gather(r0.axis_side, kR, hit.index, on_rect) & 3;
         const Vec3xN<F>& p = surface.position;
         const F p_u = select(axis == 0, p.y, p.x);  // rect_axis_u, rect_axis_v
@@ -594,9 +596,9 @@ RT_PACKET_INLINE MaskOf<F> bounce_step(const SceneView& scene, const HitPacket<F
     const Vec3xN<F> above = offset_ray_origin(surface.position, facing, hit.t, surface.extent);
     const int bounce = path.bounce++;
     const bool last = path.bounce >= max_bounces;
-    const Mask diffuse = path.alive & (type == static_cast<int>(MaterialType::Diffuse));
-    const Mask mirror = path.alive & (type == static_cast<int>(MaterialType::Mirror));
-    const Mask glass = path.alive & (type == static_cast<int>(MaterialType::Glass));
+    const Mask diffuse = path.alive & (type == static_cast<int>(material_type<Diffuse>));
+    const Mask mirror = path.alive & (type == static_cast<int>(material_type<Mirror>));
+    const Mask glass = path.alive & (type == static_cast<int>(material_type<Glass>));
 
     Mask lit = Mask::none();
     if (scene.has_light && any(diffuse)) {

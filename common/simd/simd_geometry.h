@@ -159,7 +159,7 @@ inline Hit closest_hit(const SimdSceneView& scene, const Ray& ray) {
         const int hits = (t < t_max).bits();
         if (hits == 0) continue;
         const int lane = nearest_lane(t, hits);
-        hit = {t.lane(lane), PrimitiveKind::Sphere, i * kSimdWidth + lane};
+        hit = {t.lane(lane), primitive_kind<Sphere>, i * kSimdWidth + lane};
     }
     for (int i = 0; i < scene.num_triangle_packets; ++i) {
         const Float8 t_max = hit.t;
@@ -167,11 +167,11 @@ inline Hit closest_hit(const SimdSceneView& scene, const Ray& ray) {
         const int hits = (t < t_max).bits();
         if (hits == 0) continue;
         const int lane = nearest_lane(t, hits);
-        hit = {t.lane(lane), PrimitiveKind::Triangle, i * kSimdWidth + lane};
+        hit = {t.lane(lane), primitive_kind<Triangle>, i * kSimdWidth + lane};
     }
     for (int i = 0; i < scene.num_quads; ++i) {
         const float t = intersect_quad(ray, r.shear, scene.quads[i], hit.t);
-        if (t < hit.t) hit = {t, PrimitiveKind::Quad, i};
+        if (t < hit.t) hit = {t, primitive_kind<ConvexQuad>, i};
     }
     for (int i = 0; i < scene.num_rect_packets; ++i) {
         const Float8 t_max = hit.t;
@@ -179,7 +179,7 @@ inline Hit closest_hit(const SimdSceneView& scene, const Ray& ray) {
         const int hits = (t < t_max).bits();
         if (hits == 0) continue;
         const int lane = nearest_lane(t, hits);
-        hit = {t.lane(lane), PrimitiveKind::Rect, i * kSimdWidth + lane};
+        hit = {t.lane(lane), primitive_kind<AxisRect>, i * kSimdWidth + lane};
     }
     return hit;
 }

@@ -68,13 +68,13 @@ struct SimdSceneView {
 class SimdScene {
 public:
     explicit SimdScene(const SceneView& scene)
-        : triangles_(packets_for(scene.num_triangles)),
-          spheres_(packets_for(scene.num_spheres)),
-          rects_(packets_for(scene.num_rects)),
-          quads_(scene.quads),
-          num_quads_(scene.num_quads) {
-        for (int i = 0; i < scene.num_triangles; ++i) {
-            const Triangle& tri = scene.triangles[i];
+        : triangles_(packets_for(scene.of<Triangle>().count)),
+          spheres_(packets_for(scene.of<Sphere>().count)),
+          rects_(packets_for(scene.of<AxisRect>().count)),
+          quads_(scene.of<ConvexQuad>().items),
+          num_quads_(scene.of<ConvexQuad>().count) {
+        for (int i = 0; i < scene.of<Triangle>().count; ++i) {
+            const Triangle& tri = scene.of<Triangle>()[i];
             TrianglePacket& p = triangles_[i / kSimdWidth];
             const int lane = i % kSimdWidth;
             const Vec3 v[3] = {tri.v0, tri.v1, tri.v2};
@@ -87,8 +87,8 @@ public:
         for (SpherePacket& p : spheres_) {
             for (float& r2 : p.radius2) r2 = -1.0f;  // padding until a sphere fills the lane
         }
-        for (int i = 0; i < scene.num_spheres; ++i) {
-            const Sphere& s = scene.spheres[i];
+        for (int i = 0; i < scene.of<Sphere>().count; ++i) {
+            const Sphere& s = scene.of<Sphere>()[i];
             SpherePacket& p = spheres_[i / kSimdWidth];
             const int lane = i % kSimdWidth;
             for (int axis = 0; axis < 3; ++axis) p.center[axis][lane] = s.center[axis];
@@ -97,8 +97,8 @@ public:
         for (RectPacket& p : rects_) {
             for (float& plane : p.plane) plane = NAN;  // padding until a rectangle fills the lane
         }
-        for (int i = 0; i < scene.num_rects; ++i) {
-            const AxisRect& r = scene.rects[i];
+        for (int i = 0; i < scene.of<AxisRect>().count; ++i) {
+            const AxisRect& r = scene.of<AxisRect>()[i];
             RectPacket& p = rects_[i / kSimdWidth];
             const int lane = i % kSimdWidth;
             p.plane[lane] = r.plane;

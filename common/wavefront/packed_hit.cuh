@@ -6,25 +6,29 @@
 
 #include <path_tracer.h>
 
-// primitive: index * 4 + (kind - 1) for a hit (kinds Sphere..Rect are 1..4), -1 for none.
+// primitive: index << kKindBits | (kind - 1) for a hit, -1 for none. kKindBits numbers every
+// kind of AllPrimitives (primitive_kinds.h): two bits for four kinds, and an index range that
+// shrinks by half with each bit a new kind costs.
+constexpr int kKindBits = bits_to_number(AllPrimitives::kCount);
+constexpr int kKindMask = (1 << kKindBits) - 1;
+
 struct PackedHit {
     float t;
     int primitive;
 };
 static_assert(sizeof(PackedHit) == 8, "a packed hit is two words");
-static_assert(static_cast<int>(PrimitiveKind::Rect) - 1 < 4, "four kinds fit in two bits");
 
 __host__ __device__ inline PackedHit pack_hit(const Hit& hit) {
     const int kind = static_cast<int>(hit.kind) - 1;
-    return {static_cast<float>(hit.t), hit.found() ? hit.index * 4 + kind : -1};
+    return {static_cast<float>(hit.t), hit.found() ? hit.index << kKindBits | kind : -1};
 }
 
 __host__ __device__ inline Hit unpack_hit(PackedHit packed) {
     Hit hit;
     hit.t = packed.t;
     if (packed.primitive >= 0) {
-        hit.kind = static_cast<PrimitiveKind>((packed.primitive & 3) + 1);
-        hit.index = packed.primitive >> 2;
+        hit.kind = static_cast<PrimitiveKind>((packed.primitive & kKindMask) + 1);
+        hit.index = packed.primitive >> kKindBits;
     }
     return hit;
 }

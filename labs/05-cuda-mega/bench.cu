@@ -59,8 +59,8 @@ __global__ void plain_kernel(SceneView scene, Camera camera, RenderSettings sett
 }
 
 // Kernels for the scene's walls in one kind of primitive only, besides the sphere.
-using SpheresAndQuads = GeometrySet<true, false, true, false>;
-using SpheresAndTriangles = GeometrySet<true, true, false, false>;
+using SpheresAndQuads = Kinds<Sphere, ConvexQuad>;
+using SpheresAndTriangles = Kinds<Sphere, Triangle>;
 
 struct Variant {
     const char* name;  // as in the handout's tables

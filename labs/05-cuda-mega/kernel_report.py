@@ -83,13 +83,16 @@ def occupancy(registers: int, block: int, smem: int, arch: int) -> float:
     return blocks * warps_per_block / lim["warps"]
 
 
-# The primitive sets the CUDA labs compile kernels for, by the names their sources use.
-GEOMETRY_SETS = {
-    "true, true, true, true": "AnyGeometry",
-    "true, false, false, true": "BoxGeometry",
-    "true, true, true, false": "GeneralGeometry",
-    "true, false, true, false": "SpheresAndQuads",
-    "true, true, false, false": "SpheresAndTriangles",
+# The kind sets the CUDA labs compile kernels for, by the names their sources use
+# (geometry_set.h, material_set.h, kernel_choice.cuh, bench.cu).
+KIND_SETS = {
+    "Kinds<Sphere, Triangle, ConvexQuad, AxisRect>": "AnyGeometry",
+    "Kinds<Sphere, Triangle, ConvexQuad>": "GeneralGeometry",
+    "Kinds<Sphere, AxisRect>": "BoxGeometry",
+    "Kinds<Sphere, ConvexQuad>": "SpheresAndQuads",
+    "Kinds<Sphere, Triangle>": "SpheresAndTriangles",
+    "Kinds<Diffuse, Mirror, Glass>": "AnyMaterial",
+    "Kinds<Diffuse>": "DiffuseOnly",
 }
 
 
@@ -102,10 +105,8 @@ def short(name: str) -> str:
         name = name.replace(value, loop)
     name = name.replace("(SceneMemory)0", "global").replace("(SceneMemory)1", "constant")
     name = name.replace("(SceneMemory)2", "shared").replace("SceneMemory::", "")
-    name = name.replace("MaterialSet<false, false>", "DiffuseOnly")
-    name = name.replace("MaterialSet<true, true>", "AnyMaterial")
-    for kinds, alias in GEOMETRY_SETS.items():  # geometry_set.h: spheres, triangles, quads, rects
-        name = name.replace(f"GeometrySet<{kinds}>", alias)
+    for kinds, alias in KIND_SETS.items():
+        name = name.replace(kinds, alias)
     name = re.sub(r"\s+>", ">", name)  # the demangler writes "Foo<Bar<int> >"
     return re.sub(r"^void |\(.*\)$", "", name)
 

@@ -45,17 +45,19 @@ static void expect_choice(SceneMemory memory, bool specular, GeometryKinds kinds
 }
 
 int main() {
-    // kinds: spheres, triangles, quads, rects
-    expect_choice(SceneMemory::Constant, false, {true, false, false, true}, "constant/diffuse/box");
-    expect_choice(SceneMemory::Global, true, {false, false, false, true},
+    expect_choice(SceneMemory::Constant, false, geometry_kinds_of<Kinds<Sphere, AxisRect>>(),
+                  "constant/diffuse/box");
+    expect_choice(SceneMemory::Global, true, geometry_kinds_of<Kinds<AxisRect>>(),
                   "global/any-material/box");
-    expect_choice(SceneMemory::Constant, false, {true, false, true, false},
+    expect_choice(SceneMemory::Constant, false, geometry_kinds_of<Kinds<Sphere, ConvexQuad>>(),
                   "constant/diffuse/general");
-    expect_choice(SceneMemory::Constant, true, {true, true, true, false},
+    expect_choice(SceneMemory::Constant, true,
+                  geometry_kinds_of<Kinds<Sphere, Triangle, ConvexQuad>>(),
                   "constant/any-material/general");
-    expect_choice(SceneMemory::Constant, false, {false, true, false, true},
+    expect_choice(SceneMemory::Constant, false, geometry_kinds_of<Kinds<Triangle, AxisRect>>(),
                   "constant/diffuse/any-geometry");
-    expect_choice(SceneMemory::Global, false, {true, true, true, true},
+    expect_choice(SceneMemory::Global, false,
+                  geometry_kinds_of<Kinds<Sphere, Triangle, ConvexQuad, AxisRect>>(),
                   "global/diffuse/any-geometry");
 
     // The constant bank while the pool fits in it, else global memory.
@@ -72,19 +74,24 @@ int main() {
     const Triangle triangle = make_triangle({1, 0, 0}, {1, 1, 0}, {1, 1, -1}, 0);
     const Sphere sphere{{0.5f, 0.2f, -0.5f}, 0.2f, 0};
     const Material material{};
-    SceneView scene{&sphere, 1, &triangle, 1, &quad, 1, &rect, 1, &material, 1, {}, false, {}};
+    SceneView scene{{}, &material, 1, {}, false, {}};
+    scene.of<Sphere>() = {&sphere, 1};
+    scene.of<Triangle>() = {&triangle, 1};
+    scene.of<ConvexQuad>() = {&quad, 1};
+    scene.of<AxisRect>() = {&rect, 1};
 
     const SceneInForm as_loaded(scene, GeometryForm::AsLoaded);
-    expect(as_loaded.view.num_rects == 1 && as_loaded.view.rects == &rect &&
-               as_loaded.view.num_quads == 1 && as_loaded.view.num_triangles == 1,
-           "as loaded: the scene's own arrays");
+    expect(
+        as_loaded.view.of<AxisRect>().count == 1 && as_loaded.view.of<AxisRect>().items == &rect &&
+            as_loaded.view.of<ConvexQuad>().count == 1 && as_loaded.view.of<Triangle>().count == 1,
+        "as loaded: the scene's own arrays");
 
     const SceneInForm quads(scene, GeometryForm::Quads);
-    expect(quads.view.num_rects == 0 && quads.view.num_quads == 2 &&
-               quads.view.num_triangles == 1 && quads.view.num_spheres == 1 &&
-               quads.view.triangles == &triangle,
+    expect(quads.view.of<AxisRect>().count == 0 && quads.view.of<ConvexQuad>().count == 2 &&
+               quads.view.of<Triangle>().count == 1 && quads.view.of<Sphere>().count == 1 &&
+               quads.view.of<Triangle>().items == &triangle,
            "quads: the rectangle joins the quads, the rest stays");
-    const ConvexQuad& from_rect = quads.view.quads[1];
+    const ConvexQuad& from_rect = quads.view.of<ConvexQuad>()[1];
     const Vec3 n = rect_normal(rect);
     expect(from_rect.normal.x == n.x && from_rect.normal.y == n.y && from_rect.normal.z == n.z &&
                from_rect.material == rect.material && from_rect.extent == rect.extent,
@@ -101,10 +108,10 @@ int main() {
     }
 
     const SceneInForm triangles(scene, GeometryForm::Triangles);
-    expect(triangles.view.num_rects == 0 && triangles.view.num_quads == 0 &&
-               triangles.view.num_triangles == 5,
+    expect(triangles.view.of<AxisRect>().count == 0 && triangles.view.of<ConvexQuad>().count == 0 &&
+               triangles.view.of<Triangle>().count == 5,
            "triangles: every quad and rectangle as two triangles");
-    expect(geometry_kinds(triangles.view).fits<GeometrySet<true, true, false, false>>(),
+    expect(geometry_kinds(triangles.view).fits<Kinds<Sphere, Triangle>>(),
            "triangles: spheres and triangles only");
 
     // RT_LAB05_GEOMETRY.

@@ -78,14 +78,30 @@ def skipping(kind_loop: str) -> dict:
     return {"path_tracer.h": text.replace(kind_loop, "(void)t;", 1)}
 
 
+def test_the_hidden_scene_holds_every_kind_of_the_lists(lab01_ref, tmp_path):
+    """Every primitive and material kind the renderer's lists declare (--json names them) is
+    in the hidden scene, so a kind added to a list and left out of the scene fails here."""
+    import json
+
+    from grading import hidden
+    from labkit.harness import RunPolicy, policy, run_lab
+    path = tmp_path / "hidden.json"
+    path.write_text(json.dumps(hidden.hidden_scene("kinds")))
+    with policy(RunPolicy(trusted=True)):
+        uses = run_lab(lab01_ref, path, width=4, height=4, spp=1, bounces=1).json["scene_uses"]
+    kinds = uses["primitive_kinds"] + uses["material_kinds"]
+    assert len(kinds) >= 7, uses
+    assert [k for k in kinds if uses[k] == 0] == [], uses
+
+
 def test_a_renderer_that_skips_a_primitive_kind_fails_the_hidden_scene(lab01_ref, tmp_path):
     """The hidden scene holds every primitive kind (the Cornell box holds only rectangles and a
     sphere): a renderer whose closest hit misses triangles, or convex quads, fails there."""
     from grading import hidden
     from labkit.variants import build_variant
     assert hidden.check_hidden(lab01_ref, lab01_ref, "kinds").passed
-    for name, loop in (("triangles", "if (t < hit.t) hit = {t, PrimitiveKind::Triangle, i};"),
-                       ("quads", "if (t < hit.t) hit = {t, PrimitiveKind::Quad, i};")):
+    for name, loop in (("triangles", "if (t < hit.t) hit = {t, primitive_kind<Triangle>, i};"),
+                       ("quads", "if (t < hit.t) hit = {t, primitive_kind<ConvexQuad>, i};")):
         binary = build_variant("01-serial", tmp_path / name, skipping(loop))
         result = hidden.check_hidden(binary, lab01_ref, "kinds")
         assert not result.passed, f"a renderer without {name} passed: {result.detail}"

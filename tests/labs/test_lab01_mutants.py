@@ -39,14 +39,15 @@ MUTANTS = {
                                "(cos_theta / (kPi * distance))", ["interior", "plane"]),
     "shadow rays ignore spheres": (
         "path_tracer.h",
-        "blocked |= intersect_sphere(ray, scene.spheres[i], t_max) < t_max;",
+        "blocked |= intersect_sphere(ray, scene.of<Sphere>()[i], t_max) < t_max;",
         "blocked |= false;", ["cornell"]),
     "shadow rays ignore triangles": (
         "path_tracer.h",
-        "blocked |= intersect_triangle(ray, shear, scene.triangles[i], t_max) < t_max;",
+        "blocked |= intersect_triangle(ray, shear, scene.of<Triangle>()[i], t_max) < t_max;",
         "blocked |= false;", ["showcase"]),
     "every rectangle hit names rectangle 0": (
-        "path_tracer.h", "hit = {t, PrimitiveKind::Rect, i};", "hit = {t, PrimitiveKind::Rect, 0};",
+        "path_tracer.h", "hit = {t, primitive_kind<AxisRect>, i};",
+        "hit = {t, primitive_kind<AxisRect>, 0};",
         ["cornell", "showcase"]),
     "rectangle: inside test of one axis reversed": (
         "axis_rect.h",

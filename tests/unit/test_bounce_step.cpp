@@ -13,7 +13,7 @@ namespace {
 // A floor y = 0 of half-size 10 and a light above it.
 struct FloorScene {
     Scene scene;
-    explicit FloorScene(MaterialType type = MaterialType::Diffuse, Vec3 albedo = Vec3(0.5f)) {
+    explicit FloorScene(MaterialType type = material_type<Diffuse>, Vec3 albedo = Vec3(0.5f)) {
         Material m{};
         m.type = type;
         m.albedo = albedo;
@@ -21,8 +21,8 @@ struct FloorScene {
         scene.materials.push_back(m);
         scene.material_names.push_back("floor");
         const Vec3 a(-10, 0, -10), b(-10, 0, 10), c(10, 0, 10), d(10, 0, -10);
-        scene.triangles.push_back(make_triangle(a, b, c, 0));
-        scene.triangles.push_back(make_triangle(a, c, d, 0));
+        scene.of<Triangle>().push_back(make_triangle(a, b, c, 0));
+        scene.of<Triangle>().push_back(make_triangle(a, c, d, 0));
         scene.has_light = true;
         scene.light.position = {1.0f, 2.0f, 0.5f};
         scene.light.intensity = Vec3(3.0f);
@@ -111,7 +111,7 @@ TEST(BounceStep, DiffuseHitRequestsTheLightAndContinues) {
 
 // Specular hits ask for no shadow ray; at the last bounce they just end the path.
 TEST(BounceStep, SpecularHitsRequestNoLight) {
-    for (MaterialType type : {MaterialType::Mirror, MaterialType::Glass}) {
+    for (MaterialType type : {material_type<Mirror>, material_type<Glass>}) {
         const FloorScene fs(type, Vec3(0.9f));
         const SceneView v = fs.view();
         const Ray slant{{0.0f, 1.0f, 0.0f}, normalize(Vec3(0.3f, -1.0f, 0.1f))};
@@ -121,7 +121,7 @@ TEST(BounceStep, SpecularHitsRequestNoLight) {
             ShadowRay shadow;
             EXPECT_FALSE(bounce_step(v, hit, kRng, max_bounces, path, shadow));
             EXPECT_EQ(path.alive, max_bounces > 1);
-            if (type == MaterialType::Mirror && path.alive) {
+            if (type == material_type<Mirror> && path.alive) {
                 EXPECT_FLOAT_EQ(path.ray.direction.y, -slant.direction.y);  // reflected
                 EXPECT_FLOAT_EQ(path.throughput.x, 0.9f);
             }

@@ -25,21 +25,22 @@ bool same_bits(real a, real b) { return a == b && std::signbit(a) == std::signbi
 TEST(GeneralGeometry, RectangleQuadsCarryTheRectanglesNormalToTheSignOfZero) {
     const Scene scene = centred_cornell();
     const SceneView view = scene.view();
-    ASSERT_GT(view.num_rects, 0);
+    ASSERT_GT(view.of<AxisRect>().count, 0);
     const SceneInForm quads(view, GeometryForm::Quads);
-    ASSERT_EQ(quads.view.num_quads, view.num_quads + view.num_rects);
-    for (int i = 0; i < view.num_rects; ++i) {
-        const Vec3 expected = rect_normal(view.rects[i]);
-        const Vec3 got = quads.view.quads[view.num_quads + i].normal;
+    ASSERT_EQ(quads.view.of<ConvexQuad>().count,
+              view.of<ConvexQuad>().count + view.of<AxisRect>().count);
+    for (int i = 0; i < view.of<AxisRect>().count; ++i) {
+        const Vec3 expected = rect_normal(view.of<AxisRect>()[i]);
+        const Vec3 got = quads.view.of<ConvexQuad>()[view.of<ConvexQuad>().count + i].normal;
         for (int c = 0; c < 3; ++c)
             EXPECT_TRUE(same_bits(got[c], expected[c])) << "rect " << i << " component " << c;
     }
     const SceneInForm triangles(view, GeometryForm::Triangles);
-    for (int i = 0; i < view.num_rects; ++i) {
-        const Vec3 expected = rect_normal(view.rects[i]);
+    for (int i = 0; i < view.of<AxisRect>().count; ++i) {
+        const Vec3 expected = rect_normal(view.of<AxisRect>()[i]);
         for (int k = 0; k < 2; ++k) {
-            const int index = view.num_triangles + 2 * (view.num_quads + i) + k;
-            const Vec3 got = triangles.view.triangles[index].normal;
+            const int index = view.of<Triangle>().count + 2 * (view.of<ConvexQuad>().count + i) + k;
+            const Vec3 got = triangles.view.of<Triangle>()[index].normal;
             for (int c = 0; c < 3; ++c)
                 EXPECT_TRUE(same_bits(got[c], expected[c])) << "rect " << i << " triangle " << k;
         }

@@ -16,25 +16,25 @@ Scene cornell() { return load_scene(std::string(RT_SOURCE_DIR) + "/common/scenes
 
 }  // namespace
 
-TEST(GeometrySet, KindsOfTheShippedScenes) {
+TEST(PrimitiveKinds, KindsOfTheShippedScenes) {
     const Scene box = cornell();
     const GeometryKinds k = geometry_kinds(box.view());
-    EXPECT_TRUE(k.spheres);
-    EXPECT_FALSE(k.triangles);
-    EXPECT_FALSE(k.quads);
-    EXPECT_TRUE(k.rects);
+    EXPECT_TRUE(k.has<Sphere>());
+    EXPECT_FALSE(k.has<Triangle>());
+    EXPECT_FALSE(k.has<ConvexQuad>());
+    EXPECT_TRUE(k.has<AxisRect>());
     EXPECT_TRUE(k.fits<BoxGeometry>());
     EXPECT_TRUE(k.fits<AnyGeometry>());
-    EXPECT_FALSE((k.fits<GeometrySet<true, true, true, false>>()));  // no rectangles
+    EXPECT_FALSE((k.fits<Kinds<Sphere, Triangle, ConvexQuad>>()));  // no rectangles
     const Scene showcase = load_scene(std::string(RT_SOURCE_DIR) + "/common/scenes/showcase.json");
     const GeometryKinds s = geometry_kinds(showcase.view());
-    EXPECT_TRUE(s.triangles);
+    EXPECT_TRUE(s.has<Triangle>());
     EXPECT_FALSE(s.fits<BoxGeometry>());
     const GeometryKinds none = geometry_kinds(Scene().view());
-    EXPECT_TRUE((none.fits<GeometrySet<false, false, false, false>>()));
+    EXPECT_TRUE((none.fits<Kinds<>>()));
 }
 
-TEST(GeometrySet, TheScenesOwnSetFindsTheSameHitsAndBits) {
+TEST(PrimitiveKinds, TheScenesOwnSetFindsTheSameHitsAndBits) {
     const Scene box = cornell();
     const SceneView v = box.view();
     std::mt19937 gen(3);
@@ -62,10 +62,10 @@ TEST(GeometrySet, TheScenesOwnSetFindsTheSameHitsAndBits) {
 }
 
 // A set without a kind does not test it: the renderer for spheres alone sees through walls.
-TEST(GeometrySet, ASetWithoutAKindLeavesItsLoopOut) {
+TEST(PrimitiveKinds, ASetWithoutAKindLeavesItsLoopOut) {
     const Scene box = cornell();
     const Ray to_the_back_wall{{0.1f, 0.9f, -0.1f}, {0, 0, -1}};
-    EXPECT_EQ(closest_hit(box.view(), to_the_back_wall).kind, PrimitiveKind::Rect);
-    using SpheresOnly = GeometrySet<true, false, false, false>;
+    EXPECT_EQ(closest_hit(box.view(), to_the_back_wall).kind, primitive_kind<AxisRect>);
+    using SpheresOnly = Kinds<Sphere>;
     EXPECT_FALSE(closest_hit<SpheresOnly>(box.view(), to_the_back_wall).found());
 }

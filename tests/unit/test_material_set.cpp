@@ -22,18 +22,18 @@ Material material(MaterialType type) {
 // lit from inside: paths bounce between diffuse surfaces until their budget runs out.
 Scene diffuse_box() {
     Scene s;
-    s.materials = {material(MaterialType::Diffuse), material(MaterialType::Diffuse)};
+    s.materials = {material(material_type<Diffuse>), material(material_type<Diffuse>)};
     s.material_names = {"walls", "ball"};
     const Vec3 a(-1, 0, -1), b(-1, 0, 1), c(1, 0, 1), d(1, 0, -1);
     const Vec3 up(0, 2, 0);
-    s.triangles = {make_triangle(a, b, c, 0), make_triangle(a, c, d, 0),
-                   make_triangle(a + up, c + up, b + up, 0),
-                   make_triangle(a + up, d + up, c + up, 0)};
+    s.of<Triangle>() = {make_triangle(a, b, c, 0), make_triangle(a, c, d, 0),
+                        make_triangle(a + up, c + up, b + up, 0),
+                        make_triangle(a + up, d + up, c + up, 0)};
     Sphere ball{};
     ball.center = {0.3f, 0.4f, 0.1f};
     ball.radius = 0.3f;
     ball.material = 1;
-    s.spheres = {ball};
+    s.of<Sphere>() = {ball};
     s.has_light = true;
     s.light.position = {-0.2f, 1.5f, 0.2f};
     s.light.intensity = Vec3(2.0f);
@@ -45,10 +45,10 @@ bool same_bits(Vec3 a, Vec3 b) { return std::memcmp(&a, &b, sizeof(Vec3)) == 0; 
 
 }  // namespace
 
-TEST(MaterialSet, OnlyMirrorOrGlassNeedsTheRendererForEveryMaterial) {
-    const Material diffuse = material(MaterialType::Diffuse);
-    const Material mirror = material(MaterialType::Mirror);
-    const Material glass = material(MaterialType::Glass);
+TEST(MaterialKinds, OnlyMirrorOrGlassNeedsTheRendererForEveryMaterial) {
+    const Material diffuse = material(material_type<Diffuse>);
+    const Material mirror = material(material_type<Mirror>);
+    const Material glass = material(material_type<Glass>);
     const Material all_diffuse[] = {diffuse, diffuse, diffuse};
     const Material with_mirror[] = {diffuse, mirror, diffuse};
     const Material with_glass[] = {diffuse, diffuse, glass};
@@ -58,12 +58,13 @@ TEST(MaterialSet, OnlyMirrorOrGlassNeedsTheRendererForEveryMaterial) {
     EXPECT_TRUE(has_specular_material(with_glass + 2, 1));
     EXPECT_FALSE(has_specular_material(with_glass, 2));  // only the table's first two entries
     EXPECT_FALSE(has_specular_material(nullptr, 0));
-    static_assert(!DiffuseOnly::kSpecular && AnyMaterial::kMirror && AnyMaterial::kGlass);
+    static_assert(!has_specular<DiffuseOnly> && has_kind<AnyMaterial, Mirror> &&
+                  has_kind<AnyMaterial, Glass>);
 }
 
 // Every path of a diffuse scene, traced by the DiffuseOnly renderer and by the one for every
 // material, gives the same bits: the specialisation removes code, never changes arithmetic.
-TEST(MaterialSet, DiffuseOnlyTracesADiffuseSceneBitForBit) {
+TEST(MaterialKinds, DiffuseOnlyTracesADiffuseSceneBitForBit) {
     const Scene scene = diffuse_box();
     const SceneView v = scene.view();
     ASSERT_FALSE(has_specular_material(v.materials, v.num_materials));
@@ -84,9 +85,9 @@ TEST(MaterialSet, DiffuseOnlyTracesADiffuseSceneBitForBit) {
 // so the dispatch (has_specular_material) must be asked, which this shows is not a no-op.
 // A ray straight down between mirror floor and mirror ceiling bounces up and down and never
 // sees the light; treated as diffuse, the floor samples the light (unblocked) at once.
-TEST(MaterialSet, DiffuseOnlyRendersAMirrorWrong) {
+TEST(MaterialKinds, DiffuseOnlyRendersAMirrorWrong) {
     Scene scene = diffuse_box();
-    scene.materials[0] = material(MaterialType::Mirror);
+    scene.materials[0] = material(material_type<Mirror>);
     const SceneView v = scene.view();
     ASSERT_TRUE(has_specular_material(v.materials, v.num_materials));
     const Ray down{{-0.5f, 1.0f, -0.5f}, {0.0f, -1.0f, 0.0f}};

@@ -27,15 +27,15 @@ struct TestScene {
     // The square [-h, h]^2 of the plane y = 0, facing +y, as two triangles.
     void floor(int m, float h = 10.0f) {
         const Vec3 a(-h, 0, -h), b(-h, 0, h), c(h, 0, h), d(h, 0, -h);
-        scene.triangles.push_back(make_triangle(a, b, c, m));
-        scene.triangles.push_back(make_triangle(a, c, d, m));
+        scene.of<Triangle>().push_back(make_triangle(a, b, c, m));
+        scene.of<Triangle>().push_back(make_triangle(a, c, d, m));
     }
     void sphere(Vec3 c, float r, int m) {
         Sphere s{};
         s.center = c;
         s.radius = r;
         s.material = m;
-        scene.spheres.push_back(s);
+        scene.of<Sphere>().push_back(s);
     }
     void light(Vec3 p, Vec3 intensity) {
         scene.has_light = true;
@@ -83,14 +83,15 @@ Scene scaled(const Scene& base, float s) {
     out.camera.look_at = base.camera.look_at * s;
     out.light.position = base.light.position * s;
     out.light.intensity = base.light.intensity * (s * s);
-    for (Sphere& sp : out.spheres) {
+    for (Sphere& sp : out.of<Sphere>()) {
         sp.center = sp.center * s;
         sp.radius *= s;
     }
-    for (Triangle& t : out.triangles) t = make_triangle(t.v0 * s, t.v1 * s, t.v2 * s, t.material);
-    for (ConvexQuad& q : out.quads)
+    for (Triangle& t : out.of<Triangle>())
+        t = make_triangle(t.v0 * s, t.v1 * s, t.v2 * s, t.material);
+    for (ConvexQuad& q : out.of<ConvexQuad>())
         q = make_convex_quad(q.v0 * s, q.v1 * s, q.v2 * s, q.v3 * s, q.material);
-    for (AxisRect& r : out.rects) {
+    for (AxisRect& r : out.of<AxisRect>()) {
         Vec3 corners[4];
         rect_corners(r, corners);
         for (Vec3& c : corners) c = c * s;
@@ -104,27 +105,27 @@ Scene scaled(const Scene& base, float s) {
 
 TEST(PathTracer, ClosestHitPicksTheNearestPrimitive) {
     TestScene ts;
-    const int m = ts.material(MaterialType::Diffuse, Vec3(0.5f));
+    const int m = ts.material(material_type<Diffuse>, Vec3(0.5f));
     ts.floor(m);                      // triangles 0, 1 at y = 0
     ts.sphere({0, 2, 0}, 0.5f, m);    // sphere 0: top at y = 2.5
     ts.sphere({0, 5, 0}, 0.5f, m);    // sphere 1 above it
     const SceneView v = ts.view();
     const Hit down = closest_hit(v, {{0, 10, 0}, {0, -1, 0}});
-    EXPECT_EQ(down.kind, PrimitiveKind::Sphere);
+    EXPECT_EQ(down.kind, primitive_kind<Sphere>);
     EXPECT_EQ(down.index, 1);
     EXPECT_FLOAT_EQ(down.t, 4.5f);
     const Hit floor_hit = closest_hit(v, {{3, 10, 0.5f}, {0, -1, 0}});
-    EXPECT_EQ(floor_hit.kind, PrimitiveKind::Triangle);
+    EXPECT_EQ(floor_hit.kind, primitive_kind<Triangle>);
     EXPECT_GE(floor_hit.index, 0);
     EXPECT_FLOAT_EQ(floor_hit.t, 10.0f);
     // Between the spheres, looking down: the lower sphere, not the floor behind it.
     const Hit mid = closest_hit(v, {{0, 3.5f, 0}, {0, -1, 0}});
-    EXPECT_EQ(mid.kind, PrimitiveKind::Sphere);
+    EXPECT_EQ(mid.kind, primitive_kind<Sphere>);
     EXPECT_EQ(mid.index, 0);
     EXPECT_FLOAT_EQ(mid.t, 1.0f);
     // A triangle in front of a sphere.
     const Hit up = closest_hit(v, {{0, -3, 0}, {0, 1, 0}});
-    EXPECT_EQ(up.kind, PrimitiveKind::Triangle);
+    EXPECT_EQ(up.kind, primitive_kind<Triangle>);
     EXPECT_GE(up.index, 0);
     EXPECT_FLOAT_EQ(up.t, 3.0f);
     const Hit none = closest_hit(v, {{0, 10, 0}, {0, 1, 0}});
@@ -136,7 +137,7 @@ TEST(PathTracer, ClosestHitPicksTheNearestPrimitive) {
 
 TEST(PathTracer, OccludedRespectsTMax) {
     TestScene ts;
-    const int m = ts.material(MaterialType::Diffuse, Vec3(0.5f));
+    const int m = ts.material(material_type<Diffuse>, Vec3(0.5f));
     ts.sphere({0, 5, 0}, 1.0f, m);
     ts.floor(m);
     const SceneView v = ts.view();
@@ -152,7 +153,7 @@ TEST(PathTracer, OccludedRespectsTMax) {
 TEST(PathTracer, PointLightOnDiffusePlaneIsExact) {
     TestScene ts;
     const Vec3 albedo(0.5f, 0.6f, 0.7f), intensity(1.0f, 2.0f, 3.0f), light(0.3f, 2.0f, -0.4f);
-    ts.floor(ts.material(MaterialType::Diffuse, albedo));
+    ts.floor(ts.material(material_type<Diffuse>, albedo));
     ts.light(light, intensity);
     const SceneView v = ts.view();
     for (const Vec3 p : {Vec3(0.2f, 0, 0.1f), Vec3(-3, 0, 4), Vec3(0.3f, 0, -0.4f)}) {
@@ -173,7 +174,7 @@ TEST(PathTracer, PointLightOnDiffusePlaneIsExact) {
 
 TEST(PathTracer, LightBehindTheSurfaceGivesNothing) {
     TestScene ts;
-    ts.floor(ts.material(MaterialType::Diffuse, Vec3(0.8f)));
+    ts.floor(ts.material(material_type<Diffuse>, Vec3(0.8f)));
     ts.light({0, 2, 0}, Vec3(5.0f));
     const SceneView v = ts.view();
     // Seen from below, the floor's lit side faces away: black, no light leaks through.
@@ -185,22 +186,23 @@ TEST(PathTracer, LightBehindTheSurfaceGivesNothing) {
 
 TEST(PathTracer, OccludersCastShadowsGlassIncluded) {
     const Vec3 p(0.2f, 0.0f, 0.1f), light(0.2f, 3.0f, 0.1f);
-    for (MaterialType type : {MaterialType::Diffuse, MaterialType::Mirror, MaterialType::Glass}) {
+    for (MaterialType type :
+         {material_type<Diffuse>, material_type<Mirror>, material_type<Glass>}) {
         TestScene ts;
-        ts.floor(ts.material(MaterialType::Diffuse, Vec3(0.5f)));
+        ts.floor(ts.material(material_type<Diffuse>, Vec3(0.5f)));
         ts.sphere({0.2f, 1.5f, 0.1f}, 0.3f, ts.material(type, Vec3(0.9f)));
         ts.light(light, Vec3(4.0f));
         const SceneView v = ts.view();
         const Ray ray = ray_to({2, 1, 2}, p);  // sees p past the sphere
-        ASSERT_NE(closest_hit(v, ray).kind, PrimitiveKind::Sphere);
+        ASSERT_NE(closest_hit(v, ray).kind, primitive_kind<Sphere>);
         expect_exact(trace_path(v, ray, kRng, 1), Vec3(0.0f));
         expect_exact(direct_light_from(v, p, {0, 1, 0}, Vec3(0.5f)), Vec3(0.0f));
     }
     // A sphere beside the segment, or beyond the light, casts no shadow on p.
     for (const Vec3 c : {Vec3(1.5f, 1.5f, 0.1f), Vec3(0.2f, 4.0f, 0.1f)}) {
         TestScene ts;
-        ts.floor(ts.material(MaterialType::Diffuse, Vec3(0.5f)));
-        ts.sphere(c, 0.3f, ts.material(MaterialType::Diffuse, Vec3(0.5f)));
+        ts.floor(ts.material(material_type<Diffuse>, Vec3(0.5f)));
+        ts.sphere(c, 0.3f, ts.material(material_type<Diffuse>, Vec3(0.5f)));
         ts.light(light, Vec3(4.0f));
         expect_rel_near(direct_light_from(ts.view(), p, {0, 1, 0}, Vec3(0.5f)),
                         expected_direct(p, light, Vec3(4.0f), Vec3(0.5f)), 1e-5f);
@@ -215,14 +217,14 @@ TEST(PathTracer, EscapingRaysReturnTheBackground) {
     for (int bounces : {1, 2, 8})
         expect_exact(trace_path(v, {{0, 0, 0}, {0, 0, -1}}, kRng, bounces), ts.scene.background);
     // With geometry, a ray that misses it.
-    ts.floor(ts.material(MaterialType::Diffuse, Vec3(0.5f)));
+    ts.floor(ts.material(material_type<Diffuse>, Vec3(0.5f)));
     expect_exact(trace_path(ts.view(), {{0, 1, 0}, {0, 1, 0}}, kRng, 4), ts.scene.background);
 }
 
 TEST(PathTracer, MirrorReflectsTheSky) {
     TestScene ts;
     const Vec3 tint(0.9f, 0.5f, 0.25f);
-    ts.floor(ts.material(MaterialType::Mirror, tint));
+    ts.floor(ts.material(material_type<Mirror>, tint));
     ts.scene.background = {0.5f, 1.0f, 2.0f};
     ts.light({0, 3, 0}, Vec3(10.0f));  // mirrors take no light samples
     const SceneView v = ts.view();
@@ -237,14 +239,14 @@ TEST(PathTracer, MirrorShowsWhatItFaces) {
     // A mirror floor under a diffuse sphere: the reflected ray lands on the sphere's bottom,
     // which the light (above the sphere) cannot see: black. Beside it: the sky.
     TestScene ts;
-    ts.floor(ts.material(MaterialType::Mirror, Vec3(1.0f)),
+    ts.floor(ts.material(material_type<Mirror>, Vec3(1.0f)),
              1e4f);  // wide: nothing escapes sideways
-    ts.sphere({0, 2, 0}, 1.0f, ts.material(MaterialType::Diffuse, Vec3(0.5f)));
+    ts.sphere({0, 2, 0}, 1.0f, ts.material(material_type<Diffuse>, Vec3(0.5f)));
     ts.light({0, 5, 0}, Vec3(10.0f));
     ts.scene.background = Vec3(0.25f);
     const SceneView v = ts.view();
     const Ray straight_down{{0.1f, 0.5f, 0}, {0, -1, 0}};  // under the sphere
-    EXPECT_EQ(closest_hit(v, straight_down).kind, PrimitiveKind::Triangle);
+    EXPECT_EQ(closest_hit(v, straight_down).kind, primitive_kind<Triangle>);
     const Vec3 l = trace_path(v, straight_down, kRng, 3);
     EXPECT_EQ(l.x, 0.0f);  // the sphere's unlit bottom; the next bounce would need > 3
 }
@@ -254,7 +256,7 @@ TEST(PathTracer, DiffuseUnderUniformSkyIsAlbedoTimesSky) {
     // albedo * background, whatever the random numbers.
     TestScene ts;
     const Vec3 albedo(0.2f, 0.5f, 0.75f);
-    ts.floor(ts.material(MaterialType::Diffuse, albedo), 1e4f);
+    ts.floor(ts.material(material_type<Diffuse>, albedo), 1e4f);
     ts.scene.background = {1.0f, 0.5f, 0.25f};
     const SceneView v = ts.view();
     for (int s = 0; s < 200; ++s) {
@@ -269,7 +271,7 @@ TEST(PathTracer, GlassWhiteFurnace) {
     // Glass neither absorbs nor emits: under a uniform sky a path through a glass sphere
     // returns exactly the sky, or black only if it runs out of bounces.
     TestScene ts;
-    ts.sphere({0, 0, -3}, 1.0f, ts.material(MaterialType::Glass, Vec3(0.0f), 1.5f));
+    ts.sphere({0, 0, -3}, 1.0f, ts.material(material_type<Glass>, Vec3(0.0f), 1.5f));
     ts.scene.background = Vec3(0.5f);
     const SceneView v = ts.view();
     int sky = 0, through = 0;
@@ -296,8 +298,8 @@ TEST(PathTracer, GlassRefractsStraightThroughAtNormalIncidence) {
     // back to the black sky; every other path sees exactly the floor's direct light.
     TestScene ts;
     const Vec3 albedo(0.5f);
-    ts.floor(ts.material(MaterialType::Diffuse, albedo));
-    ts.sphere({0, 2, 0}, 0.5f, ts.material(MaterialType::Glass, Vec3(0.0f), 1.5f));
+    ts.floor(ts.material(material_type<Diffuse>, albedo));
+    ts.sphere({0, 2, 0}, 0.5f, ts.material(material_type<Glass>, Vec3(0.0f), 1.5f));
     ts.light({3, 1, 0}, Vec3(2.0f));  // lights the floor under the sphere from the side
     const SceneView v = ts.view();
     const Vec3 expected = expected_direct({0, 0, 0}, {3, 1, 0}, Vec3(2.0f), albedo);
@@ -318,8 +320,8 @@ TEST(PathTracer, GlassRefractsStraightThroughAtNormalIncidence) {
 
 TEST(PathTracer, RenderPixelDeterministicAndSeedDependent) {
     TestScene ts;
-    ts.floor(ts.material(MaterialType::Diffuse, Vec3(0.6f)));
-    ts.sphere({0, 0.5f, 0}, 0.5f, ts.material(MaterialType::Diffuse, Vec3(0.3f, 0.6f, 0.9f)));
+    ts.floor(ts.material(material_type<Diffuse>, Vec3(0.6f)));
+    ts.sphere({0, 0.5f, 0}, 0.5f, ts.material(material_type<Diffuse>, Vec3(0.3f, 0.6f, 0.9f)));
     ts.light({1, 3, 1}, Vec3(5.0f));
     ts.scene.background = Vec3(0.1f);
     const SceneView v = ts.view();
@@ -350,10 +352,10 @@ TEST(PathTracer, RenderPixelAveragesOverThePixel) {
     // One 1x1 image, 90 degrees: the pixel spans [-1, 1]^2 on the plane z = -1. A black
     // card covers the left half of that view, the sky (1) the rest: the mean is 1/2.
     TestScene ts;
-    const int black = ts.material(MaterialType::Diffuse, Vec3(0.0f));
+    const int black = ts.material(material_type<Diffuse>, Vec3(0.0f));
     const Vec3 a(-100, -100, -2), b(0, -100, -2), c(0, 100, -2), d(-100, 100, -2);
-    ts.scene.triangles.push_back(make_triangle(a, b, c, black));
-    ts.scene.triangles.push_back(make_triangle(a, c, d, black));
+    ts.scene.of<Triangle>().push_back(make_triangle(a, b, c, black));
+    ts.scene.of<Triangle>().push_back(make_triangle(a, c, d, black));
     ts.scene.background = Vec3(1.0f);
     const Camera cam = Camera::look_at({0, 0, 0}, {0, 0, -1}, {0, 1, 0}, 90.0f, 1, 1);
     RenderSettings rs;
@@ -408,9 +410,9 @@ TEST(PathTracer, ClosedBoxDoesNotLeak) {
     for (float scale : {1e-4f, 1.0f, 1e5f}) {
         for (const Vec3 offset : {Vec3(0.0f), Vec3(37.0f, -120.0f, 5.0f)}) {
             TestScene ts;
-            const int wall = ts.material(MaterialType::Diffuse, Vec3(0.9f));
-            const int glass = ts.material(MaterialType::Glass, Vec3(0.0f), 1.5f);
-            const int mirror = ts.material(MaterialType::Mirror, Vec3(1.0f));
+            const int wall = ts.material(material_type<Diffuse>, Vec3(0.9f));
+            const int glass = ts.material(material_type<Glass>, Vec3(0.0f), 1.5f);
+            const int mirror = ts.material(material_type<Mirror>, Vec3(1.0f));
             Vec3 corner[8];
             for (int i = 0; i < 8; ++i)
                 corner[i] =
@@ -423,9 +425,9 @@ TEST(PathTracer, ClosedBoxDoesNotLeak) {
             for (int f = 0; f < 6; ++f) {
                 const int m = f == 1 ? mirror : wall;
                 const int* q = faces[f];
-                ts.scene.triangles.push_back(
+                ts.scene.of<Triangle>().push_back(
                     make_triangle(corner[q[0]], corner[q[1]], corner[q[2]], m));
-                ts.scene.triangles.push_back(
+                ts.scene.of<Triangle>().push_back(
                     make_triangle(corner[q[0]], corner[q[2]], corner[q[3]], m));
             }
             ts.sphere((Vec3(0.3f, -0.4f, 0.2f) + offset) * scale, 0.3f * scale, glass);
@@ -465,7 +467,7 @@ TEST(PathTracer, SphereRoomDoesNotLeak) {
         for (float radius : {0.5f, 2.0f, 50.0f}) {
             TestScene ts;
             const Vec3 centre = Vec3(3.0f, -2.0f, 1.0f) * scale;
-            ts.sphere(centre, radius * scale, ts.material(MaterialType::Diffuse, Vec3(0.9f)));
+            ts.sphere(centre, radius * scale, ts.material(material_type<Diffuse>, Vec3(0.9f)));
             ts.scene.background = Vec3(1.0f);
             const SceneView v = ts.view();
             int leaks = 0;
@@ -485,10 +487,10 @@ TEST(PathTracer, SphereRoomDoesNotLeak) {
 // rounding (the sampling basis and reflect() assume a unit normal).
 TEST(PathTracer, SphereNormalIsUnitLength) {
     TestScene ts;
-    ts.sphere({3, -2, 1}, 2.0f, ts.material(MaterialType::Diffuse, Vec3(0.5f)));
+    ts.sphere({3, -2, 1}, 2.0f, ts.material(material_type<Diffuse>, Vec3(0.5f)));
     const SceneView v = ts.view();
     Hit hit;
-    hit.kind = PrimitiveKind::Sphere;
+    hit.kind = primitive_kind<Sphere>;
     hit.index = 0;
     // A ray whose t is a little off, as after a few bounces of rounding.
     for (float t : {2.0f, 2.0001f, 1.9999f}) {

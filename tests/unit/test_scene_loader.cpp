@@ -97,10 +97,10 @@ const std::string kGoodSphere = "\"center\": [0, 0, 0], \"radius\": 1, \"materia
 
 TEST(SceneLoader, CornellLoads) {
     const Scene s = load_scene(std::string(RT_SOURCE_DIR) + "/common/scenes/cornell.json");
-    EXPECT_EQ(s.spheres.size(), 1u);
-    EXPECT_EQ(s.triangles.size(), 0u);
-    EXPECT_EQ(s.quads.size(), 0u);
-    EXPECT_EQ(s.rects.size(), 5u);  // five axis-aligned walls
+    EXPECT_EQ(s.of<Sphere>().size(), 1u);
+    EXPECT_EQ(s.of<Triangle>().size(), 0u);
+    EXPECT_EQ(s.of<ConvexQuad>().size(), 0u);
+    EXPECT_EQ(s.of<AxisRect>().size(), 5u);  // five axis-aligned walls
     EXPECT_EQ(s.materials.size(), 4u);
     EXPECT_EQ(s.material_names.size(), s.materials.size());
     EXPECT_TRUE(s.has_light);
@@ -112,23 +112,23 @@ TEST(SceneLoader, CornellLoads) {
     EXPECT_GT(s.light.intensity.x, 0.0f);
     EXPECT_GT(s.camera.position.z, 0.0f);
     EXPECT_GT(s.camera.vfov_degrees, 0.0f);
-    EXPECT_GT(s.spheres[0].radius, 0.0f);
+    EXPECT_GT(s.of<Sphere>()[0].radius, 0.0f);
     // The design's baseline: 600x600, 512 spp, 4 bounces.
     EXPECT_EQ(s.render.width, 600);
     EXPECT_EQ(s.render.height, 600);
     EXPECT_EQ(s.render.spp, 512);
     EXPECT_EQ(s.render.bounces, 4);
-    for (const AxisRect& r : s.rects) {
+    for (const AxisRect& r : s.of<AxisRect>()) {
         ASSERT_GE(r.material, 0);
         ASSERT_LT(r.material, static_cast<int>(s.materials.size()));
         EXPECT_LT(r.lo_u, r.hi_u);
         EXPECT_LT(r.lo_v, r.hi_v);
     }
     // The sphere uses "ball".
-    EXPECT_EQ(s.material_names[s.spheres[0].material], "ball");
-    EXPECT_EQ(s.materials[s.spheres[0].material].type, MaterialType::Diffuse);
+    EXPECT_EQ(s.material_names[s.of<Sphere>()[0].material], "ball");
+    EXPECT_EQ(s.materials[s.of<Sphere>()[0].material].type, material_type<Diffuse>);
     // Every wall faces into the box, towards its centre (0.5, 0.5, -0.5).
-    for (const AxisRect& r : s.rects) {
+    for (const AxisRect& r : s.of<AxisRect>()) {
         const Vec3 to_centre = Vec3(0.5f, 0.5f, -0.5f) - along_axis(rect_axis(r), r.plane);
         EXPECT_GT(dot(rect_normal(r), to_centre), 0.0f);
     }
@@ -181,8 +181,8 @@ TEST(SceneLoader, MinimalSceneGetsDefaults) {
     EXPECT_EQ(s.name, "min");
     EXPECT_FALSE(s.has_light);
     EXPECT_TRUE(is_black(s.background));
-    EXPECT_TRUE(s.spheres.empty());
-    EXPECT_TRUE(s.triangles.empty());
+    EXPECT_TRUE(s.of<Sphere>().empty());
+    EXPECT_TRUE(s.of<Triangle>().empty());
     EXPECT_EQ(s.render.width, 600);
     EXPECT_EQ(s.render.height, 600);
     EXPECT_EQ(s.render.spp, 512);
@@ -191,7 +191,7 @@ TEST(SceneLoader, MinimalSceneGetsDefaults) {
     EXPECT_FLOAT_EQ(s.camera.up.y, 1.0f);
     EXPECT_FLOAT_EQ(s.camera.vfov_degrees, 55.0f);
     ASSERT_EQ(s.materials.size(), 1u);
-    EXPECT_EQ(s.materials[0].type, MaterialType::Diffuse);
+    EXPECT_EQ(s.materials[0].type, material_type<Diffuse>);
     EXPECT_FLOAT_EQ(s.materials[0].albedo.z, 0.3f);
 }
 
@@ -225,23 +225,23 @@ TEST(SceneLoader, EverythingAsWritten) {
         ADD_FAILURE() << "no material " << name;
         return s.materials[0];
     };
-    EXPECT_EQ(material("glass").type, MaterialType::Glass);
+    EXPECT_EQ(material("glass").type, material_type<Glass>);
     EXPECT_FLOAT_EQ(material("glass").ior, 1.5f);
-    EXPECT_EQ(material("steel").type, MaterialType::Mirror);
+    EXPECT_EQ(material("steel").type, material_type<Mirror>);
     EXPECT_FLOAT_EQ(material("steel").albedo.z, 0.7f);
-    EXPECT_EQ(material("white").type, MaterialType::Diffuse);
-    ASSERT_EQ(s.spheres.size(), 2u);
-    EXPECT_EQ(s.material_names[s.spheres[0].material], "steel");
-    EXPECT_EQ(s.material_names[s.spheres[1].material], "glass");
-    EXPECT_FLOAT_EQ(s.spheres[1].radius, 3e-4f);
+    EXPECT_EQ(material("white").type, material_type<Diffuse>);
+    ASSERT_EQ(s.of<Sphere>().size(), 2u);
+    EXPECT_EQ(s.material_names[s.of<Sphere>()[0].material], "steel");
+    EXPECT_EQ(s.material_names[s.of<Sphere>()[1].material], "glass");
+    EXPECT_FLOAT_EQ(s.of<Sphere>()[1].radius, 3e-4f);
     // One triangle, and a quad that is planar but no rectangle, and shares an edge with the
     // triangle: a convex quad.
-    ASSERT_EQ(s.triangles.size(), 1u);
-    ASSERT_EQ(s.quads.size(), 1u);
-    EXPECT_EQ(s.material_names[s.triangles[0].material], "white");
-    EXPECT_EQ(s.material_names[s.quads[0].material], "glass");
-    EXPECT_EQ(s.quads[0].v2.z, -1.5f);
-    EXPECT_EQ(s.quads[0].normal.x, -1.0f);  // (v1 - v0) x (v2 - v0) points to -x
+    ASSERT_EQ(s.of<Triangle>().size(), 1u);
+    ASSERT_EQ(s.of<ConvexQuad>().size(), 1u);
+    EXPECT_EQ(s.material_names[s.of<Triangle>()[0].material], "white");
+    EXPECT_EQ(s.material_names[s.of<ConvexQuad>()[0].material], "glass");
+    EXPECT_EQ(s.of<ConvexQuad>()[0].v2.z, -1.5f);
+    EXPECT_EQ(s.of<ConvexQuad>()[0].normal.x, -1.0f);  // (v1 - v0) x (v2 - v0) points to -x
     EXPECT_EQ(s.render.width, 320);
     EXPECT_EQ(s.render.height, 240);
     EXPECT_EQ(s.render.spp, 16);
@@ -266,19 +266,19 @@ std::string scene_of(const std::vector<std::string>& quads,
     return text + "]}";
 }
 
-struct Kinds {
+struct PrimitiveCounts {
     size_t triangles, quads, rects;
 };
-Kinds kinds_of(const std::string& text) {
+PrimitiveCounts kinds_of(const std::string& text) {
     const Scene s = parse_scene(text, kName);
-    return {s.triangles.size(), s.quads.size(), s.rects.size()};
+    return {s.of<Triangle>().size(), s.of<ConvexQuad>().size(), s.of<AxisRect>().size()};
 }
 
 }  // namespace
 
 TEST(SceneLoader, EachQuadBecomesTheKindItIs) {
     const auto one = [](const std::string& quad) { return kinds_of(scene_of({quad})); };
-    const auto is = [](Kinds k, size_t t, size_t q, size_t r) {
+    const auto is = [](PrimitiveCounts k, size_t t, size_t q, size_t r) {
         return k.triangles == t && k.quads == q && k.rects == r;
     };
     EXPECT_TRUE(is(one("[[0,0,0], [1,0,0], [1,1,0], [0,1,0]]"), 0, 0, 1));  // a rectangle
@@ -292,9 +292,9 @@ TEST(SceneLoader, EachQuadBecomesTheKindItIs) {
     EXPECT_TRUE(is(one("[[0,0,0], [1,0,0], [2,0,0], [3,0,0]]"), 2, 0, 0));      // no area
     // Two halves of a split quad keep the file's order: (v0 v1 v2), (v0 v2 v3).
     const Scene s = parse_scene(scene_of({"[[0,0,0], [1,0,0], [1,1,0.01], [0,1,0]]"}), kName);
-    EXPECT_EQ(s.triangles[1].v0.x, 0.0f);
-    EXPECT_EQ(s.triangles[1].v1.z, 0.01f);
-    EXPECT_EQ(s.triangles[1].v2.y, 1.0f);
+    EXPECT_EQ(s.of<Triangle>()[1].v0.x, 0.0f);
+    EXPECT_EQ(s.of<Triangle>()[1].v1.z, 0.01f);
+    EXPECT_EQ(s.of<Triangle>()[1].v2.y, 1.0f);
 }
 
 // A rectangle that shares an edge with a triangle or a convex quad becomes a convex quad, and
@@ -304,7 +304,7 @@ TEST(SceneLoader, RectanglesThatShareAnEdgeWithAnotherKindBecomeQuads) {
     const std::string back = "[[0,0,-1], [1,0,-1], [1,1,-1], [0,1,-1]]";
     const std::string left = "[[0,0,0], [0,0,-1], [0,1,-1], [0,1,0]]";
     const std::string far_wall = "[[5,0,0], [5,1,0], [5,1,-1], [5,0,-1]]";
-    Kinds k = kinds_of(scene_of({floor, back, left, far_wall}));
+    PrimitiveCounts k = kinds_of(scene_of({floor, back, left, far_wall}));
     EXPECT_EQ(k.rects, 4u);
     // A triangle on the floor's front edge (z = 0): the floor, and the back and left walls
     // that share its edges, become quads; the far wall, apart from them, stays a rectangle.
@@ -327,7 +327,7 @@ TEST(SceneLoader, KindsDoNotDependOnWhereTheSceneIs) {
     const std::vector<std::string> quads = {
         "[[0,0,0], [1,0,0], [1,1,0], [0,1,0]]", "[[2,0,0], [3,0,0], [3.5,1,0], [2.5,1,0]]",
         "[[4,0,0], [5,0,0], [5,1,0.01], [4,1,0]]"};  // apart: no shared edges
-    const Kinds here = kinds_of(scene_of(quads));
+    const PrimitiveCounts here = kinds_of(scene_of(quads));
     EXPECT_EQ(here.rects, 1u);
     EXPECT_EQ(here.quads, 1u);
     EXPECT_EQ(here.triangles, 2u);
@@ -348,16 +348,16 @@ TEST(SceneLoader, KindsDoNotDependOnWhereTheSceneIs) {
             moved.push_back(out + "]");
         }
         const Scene s = parse_scene(scene_of(moved), kName);
-        EXPECT_EQ(s.rects.size(), here.rects) << shift;
-        EXPECT_EQ(s.quads.size(), here.quads) << shift;
-        EXPECT_EQ(s.triangles.size(), here.triangles) << shift;
+        EXPECT_EQ(s.of<AxisRect>().size(), here.rects) << shift;
+        EXPECT_EQ(s.of<ConvexQuad>().size(), here.quads) << shift;
+        EXPECT_EQ(s.of<Triangle>().size(), here.triangles) << shift;
         const Scene centred = centre_scene(s);
-        ASSERT_EQ(centred.rects.size(), 1u);
+        ASSERT_EQ(centred.of<AxisRect>().size(), 1u);
         Vec3 corners[4];
-        rect_corners(centred.rects[0], corners);
+        rect_corners(centred.of<AxisRect>()[0], corners);
         const Vec3(&c)[4] = corners;
-        EXPECT_EQ(axis_rect_axis(c), rect_axis(centred.rects[0])) << shift;
-        EXPECT_EQ(centred.rects[0].hi_u - centred.rects[0].lo_u, 1.0f) << shift;
+        EXPECT_EQ(axis_rect_axis(c), rect_axis(centred.of<AxisRect>()[0])) << shift;
+        EXPECT_EQ(centred.of<AxisRect>()[0].hi_u - centred.of<AxisRect>()[0].lo_u, 1.0f) << shift;
     }
 }
 
@@ -371,10 +371,10 @@ TEST(SceneLoader, QuadAsTwoTrianglesKeepsItsHalves) {
 })",
                                 kName);
     // One triangle plus a quad that is not convex, as two: (v0 v1 v2) and (v0 v2 v3).
-    ASSERT_EQ(s.triangles.size(), 3u);
-    EXPECT_EQ(s.material_names[s.triangles[0].material], "white");
-    const Triangle& q0 = s.triangles[1];
-    const Triangle& q1 = s.triangles[2];
+    ASSERT_EQ(s.of<Triangle>().size(), 3u);
+    EXPECT_EQ(s.material_names[s.of<Triangle>()[0].material], "white");
+    const Triangle& q0 = s.of<Triangle>()[1];
+    const Triangle& q1 = s.of<Triangle>()[2];
     EXPECT_EQ(s.material_names[q0.material], "glass");
     EXPECT_EQ(q1.material, q0.material);
     EXPECT_FLOAT_EQ(q0.v1.y, 1.0f);
@@ -389,14 +389,14 @@ TEST(SceneLoader, QuadAsTwoTrianglesKeepsItsHalves) {
 TEST(SceneLoader, ViewMirrorsTheArrays) {
     const Scene s = load_scene(std::string(RT_SOURCE_DIR) + "/common/scenes/cornell.json");
     const SceneView v = s.view();
-    EXPECT_EQ(v.spheres, s.spheres.data());
-    EXPECT_EQ(v.num_spheres, 1);
-    EXPECT_EQ(v.triangles, s.triangles.data());
-    EXPECT_EQ(v.num_triangles, 0);
-    EXPECT_EQ(v.quads, s.quads.data());
-    EXPECT_EQ(v.num_quads, 0);
-    EXPECT_EQ(v.rects, s.rects.data());
-    EXPECT_EQ(v.num_rects, 5);
+    EXPECT_EQ(v.of<Sphere>().items, s.of<Sphere>().data());
+    EXPECT_EQ(v.of<Sphere>().count, 1);
+    EXPECT_EQ(v.of<Triangle>().items, s.of<Triangle>().data());
+    EXPECT_EQ(v.of<Triangle>().count, 0);
+    EXPECT_EQ(v.of<ConvexQuad>().items, s.of<ConvexQuad>().data());
+    EXPECT_EQ(v.of<ConvexQuad>().count, 0);
+    EXPECT_EQ(v.of<AxisRect>().items, s.of<AxisRect>().data());
+    EXPECT_EQ(v.of<AxisRect>().count, 5);
     EXPECT_EQ(v.num_materials, 4);
     EXPECT_EQ(v.materials, s.materials.data());
     EXPECT_TRUE(v.has_light);

@@ -51,13 +51,13 @@ std::string box_at(double x) {
 }
 
 void expect_same_rects(const Scene& a, const Scene& b) {
-    ASSERT_EQ(a.rects.size(), b.rects.size());
-    for (size_t i = 0; i < a.rects.size(); ++i) {
-        EXPECT_EQ(a.rects[i].plane, b.rects[i].plane) << i;
-        EXPECT_EQ(a.rects[i].lo_u, b.rects[i].lo_u) << i;
-        EXPECT_EQ(a.rects[i].hi_u, b.rects[i].hi_u) << i;
-        EXPECT_EQ(a.rects[i].lo_v, b.rects[i].lo_v) << i;
-        EXPECT_EQ(a.rects[i].hi_v, b.rects[i].hi_v) << i;
+    ASSERT_EQ(a.of<AxisRect>().size(), b.of<AxisRect>().size());
+    for (size_t i = 0; i < a.of<AxisRect>().size(); ++i) {
+        EXPECT_EQ(a.of<AxisRect>()[i].plane, b.of<AxisRect>()[i].plane) << i;
+        EXPECT_EQ(a.of<AxisRect>()[i].lo_u, b.of<AxisRect>()[i].lo_u) << i;
+        EXPECT_EQ(a.of<AxisRect>()[i].hi_u, b.of<AxisRect>()[i].hi_u) << i;
+        EXPECT_EQ(a.of<AxisRect>()[i].lo_v, b.of<AxisRect>()[i].lo_v) << i;
+        EXPECT_EQ(a.of<AxisRect>()[i].hi_v, b.of<AxisRect>()[i].hi_v) << i;
     }
 }
 
@@ -70,8 +70,8 @@ TEST(ScenePlacement, ASmallSceneFarAwayIsTheSceneAtTheOrigin) {
     for (double x : {1e6, 1e8, 1e12}) {
         const Scene far = centre_scene(parse_scene(box_at(x), "far.json"));
         expect_same_rects(near, far);
-        ASSERT_EQ(far.spheres.size(), 1u);
-        EXPECT_EQ(far.spheres[0].center.x, near.spheres[0].center.x) << x;
+        ASSERT_EQ(far.of<Sphere>().size(), 1u);
+        EXPECT_EQ(far.of<Sphere>()[0].center.x, near.of<Sphere>()[0].center.x) << x;
         EXPECT_EQ(far.light.position.y, near.light.position.y) << x;
         EXPECT_EQ(far.camera.position.z, near.camera.position.z) << x;
     }
@@ -91,15 +91,15 @@ TEST(ScenePlacement, ANearRectangleFarAwayIsPlacedFromItsCentredCorners) {
         point(x - 4 + w, 0, -4) + ", " + point(x - 4 - w, 0, 4) + ", " + point(x + 4 + w, 0, 4) +
         ", " + point(x + 4 - w, 0, -4) + "], \"material\": \"w\"}]}";
     const Scene scene = centre_scene(parse_scene(text, "wobble.json"));
-    ASSERT_EQ(scene.rects.size() + scene.quads.size(), 1u);
+    ASSERT_EQ(scene.of<AxisRect>().size() + scene.of<ConvexQuad>().size(), 1u);
     double worst = 0;
-    if (!scene.rects.empty()) {
-        const AxisRect& r = scene.rects[0];
+    if (!scene.of<AxisRect>().empty()) {
+        const AxisRect& r = scene.of<AxisRect>()[0];
         for (double value : {double(r.lo_u) + 4, double(r.hi_u) - 4, double(r.lo_v) + 4,
                              double(r.hi_v) - 4, double(r.plane)})
             worst = std::max(worst, std::fabs(value));
     } else {
-        const ConvexQuad& q = scene.quads[0];
+        const ConvexQuad& q = scene.of<ConvexQuad>()[0];
         for (const Vec3& v : {q.v0, q.v1, q.v2, q.v3})
             worst = std::max({worst, std::fabs(std::fabs(double(v.x)) - 4), std::fabs(double(v.y)),
                               std::fabs(std::fabs(double(v.z)) - 4)});

@@ -10,18 +10,18 @@ namespace {
 Scene scene_with(double detail_radius, double wall) {
     Scene s;
     Material diffuse{};
-    diffuse.type = MaterialType::Diffuse;
+    diffuse.type = material_type<Diffuse>;
     Material glass = diffuse;
-    glass.type = MaterialType::Glass;
+    glass.type = material_type<Glass>;
     s.materials = {diffuse, glass};
     s.material_names = {"wall", "bead"};
     const float w = static_cast<float>(wall);
-    s.triangles = {make_triangle({-w, 0, -w}, {-w, 0, w}, {w, 0, w}, 0)};
+    s.of<Triangle>() = {make_triangle({-w, 0, -w}, {-w, 0, w}, {w, 0, w}, 0)};
     Sphere bead{};
     bead.center = {0.0f, 1.0f, 0.0f};
     bead.radius = static_cast<float>(detail_radius);
     bead.material = 1;
-    s.spheres = {bead};
+    s.of<Sphere>() = {bead};
     s.has_light = true;
     return s;
 }
@@ -30,11 +30,11 @@ Scene scene_with(double detail_radius, double wall) {
 
 TEST(SceneReport, CountsWhatTheSceneUses) {
     const SceneUse use = scene_use(scene_with(0.25, 2.0));
-    EXPECT_EQ(use.spheres, 1);
-    EXPECT_EQ(use.triangles, 1);
-    EXPECT_EQ(use.diffuse, 1);
-    EXPECT_EQ(use.glass, 1);
-    EXPECT_EQ(use.mirrors, 0);
+    EXPECT_EQ(use.primitives_of<Sphere>(), 1);
+    EXPECT_EQ(use.primitives_of<Triangle>(), 1);
+    EXPECT_EQ(use.materials_of<Diffuse>(), 1);
+    EXPECT_EQ(use.materials_of<Glass>(), 1);
+    EXPECT_EQ(use.materials_of<Mirror>(), 0);
     EXPECT_TRUE(use.light);
     EXPECT_FALSE(use.background);
     EXPECT_FLOAT_EQ(static_cast<float>(use.smallest), 0.25f);
@@ -50,14 +50,14 @@ TEST(SceneReport, CountsWhatTheSceneUses) {
 // not have are not named.
 TEST(SceneReport, CountsQuadsAndRectanglesByKind) {
     Scene s = scene_with(0.25, 2.0);
-    s.triangles.clear();
+    s.of<Triangle>().clear();
     const Vec3 r[4] = {{0, 0, 0}, {0.125f, 0, 0}, {0.125f, 0.1f, 0}, {0, 0.1f, 0}};
-    s.rects = {make_axis_rect(r, 2, 0), make_axis_rect(r, 2, 0)};
-    s.quads = {make_convex_quad({0, 0, 0}, {3, 0, 0}, {3.5f, 1, 0}, {0.5f, 1, 0}, 0)};
+    s.of<AxisRect>() = {make_axis_rect(r, 2, 0), make_axis_rect(r, 2, 0)};
+    s.of<ConvexQuad>() = {make_convex_quad({0, 0, 0}, {3, 0, 0}, {3.5f, 1, 0}, {0.5f, 1, 0}, 0)};
     const SceneUse use = scene_use(s);
-    EXPECT_EQ(use.triangles, 0);
-    EXPECT_EQ(use.quads, 1);
-    EXPECT_EQ(use.rects, 2);
+    EXPECT_EQ(use.primitives_of<Triangle>(), 0);
+    EXPECT_EQ(use.primitives_of<ConvexQuad>(), 1);
+    EXPECT_EQ(use.primitives_of<AxisRect>(), 2);
     EXPECT_FLOAT_EQ(static_cast<float>(use.smallest), 0.125f);  // the rectangle's longer side
     EXPECT_FLOAT_EQ(static_cast<float>(use.extent), 3.5f);      // the quad's corner
     const std::string line = describe(use);

@@ -18,13 +18,13 @@ namespace {
 Scene mirror_floor() {
     Scene scene;
     Material m{};
-    m.type = MaterialType::Mirror;
+    m.type = material_type<Mirror>;
     m.albedo = Vec3(1.0f);
     scene.materials.push_back(m);
     scene.material_names.push_back("mirror");
     const Vec3 a(-1, 0, -1), b(-1, 0, 1), c(1, 0, 1), d(1, 0, -1);
-    scene.triangles.push_back(make_triangle(a, b, c, 0));
-    scene.triangles.push_back(make_triangle(a, c, d, 0));
+    scene.of<Triangle>().push_back(make_triangle(a, b, c, 0));
+    scene.of<Triangle>().push_back(make_triangle(a, c, d, 0));
     return scene;
 }
 
@@ -48,11 +48,11 @@ std::string parse_error(const std::string& text) {
 TEST(SpecularBounce, ReflectedDirectionsStayUnitLength) {
     Scene scene;
     Material m{};
-    m.type = MaterialType::Mirror;
+    m.type = material_type<Mirror>;
     m.albedo = Vec3(1.0f);
     scene.materials.push_back(m);
     scene.material_names.push_back("mirror");
-    scene.spheres.push_back({Vec3(0.13f, -0.07f, 0.05f), 1.37f, 0});
+    scene.of<Sphere>().push_back({Vec3(0.13f, -0.07f, 0.05f), 1.37f, 0});
     const SceneView v = scene.view();
     for (int k = 0; k < 50; ++k) {
         const Vec3 d = normalize(Vec3(0.31f + 0.05f * k, -1.0f + 0.03f * k, 0.17f - 0.02f * k));
@@ -97,13 +97,13 @@ TEST(StepOffEdges, StepsInsideEveryEdgeThePointLiesOn) {
 TEST(StepOffEdges, AMirrorHitOnARoomsEdgeStartsInFrontOfBothFaces) {
     Scene scene = mirror_floor();
     // A wall x = 1 facing -x, meeting the floor at the edge x = 1, y = 0.
-    scene.triangles.push_back(make_triangle({1, 0, -1}, {1, 0, 1}, {1, 1, 1}, 0));
+    scene.of<Triangle>().push_back(make_triangle({1, 0, -1}, {1, 0, 1}, {1, 1, 1}, 0));
     const SceneView v = scene.view();
     // 0.4f + 0.6f and 0.8f - 0.8f round to 1 and 0: the hit lies exactly on the edge.
     const Ray ray{{0.4f, 0.8f, 0.25f}, {0.6f, -0.8f, 0.0f}};
     Hit hit;
     hit.t = 1.0f;
-    hit.kind = PrimitiveKind::Triangle;
+    hit.kind = primitive_kind<Triangle>;
     hit.index = 1;  // the floor's second triangle holds the edge x = 1
     ASSERT_EQ(ray.at(hit.t).x, 1.0f);
     ASSERT_EQ(ray.at(hit.t).y, 0.0f);
@@ -121,14 +121,15 @@ TEST(StepOffEdges, AMirrorHitOnARoomsEdgeStartsInFrontOfBothFaces) {
 TEST(StepOffEdges, RectanglesAndQuadsStepOffTheirEdgesToo) {
     const Vec3 a(-1, 0, -1), b(-1, 0, 1), c(1, 0, 1), d(1, 0, -1);          // the floor
     const Vec3 e(1, 0, -1), f(1, 0, 1), g(1, 1, 1), h(1, 1, -1);            // the wall x = 1
-    for (const PrimitiveKind kind : {PrimitiveKind::Rect, PrimitiveKind::Quad}) {
+    for (const PrimitiveKind kind : {primitive_kind<AxisRect>, primitive_kind<ConvexQuad>}) {
         Scene scene = mirror_floor();
-        scene.triangles.clear();
-        if (kind == PrimitiveKind::Rect) {
+        scene.of<Triangle>().clear();
+        if (kind == primitive_kind<AxisRect>) {
             const Vec3 floor[4] = {a, b, c, d}, wall[4] = {e, f, g, h};
-            scene.rects = {make_axis_rect(floor, 1, 0), make_axis_rect(wall, 0, 0)};
+            scene.of<AxisRect>() = {make_axis_rect(floor, 1, 0), make_axis_rect(wall, 0, 0)};
         } else {
-            scene.quads = {make_convex_quad(a, b, c, d, 0), make_convex_quad(e, f, g, h, 0)};
+            scene.of<ConvexQuad>() = {make_convex_quad(a, b, c, d, 0),
+                                      make_convex_quad(e, f, g, h, 0)};
         }
         const SceneView v = scene.view();
         const Ray ray{{0.4f, 0.8f, 0.25f}, {0.6f, -0.8f, 0.0f}};
@@ -150,7 +151,7 @@ TEST(StepOffEdges, RectanglesAndQuadsStepOffTheirEdgesToo) {
 // no sample, and nothing that sample_light returns is NaN.
 TEST(SampleLight, ALightAtTheSurfacePointGivesNoSample) {
     Scene scene = mirror_floor();
-    scene.materials[0].type = MaterialType::Diffuse;
+    scene.materials[0].type = material_type<Diffuse>;
     scene.has_light = true;
     scene.light.intensity = Vec3(1.0f);
     const Vec3 n(0, 1, 0);
@@ -196,11 +197,11 @@ TEST(WrittenCoordinates, AGenericOffsetCentresToTheUnmovedScene) {
         centre_scene(parse_scene(scene_text(12345.678, -8765.4321, 3456.789), "moved.json"));
     EXPECT_NEAR(moved.light.position.y, base.light.position.y, 1e-9f);
     EXPECT_NEAR(moved.light.position.x, base.light.position.x, 1e-9f);
-    ASSERT_EQ(moved.rects.size(), 1u);  // the floor, in both
-    ASSERT_EQ(base.rects.size(), 1u);
-    EXPECT_EQ(moved.rects[0].plane, base.rects[0].plane);
-    EXPECT_EQ(moved.rects[0].lo_v, base.rects[0].lo_v);
-    EXPECT_EQ(moved.rects[0].hi_u, base.rects[0].hi_u);
+    ASSERT_EQ(moved.of<AxisRect>().size(), 1u);  // the floor, in both
+    ASSERT_EQ(base.of<AxisRect>().size(), 1u);
+    EXPECT_EQ(moved.of<AxisRect>()[0].plane, base.of<AxisRect>()[0].plane);
+    EXPECT_EQ(moved.of<AxisRect>()[0].lo_v, base.of<AxisRect>()[0].lo_v);
+    EXPECT_EQ(moved.of<AxisRect>()[0].hi_u, base.of<AxisRect>()[0].hi_u);
     const Camera a = base.camera.for_image(16, 16), b = moved.camera.for_image(16, 16);
     const Vec3 da = a.ray_through(8, 8).direction, db = b.ray_through(8, 8).direction;
     EXPECT_GT(dot(da, db), 1.0f - 1e-6f) << "the moved camera aims elsewhere";

@@ -203,9 +203,9 @@ TEST(TJunctions, ALoadedSceneHasNoneLeftAndOthersKeepEveryBit) {
             return a.size() == b.size() &&
                    (a.empty() || std::memcmp(a.data(), b.data(), a.size() * sizeof(a[0])) == 0);
         };
-        EXPECT_TRUE(same_bytes(again.triangles, loaded.triangles)) << loaded.name;
-        EXPECT_TRUE(same_bytes(again.quads, loaded.quads)) << loaded.name;
-        EXPECT_TRUE(same_bytes(again.rects, loaded.rects)) << loaded.name;
+        EXPECT_TRUE(same_bytes(again.of<Triangle>(), loaded.of<Triangle>())) << loaded.name;
+        EXPECT_TRUE(same_bytes(again.of<ConvexQuad>(), loaded.of<ConvexQuad>())) << loaded.name;
+        EXPECT_TRUE(same_bytes(again.of<AxisRect>(), loaded.of<AxisRect>())) << loaded.name;
         EXPECT_TRUE(same_bytes(again.written.triangle_vertices, loaded.written.triangle_vertices));
         EXPECT_TRUE(same_bytes(again.written.quad_vertices, loaded.written.quad_vertices));
         EXPECT_TRUE(same_bytes(again.written.rect_vertices, loaded.written.rect_vertices));

@@ -54,25 +54,44 @@ def read(record: pathlib.Path = RECORD) -> dict:
 # lab05-bench's shapes each kernel is, by the run and the kernel's template arguments
 # (threads a pixel, scene memory, block, path loop, register cap, materials, geometry).
 NCU_SHAPES = {
-    ("cornell", "32, 1, 64, 0, 56, MaterialSet<0, 0>, GeometrySet<1, 0, 0, 1>"): "reference",
-    ("cornell", "32, 1, 64, 0, 56, MaterialSet<0, 0>, GeometrySet<1, 1, 1, 0>"): "general",
-    ("cornell", "32, 1, 64, 0, 56, MaterialSet<0, 0>, GeometrySet<1, 0, 1, 0>"): "quads",
-    ("cornell", "32, 1, 64, 0, 56, MaterialSet<0, 0>, GeometrySet<1, 1, 0, 0>"): "triangles",
-    ("cornell", "32, 2, 64, 0, 56, MaterialSet<0, 0>, GeometrySet<1, 0, 0, 1>"): "scene-shared",
-    ("cornell", "32, 1, 64, 2, 56, MaterialSet<0, 0>, GeometrySet<1, 0, 0, 1>"): "regenerate",
-    ("cornell", "32, 1, 64, 1, 56, MaterialSet<0, 0>, GeometrySet<1, 0, 0, 1>"): "together",
-    ("cornell", "32, 1, 64, 0, 255, MaterialSet<0, 0>, GeometrySet<1, 0, 0, 1>"): "no-register-cap",
+    ("cornell", "32, 1, 64, 0, 56, Kinds<Diffuse>, Kinds<Sphere, AxisRect>"): "reference",
+    ("cornell", "32, 1, 64, 0, 56, Kinds<Diffuse>, Kinds<Sphere, Triangle, ConvexQuad>"): "general",
+    ("cornell", "32, 1, 64, 0, 56, Kinds<Diffuse>, Kinds<Sphere, ConvexQuad>"): "quads",
+    ("cornell", "32, 1, 64, 0, 56, Kinds<Diffuse>, Kinds<Sphere, Triangle>"): "triangles",
+    ("cornell", "32, 2, 64, 0, 56, Kinds<Diffuse>, Kinds<Sphere, AxisRect>"): "scene-shared",
+    ("cornell", "32, 1, 64, 2, 56, Kinds<Diffuse>, Kinds<Sphere, AxisRect>"): "regenerate",
+    ("cornell", "32, 1, 64, 1, 56, Kinds<Diffuse>, Kinds<Sphere, AxisRect>"): "together",
+    ("cornell", "32, 1, 64, 0, 255, Kinds<Diffuse>, Kinds<Sphere, AxisRect>"): "no-register-cap",
     ("cornell", "plain_kernel"): "plain",
-    ("cornell-1-bounce", "32, 1, 64, 0, 56, MaterialSet<0, 0>, GeometrySet<1, 0, 0, 1>"):
+    ("cornell-1-bounce", "32, 1, 64, 0, 56, Kinds<Diffuse>, Kinds<Sphere, AxisRect>"):
         "reference, 1 bounce",
-    ("showcase", "32, 1, 64, 0, 56, MaterialSet<1, 1>, GeometrySet<1, 1, 1, 1>"):
-        "showcase",
+    ("showcase", "32, 1, 64, 0, 56, Kinds<Diffuse, Mirror, Glass>, "
+                 "Kinds<Sphere, Triangle, ConvexQuad, AxisRect>"): "showcase",
 }
 NCU_PATHS = 600 * 600 * 64  # check.sh profiles the baseline's size at 64 spp
 
 
 def number(text: str) -> float:
     return float(text.replace(",", ""))
+
+
+# The kind sets as the recorded profiles spell them, from when a set was a row of flags
+# (GeometrySet<spheres, triangles, quads, rects>, MaterialSet<mirror, glass>), in the names
+# the sources give them now (kinds.h).
+OLD_SETS = {
+    r"GeometrySet<([01, ]+)>": ("", ["Sphere", "Triangle", "ConvexQuad", "AxisRect"]),
+    r"MaterialSet<([01, ]+)>": ("Diffuse", ["Mirror", "Glass"]),
+}
+
+
+def kinds_spelling(args: str) -> str:
+    for pattern, (always, kinds) in OLD_SETS.items():
+        def named(m, always=always, kinds=kinds):
+            flags = [f.strip() == "1" for f in m.group(1).split(",")]
+            return "Kinds<" + ", ".join([always] * bool(always)
+                                        + [k for k, f in zip(kinds, flags) if f]) + ">"
+        args = re.sub(pattern, named, args)
+    return args
 
 
 def ncu_by_shape(rows: list) -> dict:
@@ -82,6 +101,7 @@ def ncu_by_shape(rows: list) -> dict:
     for r in rows:
         name = r["Kernel Name"]
         args = name[name.find("<") + 1:name.rfind(">")] if "<" in name else name.split("(")[0]
+        args = kinds_spelling(args)
         shape = NCU_SHAPES.get((r["run"], args))
         if shape is None:
             continue

@@ -50,19 +50,19 @@ struct SurfacePoint {
 template <class Primitives = AnyGeometry>
 RT_HD inline SurfacePoint surface_at(const SceneView& scene, const Ray& ray, const Hit& hit) {
     const Vec3 p = ray.at(hit.t);
-    if (Primitives::kSpheres && hit.kind == PrimitiveKind::Sphere) {
-        const Sphere& s = scene.spheres[hit.index];
+    if (has_kind<Primitives, Sphere> && hit.kind == primitive_kind<Sphere>) {
+        const Sphere& s = scene.of<Sphere>()[hit.index];
         return {p, normalize(p - s.center), sphere_extent(s), s.material};
     }
-    if (Primitives::kRects && hit.kind == PrimitiveKind::Rect) {
-        const AxisRect& r = scene.rects[hit.index];
+    if (has_kind<Primitives, AxisRect> && hit.kind == primitive_kind<AxisRect>) {
+        const AxisRect& r = scene.of<AxisRect>()[hit.index];
         return {p, rect_normal(r), r.extent, r.material};
     }
-    if (Primitives::kQuads && hit.kind == PrimitiveKind::Quad) {
-        const ConvexQuad& q = scene.quads[hit.index];
+    if (has_kind<Primitives, ConvexQuad> && hit.kind == primitive_kind<ConvexQuad>) {
+        const ConvexQuad& q = scene.of<ConvexQuad>()[hit.index];
         return {p, q.normal, q.extent, q.material};
     }
-    const Triangle& tri = scene.triangles[hit.index];
+    const Triangle& tri = scene.of<Triangle>()[hit.index];
     return {p, tri.normal, tri.extent, tri.material};
 }
 
@@ -76,9 +76,9 @@ RT_HD inline Hit closest_hit(const SceneView& scene, const Ray& ray) {
     // order, keeping the nearest hit: the triangles and the quads (build one RayShear per
     // ray, then intersect_triangle and intersect_quad), then the axis-aligned rectangles
     // (intersect_rect: the Cornell box's walls). Each hit records its kind and index.
-    for (int i = 0; Primitives::kSpheres && i < scene.num_spheres; ++i) {
-        const real t = intersect_sphere(ray, scene.spheres[i], hit.t);
-        if (t < hit.t) hit = {t, PrimitiveKind::Sphere, i};
+    for (int i = 0; has_kind<Primitives, Sphere> && i < scene.of<Sphere>().count; ++i) {
+        const real t = intersect_sphere(ray, scene.of<Sphere>()[i], hit.t);
+        if (t < hit.t) hit = {t, primitive_kind<Sphere>, i};
     }
     return hit;
 }
@@ -99,12 +99,12 @@ RT_HD inline bool occluded(const SceneView& scene, const Ray& ray, real t_max) {
 // convex_quad.h, axis_rect.h); zero on a sphere, which has none.
 template <class Primitives = AnyGeometry>
 RT_HD inline Vec3 step_off_hit_edges(const SceneView& scene, const Hit& hit, Vec3 p, real margin) {
-    if (Primitives::kTriangles && hit.kind == PrimitiveKind::Triangle)
-        return step_off_edges(scene.triangles[hit.index], p, margin);
-    if (Primitives::kQuads && hit.kind == PrimitiveKind::Quad)
-        return step_off_edges(scene.quads[hit.index], p, margin);
-    if (Primitives::kRects && hit.kind == PrimitiveKind::Rect)
-        return step_off_edges(scene.rects[hit.index], p, margin);
+    if (has_kind<Primitives, Triangle> && hit.kind == primitive_kind<Triangle>)
+        return step_off_edges(scene.of<Triangle>()[hit.index], p, margin);
+    if (has_kind<Primitives, ConvexQuad> && hit.kind == primitive_kind<ConvexQuad>)
+        return step_off_edges(scene.of<ConvexQuad>()[hit.index], p, margin);
+    if (has_kind<Primitives, AxisRect> && hit.kind == primitive_kind<AxisRect>)
+        return step_off_edges(scene.of<AxisRect>()[hit.index], p, margin);
     return Vec3(0.0f);
 }
 

@@ -149,7 +149,7 @@ RenderStats render(const RenderJob& job, Image& image) {
     //> // lives in the constant bank (memory == SceneMemory::Constant), into the bank too
     //> // (upload_to_constant, scene_constant.cuh). Until then: the kernel is told of the
     //> // materials and spheres only, so the walls are missing from the image.
-    //> layout.num_triangles = layout.num_quads = layout.num_rects = 0;
+    //> layout.of<Triangle>().count = layout.of<ConvexQuad>().count = layout.of<AxisRect>().count = 0;
     //> check(cudaMemcpy(pool.data(), host_pool.data(), pool.bytes(), cudaMemcpyHostToDevice),
     //>       "copying the scene to the GPU");
     //> if (memory == SceneMemory::Constant) upload_to_constant(host_pool, layout);
