@@ -43,6 +43,7 @@ import zipfile
 from grading import class_page, hidden, references, shown
 from grading.grade import BUDGET_SECONDS, RUBRICS
 from grading.speed_numbers import speed_numbers
+from grading.verdicts import failure_cause, flagged, provisional_points
 from labkit import gpu
 from labkit.harness import ROOT
 
@@ -96,73 +97,6 @@ def refused_results(lab: str, reason: str) -> dict:
     results.add_all(Test(i.id, i.label, i.points, visibility=i.visibility) for i in RUBRICS[lab])
     results.refuse(f"the hand-in was refused: {reason}")
     return results.as_dict()
-
-
-# The cause of a failure, from what the failing check or the grader said: first match wins.
-CAUSES = [
-    ("timeout", re.compile(r"the grader did not finish in")),  # stopped by the batch
-    ("no results", re.compile(r"left no results\.json")),
-    ("compile error", re.compile(r"does not compile")),
-    ("no hand-in", re.compile(r"the hand-in holds (none|lab)")),
-    ("refused", re.compile(r"the hand-in was refused")),
-    ("timeout", re.compile(r"timed out")),
-    ("work split", re.compile(r"deterministic but different")),
-    ("race", re.compile(r"nondeterministic|data race|differs? for|differs from the serial")),
-    ("signal", re.compile(r"killed by|signal|SIG[A-Z]+")),
-    ("crash", re.compile(r"exit status|exited with|could not run")),
-    ("no sandbox", re.compile(r"without a sandbox")),
-    ("no GPU", re.compile(r"NVIDIA GPU|cannot render on this machine's GPU")),
-]
-
-
-def provisional_points(results: dict) -> int:
-    """Points given without a measurement (a machine too busy): the regrade decides them."""
-    return sum(t.get("score", 0) for t in results.get("tests", [])
-               if t.get("extra_data", {}).get("regrade"))
-
-
-def flagged(results: dict) -> bool:
-    """To be graded again on a quiet machine: provisional points, or refused for the
-    machine's sake (no GPU), or no results at all."""
-    return (any(t.get("extra_data", {}).get("regrade") for t in results.get("tests", []))
-            or not results.get("tests"))
-
-
-def waiting(test: dict) -> bool:
-    """A check whose points wait for a gate and which lost none of its own: not run yet, or
-    run and passed ("not counted until ...; it saw: PASS ..."). The gate's verdict is the
-    cause, never a check that passed."""
-    output = test.get("output", "")
-    return output.startswith("not graded until") or (
-        output.startswith("not counted until") and "it saw: PASS" in output)
-
-
-def failure_cause(results: dict) -> str:
-    """Why points were lost, in a few words, with the first failing check's words: the
-    compiler's first error, a signal, a timeout, a race, which image check."""
-    tests = results.get("tests", [])
-    top = results.get("output", "")
-    failing = [t for t in tests if t.get("status") != "passed" and not waiting(t)]
-    texts = [top] + [f"{t['name']}: {t.get('output', '')}" for t in failing]
-    for cause, pattern in CAUSES:
-        for text in texts:
-            if pattern.search(text):
-                if cause == "refused":  # the grader's one line, once
-                    why = text.split("the hand-in was refused: ", 1)[1].splitlines()
-                    return f"refused: {why[0][:200] if why else ''}"
-                if cause == "compile error":  # the compiler's first line after the note
-                    lines = top.splitlines()
-                    at = next((i for i, line in enumerate(lines) if "does not compile" in line), 0)
-                    after = [line for line in lines[at + 1:] if line.strip()]
-                    return f"compile error: {after[0][:200] if after else ''}".rstrip(": ")
-                return f"{cause}: {text.splitlines()[0][:200]}"
-    if failing:
-        t = failing[0]
-        kind = "image check" if t.get("extra_data", {}).get("check", "").startswith(
-            ("golden", "hidden", "sphere", "lit", "glass", "scale")) else "check"
-        first = t.get("output", "").splitlines()[0][:200] if t.get("output") else ""
-        return f"{kind} {t['name']}: {first}"
-    return ""
 
 
 class CleanWriter:

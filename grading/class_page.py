@@ -13,6 +13,7 @@ import urllib.parse
 
 from grading import report_html, shown
 from grading.speed_numbers import speed_numbers
+from grading.verdicts import failure_cause, flagged, provisional_points, waiting
 
 MOST_NOTE_LINES = 3  # of a row's own notes (a compile error's lines are in its cause and page)
 
@@ -101,7 +102,6 @@ def student_page(report: pathlib.Path, student: str, lab: str, who: str, results
 
 def write_html(path: pathlib.Path, lab: str, rows: dict[str, dict], labels: list[str],
                submitters: dict[str, str] | None = None) -> None:
-    from grading.batch import failure_cause, flagged, provisional_points, waiting
     e = shown.html
     shared_count = collections.Counter(line for r in rows.values() for line in set(note_lines(r)))
     shared = [line for line, n in shared_count.items() if n > 1]

@@ -431,9 +431,13 @@ def run_check(item: Item, binary, heatmap_dir, secret: str = "") -> checks.Check
     if item.id in ("hidden", "part-a"):
         kwargs["secret"] = secret
     try:
-        return item.run(binary, **kwargs)
+        result = item.run(binary, **kwargs)
     except Exception as e:  # a crash, a timeout, a missing image: no points, say why
         return checks.CheckResult(item.label, False, f"could not run: {e}")
+    if heatmap_dir:  # the images the page shows beside the check (grading/report_html.py)
+        for scene, (yours, want) in result.images.items():
+            report_html.write_images(heatmap_dir, scene, yours, want)
+    return result
 
 
 def check_id(test: dict) -> str:

@@ -23,6 +23,8 @@ import tempfile
 import numpy as np
 
 from grading import symptoms
+from grading.check_result import CheckResult, image_checked
+from grading.lanes import lanes_not_lab01
 from labkit import scenes
 from labkit.compare import GRADING_ALPHA, compare
 from labkit.harness import RunPolicy, available_cores, policy, run_lab
@@ -131,8 +133,6 @@ def make_golden(reference, scene_path: pathlib.Path, size: int = SIZE,
 def check_hidden(binary, reference, secret: str, *, launcher=(), threads=None,
                  heatmap_dir: pathlib.Path | None = None):
     """The submission's render of the hidden scene against golden data made just now."""
-    from grading.checks import CheckResult, image_checked, lanes_not_lab01
-
     @image_checked("hidden scene")
     def run() -> CheckResult:
         with tempfile.TemporaryDirectory() as tmp:

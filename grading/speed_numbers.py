@@ -6,7 +6,7 @@ from __future__ import annotations
 import re
 
 SPEED_CHECKS = ("parallel-speedup", "speedup", "speed")
-# What the speed checks print (grading/checks.py): "... 1.85x over the serial reference
+# What the speed checks print (grading/speed_checks.py): "... 1.85x over the serial reference
 # (0.600 s -> 0.324 s) on 2 cores giving 1.98x capacity ..." and "1.62x (0.412 s -> 0.254 s
 # wall clock ...)". Structured numbers in a test's extra_data, where the grader gives them,
 # come first.

@@ -221,7 +221,7 @@ def test_a_gpu_lab_grades_one_submission_per_gpu_at_once(tmp_path, monkeypatch):
 
 
 def test_a_race_and_a_work_split_are_told_apart():
-    """The bit check's two diagnoses (grading/checks.py) become two causes in grades.csv."""
+    """The bit check's two diagnoses (grading/identity_checks.py) are two causes in grades.csv."""
     def failed(output):
         return {"score": 40, "tests": [{"name": "bit for bit", "score": 0, "max_score": 20,
                                         "output": output}]}

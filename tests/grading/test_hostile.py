@@ -442,7 +442,7 @@ def test_values_at_the_float_limit_fail_every_image_check(tmp_path):
     assert "radiance is never negative and no test scene gives more" in describe(results)
 
 
-# ---- speed that fails closed (grading/checks.py) -------------------------------------------
+# ---- speed that fails closed (grading/speed_checks.py) ----------------------------------------
 
 @contextlib.contextmanager
 def burning_one_core():

@@ -143,3 +143,45 @@ def test_paths_and_modules_the_repository_names_exist():
             if importlib.util.find_spec(m.group(1)) is None:
                 missing.append(f"{f.relative_to(ROOT)}: -m {m.group(1)}")
     assert not missing, missing
+
+
+def module_graph(package: str) -> dict[str, set[str]]:
+    """Module -> the modules of `package` it imports (at its top or inside a function)."""
+    graph = {}
+    for f, tree in trees(tracked(f"{package}/*.py")):
+        deps = set()
+        for node in ast.walk(tree):
+            if isinstance(node, ast.ImportFrom) and node.module == package:
+                deps |= {a.name for a in node.names}
+            elif isinstance(node, ast.ImportFrom) and (node.module or "").startswith(package + "."):
+                deps.add(node.module.split(".")[1])
+            elif isinstance(node, ast.Import):
+                deps |= {a.name.split(".")[1] for a in node.names
+                         if a.name.startswith(package + ".")}
+        graph[f.stem] = deps - {f.stem}
+    return graph
+
+
+def cycles(graph: dict[str, set[str]]) -> list[list[str]]:
+    """Each import cycle once, as the modules along it."""
+    found, done = [], set()
+
+    def visit(node, path):
+        for nxt in sorted(graph.get(node, ())):
+            if nxt in path:
+                cycle = path[path.index(nxt):]
+                if frozenset(cycle) not in done:
+                    done.add(frozenset(cycle))
+                    found.append(cycle + [nxt])
+            elif nxt in graph:
+                visit(nxt, path + [nxt])
+    for start in sorted(graph):
+        visit(start, [start])
+    return found
+
+
+def test_the_graders_modules_import_in_one_direction():
+    """No module of grading/ imports one that imports it back, even inside a function: each
+    has one job, and a check's module needs nothing from the grade that runs it."""
+    assert cycles(module_graph("grading")) == []
+    assert cycles({"checks": {"hidden"}, "hidden": {"checks"}}) == [["checks", "hidden", "checks"]]

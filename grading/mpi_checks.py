@@ -1,0 +1,65 @@
+"""Lab 04's ranks: mpirun as the grader starts it, and every distribution of rows."""
+from __future__ import annotations
+
+import re
+
+from grading.check_result import CheckResult
+from grading.identity_checks import row_ranges
+from labkit.harness import run_lab
+
+
+def mpirun(ranks: int, distribution: str | None = None, *env: str) -> list[str]:
+    """The launcher for MPI labs, RT_MPI_DISTRIBUTION set for every rank when `distribution`
+    is given and each NAME=VALUE of `env` too (the sandbox passes none of the grader's
+    environment on). Not -q: it would hide OpenMPI's own error text (MPI_ERR_TRUNCATE, a
+    rank that died), the cause a student needs; a run that succeeds prints no banner."""
+    cmd = ["mpirun", "--oversubscribe", "--bind-to", "none", "-np", str(ranks)]
+    for setting in ([f"RT_MPI_DISTRIBUTION={distribution}"] if distribution else []) + list(env):
+        cmd += ["-x", setting]
+    return cmd
+
+
+DISTRIBUTIONS = ("block", "interleaved", "dynamic")
+
+
+def report_rows(stderr: str) -> dict[int, set[int]]:
+    """RT_MPI_REPORT's lines ("rank 1: ... : rows 1,4,7-9"): {rank: the rows it rendered}."""
+    rows: dict[int, set[int]] = {}
+    for rank, ranges in re.findall(r"^rank (\d+): .*: rows (\S+)$", stderr, re.M):
+        rows[int(rank)] = set()
+        for part in ranges.split(","):
+            first, _, last = part.partition("-")
+            if first.isdigit() and (not last or last.isdigit()):
+                rows[int(rank)].update(range(int(first), int(last or first) + 1))
+    return rows
+
+
+def check_distributions(binary, ranks: int = 3, width: int = 16, height: int = 12) -> CheckResult:
+    """Lab 04's tasks 2 and 3, which the image cannot show (every distribution renders lab
+    01's bits, blocks included): the rows each rank rendered, as RT_MPI_REPORT lists them,
+    for `ranks` ranks: interleaved is every `ranks`-th row from the rank's own; dynamic is
+    not the fixed bands of block. Half the points each."""
+    bands = {r: set(range(height * r // ranks, height * (r + 1) // ranks)) for r in range(ranks)}
+    verdicts = []
+    for distribution in ("interleaved", "dynamic"):
+        run = run_lab(binary, width=width, height=height, spp=2,
+                      launcher=mpirun(ranks, distribution, "RT_MPI_REPORT=1"))
+        rows = report_rows(run.stderr)
+        if sorted(rows) != list(range(ranks)) or set().union(*rows.values()) != set(range(height)):
+            verdicts.append((False, f"{distribution}: RT_MPI_REPORT=1 does not list every "
+                                    f"row once among ranks 0-{ranks - 1}"))
+        elif distribution == "interleaved":
+            want = {r: set(range(r, height, ranks)) for r in range(ranks)}
+            verdicts.append((rows == want, f"interleaved: rank 1 rendered rows "
+                                           f"{row_ranges(sorted(rows[1]))}" + (
+                "" if rows == want else f", not {row_ranges(sorted(want[1]))} (rank r renders "
+                                        f"rows r, r + {ranks}, ...: task 2 undone?)")))
+        else:
+            verdicts.append((rows != bands, "dynamic: " + (
+                "rows handed out as ranks finish" if rows != bands else
+                "the rows were split into block's fixed bands (task 3, the master and its "
+                "workers, undone?)")))
+    passed = sum(ok for ok, _ in verdicts)
+    detail = f"{ranks} ranks, {width}x{height}: " + "; ".join(text for _, text in verdicts)
+    return CheckResult("rows per distribution", passed == len(verdicts), detail,
+                       credit=passed / len(verdicts))
