@@ -108,6 +108,30 @@ echo "SECRET=$GRADING_SECRET"
     assert not left, left
 
 
+def test_only_mpiruns_runs_get_ip_sockets(user_sandbox, tmp_path):
+    """Lab 04 in the user sandbox: OpenMPI's PMIx reaches every rank over loopback TCP, so a
+    run the grader starts under mpirun has IP sockets (lab04-ref renders there, and a client
+    under mpirun connects), and a run without it has none."""
+    import socket
+
+    from grading.mpi_checks import mpirun
+    from labkit.harness import RunPolicy, policy, run_lab
+    build("lab04-ref")
+    client = sub.socket_client(tmp_path)
+    with socket.socket() as server:
+        server.bind(("127.0.0.1", 0))
+        server.listen()
+        port = str(server.getsockname()[1])
+        with sandbox.Runner(trusted=False) as r:
+            plain = r.run([r.input(client), port])
+            launched = r.run([*mpirun(1), r.input(client), port])
+    assert plain.returncode == 3, (plain.returncode, plain.stderr)
+    assert launched.returncode == 0 and "connected" in launched.stdout, launched
+    with policy(RunPolicy(trusted=False)):
+        run = run_lab(ROOT / "lab04-ref", width=8, height=6, spp=2, launcher=mpirun(2))
+    assert run.image.shape == (6, 8, 3)
+
+
 def test_a_run_confined_to_one_cpu_cannot_widen_its_affinity(user_sandbox):
     """Limits.cpu in the user sandbox: confine.py's filter refuses sched_setaffinity there."""
     cpus = sorted(os.sched_getaffinity(0))
