@@ -1,26 +1,15 @@
 """Correctness checks of a lab binary, shared by the pytest suites, the mutation tests and the
-grader. Each returns a CheckResult: whether it passed and a line saying what it saw.
+grader. Each returns a CheckResult: whether it passed, a line saying what it saw, and the
+images it compared.
 
-How often a correct renderer fails each check (its false-failure rate), and why:
-- golden images: at most alpha = 1e-4 per comparison, by the Bonferroni bound over every
-  block and global z-test (labkit/compare.py explains the model and its assumptions).
-- sphere interior: the estimator has zero variance there (every next-event estimate is the
-  same), so only float rounding differs from the closed form: ~1e-5 relative, bound 3e-4.
-- millions of samples: the same zero-variance scene at 2^22 and 2^12 spp; a double sum keeps
-  the two means equal to float rounding (~1e-7), bound 1e-5; a float sum drifts by ~1e-2.
-- lit plane: the only noise is where the pixel jitter lands; at 256 spp the per-pixel error
-  is ~1e-3, bounds 3e-3 (mean) and 2e-2 (max) are far outside it.
-- glass pane: the mean of 262,144 Bernoulli(~4-5%) paths has a relative standard error of
-  ~1%; the 5% bound is five standard errors (two-sided rate ~6e-7) at each of 4 renders.
-- scale invariance: the scaled and unscaled renders use the same random numbers, so they
-  differ only where rounding sends a path another way: measured 0.00% for the reference.
-A renderer whose float roundings differ (SIMD, GPU) is another random draw of the same
-estimator, so these rates apply to it too. Which bugs each check catches is shown by
-tests/labs/test_lab01_mutants.py.
-
-The checks live by concern in check_result, golden_checks, analytic_checks,
-invariance_checks, speed_checks, identity_checks, mpi_checks, layout_check and lanes; this
-module names them all for the grader and the tests."""
+They live by concern, each module with the false-failure rates of its checks:
+check_result (what a check returns), golden_checks (the golden images), analytic_checks (the
+closed forms), invariance_checks (scale, moves, size, reproducibility), speed_checks (timed
+renders), identity_checks (lab 01's bits), mpi_checks (lab 04's distributions), layout_check
+(lab 07's pool) and lanes (lab 02's lanes); this module names them all for the grader and the
+tests. A renderer whose float roundings differ (SIMD, GPU) is another random draw of the same
+estimator, so the rates apply to it too. Which bugs each check catches is shown by
+tests/labs/test_lab01_mutants.py."""
 from __future__ import annotations
 
 from grading.analytic_checks import (

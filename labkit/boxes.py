@@ -126,6 +126,23 @@ def new_box() -> tuple[tuple[int, int], bool]:
 
 # ---- ending a box ------------------------------------------------------------------------
 
+def thread_fields(pid: int | str):
+    """(tid, fields) for each thread of a process that can be read now, the fields of its
+    /proc/PID/task/TID/stat after the command name (fields[0] is its state; a name may
+    hold spaces and parentheses, so the split starts after the last ')')."""
+    try:
+        tasks = os.listdir(f"/proc/{pid}/task")
+    except OSError:
+        return
+    for tid in tasks:
+        try:
+            with open(f"/proc/{pid}/task/{tid}/stat", "rb") as f:
+                line = f.read()
+        except OSError:
+            continue
+        yield int(tid), line[line.rfind(b")") + 2:].split()
+
+
 def _runs_as(pid: str, uid: int) -> bool:
     """Whether `uid` is one of a process's uids (real, effective, saved, file system: the
     owner of /proc/PID is root for a process that is not dumpable) and any of its threads is
@@ -133,20 +150,10 @@ def _runs_as(pid: str, uid: int) -> bool:
     try:
         with open(f"/proc/{pid}/status") as f:
             uids = next(line.split()[1:] for line in f if line.startswith("Uid:"))
-        if str(uid) not in uids:
-            return False
-        tasks = os.listdir(f"/proc/{pid}/task")
     except (OSError, StopIteration):
         return False
-    for tid in tasks:
-        try:
-            with open(f"/proc/{pid}/task/{tid}/stat", "rb") as f:
-                line = f.read()
-        except OSError:
-            continue
-        if line[line.rfind(b")") + 2:][:1] not in (b"Z", b"X"):
-            return True
-    return False
+    return str(uid) in uids and any(
+        fields[0] not in (b"Z", b"X") for _, fields in thread_fields(pid))
 
 
 def processes(uid: int) -> list[int]:

@@ -610,23 +610,13 @@ class TreeClock:
                     f.write(str(self.nice))
             except OSError:
                 pass  # a kernel without autogroups, or the process has gone
-        try:
-            tasks = os.listdir(f"/proc/{pid}/task")
-        except OSError:
-            return
-        for tid in tasks:
-            try:
-                with open(f"/proc/{pid}/task/{tid}/stat", "rb") as f:
-                    stat_line = f.read()
-            except OSError:
-                continue
-            fields = stat_line[stat_line.rfind(b")") + 2:].split()
-            key = (pid, int(tid), int(fields[19]))  # a reused thread id starts at another time
+        for tid, fields in boxes.thread_fields(pid):
+            key = (pid, tid, int(fields[19]))  # a reused thread id starts at another time
             ticks = int(fields[11]) + int(fields[12])  # this thread's utime + stime
             self._threads[key] = max(self._threads.get(key, 0), ticks)
             if self.nice is not None and int(fields[16]) > self.nice:
                 try:
-                    os.setpriority(os.PRIO_PROCESS, int(tid), self.nice)
+                    os.setpriority(os.PRIO_PROCESS, tid, self.nice)
                 except OSError:
                     pass
 

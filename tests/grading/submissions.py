@@ -5,8 +5,10 @@ repository, so a script cannot just exec ./lab01-ref) and unpack it into their s
 """
 from __future__ import annotations
 
+import contextlib
 import pathlib
 import shlex
+import socket
 import subprocess
 import sys
 
@@ -127,6 +129,16 @@ int main(int argc, char** argv) {
     return 0;
 }
 """
+
+
+@contextlib.contextmanager
+def loopback_server():
+    """A TCP server listening on 127.0.0.1 for socket_client: yields its port, as a word of a
+    command line."""
+    with socket.socket() as server:
+        server.bind(("127.0.0.1", 0))
+        server.listen()
+        yield str(server.getsockname()[1])
 
 
 def socket_client(folder) -> pathlib.Path:

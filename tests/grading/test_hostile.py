@@ -185,12 +185,8 @@ def test_an_output_flood_is_cut(tmp_path, stream):
 
 
 def test_no_network(tmp_path):
-    import socket
     client = sub.socket_client(tmp_path)
-    with socket.socket() as server:
-        server.bind(("127.0.0.1", 0))
-        server.listen()
-        port = str(server.getsockname()[1])
+    with sub.loopback_server() as port:
         with sandbox.Runner(trusted=False) as r:
             inside = r.run([r.input(client), port])
         with sandbox.Runner(trusted=True) as r:

@@ -156,13 +156,19 @@ def finish_lab(release: pathlib.Path, lab: str) -> None:
         shutil.copy(ROOT / shared, skeleton / pathlib.Path(shared).name)
 
 
+def released(lab: str, tmp_path_factory, timeout: int) -> pathlib.Path:
+    """A fresh `make release LAB=lab`, as course staff make it."""
+    out = tmp_path_factory.mktemp(f"release{lab}") / f"lab{lab}"
+    p = subprocess.run(["make", "-s", "-C", str(ROOT), "release", f"LAB={lab}", f"OUT={out}"],
+                       capture_output=True, text=True, timeout=timeout, env=CLEAN_ENV)
+    assert p.returncode == 0, p.stdout + p.stderr
+    return out
+
+
 @pytest.fixture(scope="module", params=LABS)
 def finished(request, tmp_path_factory):
     lab = request.param
-    out = tmp_path_factory.mktemp(f"release{lab}") / f"lab{lab}"
-    p = subprocess.run(["make", "-s", "-C", str(ROOT), "release", f"LAB={lab}", f"OUT={out}"],
-                       capture_output=True, text=True, timeout=1800, env=CLEAN_ENV)
-    assert p.returncode == 0, p.stdout + p.stderr
+    out = released(lab, tmp_path_factory, timeout=1800)
     finish_lab(out, lab)
     return lab, out
 
@@ -332,12 +338,7 @@ def missing_from(release: pathlib.Path, command: str) -> str | None:
 
 @pytest.fixture(scope="module", params=GPU_LABS)
 def gpu_release(request, tmp_path_factory):
-    lab = request.param
-    out = tmp_path_factory.mktemp(f"release{lab}") / f"lab{lab}"
-    p = subprocess.run(["make", "-s", "-C", str(ROOT), "release", f"LAB={lab}", f"OUT={out}"],
-                       capture_output=True, text=True, timeout=3600, env=CLEAN_ENV)
-    assert p.returncode == 0, p.stdout + p.stderr
-    return lab, out
+    return request.param, released(request.param, tmp_path_factory, timeout=3600)
 
 
 def test_every_command_of_a_gpu_release_exists(gpu_release):

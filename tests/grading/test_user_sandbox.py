@@ -79,7 +79,6 @@ def user_sandbox(monkeypatch):
 def test_user_sandbox_walls(user_sandbox, tmp_path):
     """No network, no namespaces, no reading the grader's files or the grader's environment,
     nothing left running after a run."""
-    import socket
     client = sub.socket_client(tmp_path)
     spy = sub.script(
         tmp_path,
@@ -93,11 +92,9 @@ echo "SECRET=$GRADING_SECRET"
     )
     os.environ["GRADING_SECRET"] = "leak-me-4713"
     try:
-        with socket.socket() as server:
-            server.bind(("127.0.0.1", 0))
-            server.listen()
+        with sub.loopback_server() as port:
             with sandbox.Runner(trusted=False) as r:
-                net = r.run([r.input(client), str(server.getsockname()[1])])
+                net = r.run([r.input(client), port])
                 out = r.run([r.input(spy)])
                 uid = r.box[0]
     finally:
@@ -112,16 +109,11 @@ def test_only_mpiruns_runs_get_ip_sockets(user_sandbox, tmp_path):
     """Lab 04 in the user sandbox: OpenMPI's PMIx reaches every rank over loopback TCP, so a
     run the grader starts under mpirun has IP sockets (lab04-ref renders there, and a client
     under mpirun connects), and a run without it has none."""
-    import socket
-
     from grading.mpi_checks import mpirun
     from labkit.harness import RunPolicy, policy, run_lab
     build("lab04-ref")
     client = sub.socket_client(tmp_path)
-    with socket.socket() as server:
-        server.bind(("127.0.0.1", 0))
-        server.listen()
-        port = str(server.getsockname()[1])
+    with sub.loopback_server() as port:
         with sandbox.Runner(trusted=False) as r:
             plain = r.run([r.input(client), port])
             launched = r.run([*mpirun(1), r.input(client), port])
