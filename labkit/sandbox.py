@@ -124,7 +124,7 @@ BUBBLEWRAP, USER = "bubblewrap", "user"
 DESCRIPTIONS = {
     BUBBLEWRAP: "bubblewrap (user, PID, network, IPC and mount namespaces)",
     USER: "a user of its own for each run (setpriv, prlimit, seccomp filter{landlock}; no "
-          "namespaces here)",
+          "namespaces here; IP sockets only under mpirun)",
 }
 # OpenMPI's launchers: their PMIx server and every rank's MPI_Init talk over loopback TCP.
 MPI_LAUNCHERS = ("mpirun", "mpiexec")
