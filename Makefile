@@ -196,11 +196,19 @@ $(BUILD)/precision_tests_double: $(DOUBLE_BUILD)/tests/precision/test_double.o \
                                  $(DOUBLE_BUILD)/tests/unit/test_t_junctions.o $(DOUBLE_LIB_OBJ)
 	$(CXX) $(CXXFLAGS) $^ -o $@ -lgtest -lgtest_main -pthread
 
-test-unit: $(BUILD)/unit_tests
+# The test targets build on every core (PARALLEL) unless make already runs jobs in parallel
+# (make -jN test); pytest gets no jobserver to inherit, which the makes its tests run could not
+# reach (Python closes the descriptors) and would warn about.
+JOBS     := $(shell nproc 2>/dev/null || echo 1)
+PARALLEL  = $(if $(findstring jobserver,$(MAKEFLAGS)),,-j$(JOBS))
+test-unit:
+	@$(MAKE) --no-print-directory $(PARALLEL) $(BUILD)/unit_tests
 	$(BUILD)/unit_tests --gtest_brief=1
 
-test-labs: labs
-	$(PYTHON) -m pytest -q tests
+test-labs:
+	@$(MAKE) --no-print-directory $(PARALLEL) labs
+	@echo "$(PYTHON) -m pytest -q tests"
+	@MAKEFLAGS='$(filter-out -j% --jobserver%,$(MAKEFLAGS))' $(PYTHON) -m pytest -q tests
 
 # The quick tier, beside the full make test: the style, the unit tests and the pytest files
 # that run in seconds and build at most lab 01 (the registry, the layout of the kit, the

@@ -13,7 +13,7 @@ say() { echo "make render: $*"; }
 try() {  # try TARGET DESCRIPTION: build and run it; non-zero if either fails
     local target=$1 what=$2
     say "using $target ($what)"
-    "$MAKE" --no-print-directory -s "$target" >/dev/null || { say "$target did not build"; return 1; }
+    "$MAKE" --no-print-directory -s -j"$(nproc)" "$target" >/dev/null || { say "$target did not build"; return 1; }
     "./$target" --out "$out"
 }
 
