@@ -32,6 +32,11 @@ def check_bitwise_equal(binary, baseline, *, runs=None) -> CheckResult:
                            + why_different(binary, settings, runs, images, differing, want))
 
 
+# The race probe's renders (why_different): how many at each count, and how much larger.
+RACE_RUNS = 4
+RACE_SCALE = 3
+
+
 def row_ranges(rows: list[int]) -> str:
     """[0, 1, 2, 7, 9, 10] -> "0-2, 7, 9-10"."""
     spans: list[list[int]] = []
@@ -51,26 +56,31 @@ def why_different(binary, settings: dict, runs: dict, images: dict, differing: l
                   want: np.ndarray | None = None) -> str:
     """Tells the causes of other bits apart. Identified first: rows exactly black where lab
     01's image (`want`) is not, rows never rendered or never gathered (lab 04's skeleton),
-    which would otherwise read as a work split below. Then, by rendering twice more each way
-    that differed, the most threads or ranks first: renders that change from run to run at one
-    count (a data race, a generator shared by threads), or the same image every time that
+    which would otherwise read as a work split below. Then, by rendering RACE_RUNS times each
+    way that differed, the most threads or ranks first: renders that change from run to run at
+    one count (a data race, a generator shared by threads), or the same image every time that
     depends on the count (random numbers drawn by thread, rank or chunk instead of by pixel:
     how the work is split). A race need not show in every run, so every differing count is
-    tried before an image is called deterministic."""
+    tried before an image is called deterministic, on a render RACE_SCALE times larger a side:
+    at the check's size each thread's share takes well under a time slice, and on a busy
+    machine the threads then run one after another, which hides a shared generator."""
     if want is not None:
         for label in differing:
             black = symptoms.black_rows(images[label], want)
             if black:
                 return f"at {label}, {black}"
+    larger = dict(settings, width=settings["width"] * RACE_SCALE,
+                  height=settings["height"] * RACE_SCALE)
     for label in reversed(differing):
-        first = images[label]
-        again = [run_lab(binary, **settings, **runs[label]).image for _ in range(2)]
+        first, *again = [run_lab(binary, **larger, **runs[label]).image
+                         for _ in range(RACE_RUNS)]
         rows = sorted({y for image in again for y in rows_differing(first, image)})
         if rows:
             return (f"nondeterministic: a data race or shared generator: renders at {label} "
                     f"differ from each other in {len(rows)} of {first.shape[0]} rows (rows "
-                    f"{row_ranges(rows)}); each pixel's random numbers must depend on the "
-                    f"pixel alone, and each pixel be written by one thread")
+                    f"{row_ranges(rows)}, at {larger['width']}x{larger['height']}); each "
+                    f"pixel's random numbers must depend on the pixel alone, and each pixel be "
+                    f"written by one thread")
     same = [label for label in runs if label not in differing]
     if not same:  # even the first way (1 thread, 1 rank) is not lab 01's image
         return (f"deterministic but different from lab 01 even at {differing[0]}: the same "

@@ -15,13 +15,13 @@ $(eval $(call cuda_lab,lab05,05-cuda-mega,,megakernel.cuh))
 define lab05_variant_object
 $(LAB05_BUILD)/$(1)/$(basename $(notdir $(2))).o: $(2)
 	@mkdir -p $$(dir $$@)
-	$$(NVCC) $$(NVCCFLAGS) $$(CUDA_ARCH) $(3) -I$(LAB05)/solution $$(GPU_BENCH_INCLUDES) \
-	    $$(CUDA_INCLUDES) $$(INCLUDES) -MMD -MP -MF $$(@:.o=.d) -c $$< -o $$@
+	$$(NVCC) $$(NVCCFLAGS) $$(CUDA_ARCH) $(3) -I$(LAB05)/solution $$(CUDA_INCLUDES) \
+	    $$(INCLUDES) -MMD -MP -MF $$(@:.o=.d) -c $$< -o $$@
 endef
 $(eval $(call lab05_variant_object,fast-math,$(LAB05)/solution/render.cu,--use_fast_math))
 $(eval $(call lab05_variant_object,no-fma,$(LAB05)/solution/render.cu,--fmad=false))
 $(eval $(call lab05_variant_object,double,$(LAB05)/solution/render.cu,-DRT_DOUBLE))
-$(eval $(call lab05_variant_object,fast-math,$(LAB05)/bench.cu,--use_fast_math))
+$(eval $(call lab05_variant_object,fast-math,$(LAB05)/bench.cu,--use_fast_math $(GPU_BENCH_INCLUDES)))
 lab05-ref-fast-math: $(LAB05_BUILD)/fast-math/render.o $(COMMON_OBJ)
 	$(NVCC) $(CUDA_ARCH) $^ $(INTO_TARGET)
 lab05-ref-no-fma: $(LAB05_BUILD)/no-fma/render.o $(COMMON_OBJ)

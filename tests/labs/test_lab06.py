@@ -168,7 +168,8 @@ def make_commands(*targets):
 @pytest.mark.parametrize("folder", sorted(CUDA_LABS))
 def test_no_lab_reads_another_labs_folder(nvcc, folder):
     """Every CUDA target of a lab compiles sources of its own folder or of common/ only, with
-    no other lab's folder on the include path: what labs share lives in common/."""
+    no other lab's folder on the include path: what labs share lives in common/ (and what
+    their benchmarks share in bench/gpu/, on the benchmarks' include path alone)."""
     stem = CUDA_LABS[folder]
     targets = [stem, stem + "-ref", stem + "-bench"]
     others = [f for f in CUDA_LABS if f != folder]
@@ -180,7 +181,8 @@ def test_no_lab_reads_another_labs_folder(nvcc, folder):
         assert source.startswith((f"labs/{folder}/", "common/")), command
         includes = [w[2:] for w in words if w.startswith("-I")]
         assert not [i for i in includes if any(o in i for o in others)], command
-        assert all(i.startswith((f"labs/{folder}", "common/")) for i in includes), command
+        bench = ("bench/gpu",) if source == f"labs/{folder}/bench.cu" else ()
+        assert all(i.startswith((f"labs/{folder}", "common/", *bench)) for i in includes), command
 
 
 @pytest.mark.parametrize("folder", sorted(CUDA_LABS))
