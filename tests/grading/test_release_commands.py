@@ -24,8 +24,10 @@ from __future__ import annotations
 import os
 import pathlib
 import re
+import shlex
 import shutil
 import subprocess
+import time
 
 import pytest
 
@@ -61,6 +63,8 @@ REDUCED = {
     "python3 -m tools.bench.simd": "python3 -m tools.bench.simd --size 32 --spp 8 --repeat 1",
     "python3 -m tools.bench.simd --full --only lab02-ref-avx2":
         "python3 -m tools.bench.simd --size 32 --spp 8 --repeat 1 --only lab02-ref-avx2",
+    "python3 -m tools.bench.simd --cpu-time":
+        "python3 -m tools.bench.simd --cpu-time --size 32 --spp 8 --repeat 1",
     "python3 -m tools.bench.simd --packets":
         "python3 -m tools.bench.simd --packets --size 32 --spp 8 --repeat 1",
     "python3 -m tools.bench.simd --full --only lab02":
@@ -140,7 +144,17 @@ def planned(command: str) -> tuple[str | None, str]:
     if "\n" not in command and LAB_BINARY.match(command) and not re.search(r"[;&|]", command) \
             and not ("--width" in command and "--spp" in command):
         return f"{command} {SMALL}", f"run with {SMALL}"
+    if is_build(command):
+        return f"make -j{os.cpu_count() or 1} {command[5:]}", "built on every core"
     return command, "run as written"
+
+
+def is_build(command: str) -> bool:
+    """`make` of lab binaries alone (and variables): what -jN changes only the speed of."""
+    words = shlex.split(command) if "\n" not in command else []
+    targets = set(registry.all_targets())
+    return (len(words) > 1 and words[0] == "make" and not any(w.startswith("-") for w in words)
+            and all(w in targets or re.fullmatch(r"[A-Z_]+=.*", w) for w in words[1:]))
 
 
 def finish_lab(release: pathlib.Path, lab: str) -> None:
@@ -194,9 +208,10 @@ def test_every_command_of_readme_and_handout_runs(finished):
         if actual is None:
             done.append(f"{how}: {command}")
             continue
+        start = time.monotonic()
         p = run(release, actual)
         expected = EXPECTED_STATUS.get(command, 0)
-        done.append(f"{how}, exit {p.returncode}: {command}")
+        done.append(f"{how}, exit {p.returncode}, {time.monotonic() - start:.0f} s: {command}")
         if p.returncode != expected:
             failed.append(f"{command}\n  ({how}) exit {p.returncode}, expected {expected}: "
                           f"{(p.stdout + p.stderr).strip()[-1500:]}")
