@@ -57,12 +57,12 @@ def record(cause: str) -> None:
         found.append(cause)
 
 
-# Who renders which rows, by how the lab's work is split (its rubric in labs/labs.toml).
+# Who renders which rows, by how the lab's work is split: a GPU lab's grid, else its rubric in
+# labs/labs.toml.
+_GPU_SPLIT = "a grid that does not cover the image, or blocks that return early?"
 _SPLIT_BY_RUBRIC = {
     "openmp": "the remainder of rows divided among threads?",
     "mpi": "the remainder of rows divided among ranks, or rows never gathered?",
-    "gpu": "a grid that does not cover the image, or blocks that return early?",
-    "gpu-soa": "a grid that does not cover the image, or blocks that return early?",
 }
 
 
@@ -77,6 +77,8 @@ def _where_work_is_split() -> str:
     lab = _graded_lab()
     if lab is None:  # a check run outside a grade: every lab's cause
         return "a loop bound that stops short, or the remainder of rows divided among ranks?"
+    if lab.gpu:
+        return _GPU_SPLIT
     return _SPLIT_BY_RUBRIC.get(lab.rubric, "a loop bound that stops short?")
 
 

@@ -39,8 +39,8 @@ def test_an_mpi_type_mismatch_is_named_with_a_command_to_rerun(tmp_path):
     mutant = build_variant("04-mpi", tmp_path,
                            {"render.cpp": source.replace(old, old.replace(", 2,", ", 1,"))})
     # Inside the sandbox OpenMPI sometimes fails to print its own error ("ORTE_ERROR_LOG: Out
-    # of resource in file ... show_help.c": about one run in three on a 2-core VM), and then
-    # there is no MPI error to name: up to three runs, the first whose text came through.
+    # of resource in file ... show_help.c"), and then there is no MPI error to name: up to
+    # three runs, the first whose text came through.
     for _ in range(3):
         with policy(UNTRUSTED), rerun_as("./lab04"), pytest.raises(RunError) as failed:
             run_lab(mutant, scene=ROOT / "common/scenes/cornell.json", width=16, height=12,
