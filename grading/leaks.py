@@ -15,13 +15,18 @@ A release for lab NN leaks when it holds
 - an executable outside reference-bin/ (a binary built from solution sources, committed by
   accident);
 - the hidden scene's secret (GRADING_SECRET, grading/hidden.py), anywhere, in any file, or
-  the scene made from it, as a scene file (what a saved copy of it would be).
+  the scene made from it, as a scene file (what a saved copy of it would be);
+- in its git repository (.git/), anything but one commit of the files as they are: the objects
+  there are compressed, so they are not read byte by byte (compressed data holds a marker's
+  bytes now and then by chance); git says instead whether every object it holds is the one
+  commit, its trees and the files checked above.
 """
 from __future__ import annotations
 
 import fnmatch
 import json
 import pathlib
+import subprocess
 
 from grading import hidden
 from labkit import (  # skeletons: the one definition of the markers and of SHARED_SOURCES
@@ -73,6 +78,33 @@ def parsed_json(data: bytes):
         return None
 
 
+def git_output(release: pathlib.Path, *args: str) -> str:
+    return subprocess.run(["git", "-c", f"safe.directory={release}", "-C", str(release), *args],
+                          capture_output=True, text=True, check=True).stdout
+
+
+def git_problems(release: pathlib.Path) -> list[str]:
+    """Why the release's repository holds more than one commit of its files, one line each."""
+    if not (release / ".git").exists():
+        return []
+    try:
+        commits = git_output(release, "rev-list", "--all").split()
+        if len(commits) != 1:
+            return [f".git: {len(commits)} commits (a release is one commit of its files)"]
+        changed = git_output(release, "diff", "--name-only", "--no-renames", "HEAD").split("\n")
+        problems = [f"{name}: the release's commit holds another version of it"
+                    for name in changed if name]
+        reachable = len(git_output(release, "rev-list", "--objects", "--all").splitlines())
+        counts = dict(line.split(": ") for line in
+                      git_output(release, "count-objects", "-v").splitlines())
+        stored = int(counts["count"]) + int(counts["in-pack"])
+        if stored != reachable:
+            problems.append(f".git: {stored - reachable} objects beyond the release's commit")
+        return problems
+    except (OSError, subprocess.CalledProcessError, KeyError, ValueError) as e:
+        return [f".git: not a repository git can read ({e})"]
+
+
 def leaks(release: pathlib.Path, lab: str, folders: dict[str, str],
           secret: str | None = None) -> list[str]:
     """Every reason `release` (a folder) may not be handed to students of lab `lab`, one line
@@ -85,8 +117,11 @@ def leaks(release: pathlib.Path, lab: str, folders: dict[str, str],
                             f"later ship as skeletons)")
     secret_bytes = secret.encode() if secret else None
     secret_scene = hidden.hidden_scene(secret) if secret else None
+    problems += git_problems(release)
     for path in sorted(p for p in release.rglob("*") if p.is_file() or p.is_symlink()):
         rel = path.relative_to(release).as_posix()
+        if rel.startswith(".git/"):
+            continue
         if path.is_symlink():
             problems.append(f"{rel}: a symbolic link (it could point at anything)")
             continue

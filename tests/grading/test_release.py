@@ -331,6 +331,28 @@ def test_leak_check_finds_a_planted_leak(tmp_path, pristine01, plant):
     assert any(expected in line for line in problems), problems
 
 
+GIT_PLANTS = {
+    "an object no commit reaches": (["hash-object", "-w", "labs/03-openmp/solution/render.cpp"],
+                                    "objects beyond the release's commit"),
+    "a second commit": (["commit", "-q", "--allow-empty", "-m", "more"], "2 commits"),
+}
+
+
+@pytest.mark.parametrize("plant", GIT_PLANTS)
+def test_leak_check_reads_the_releases_repository_through_git(tmp_path, pristine01, plant):
+    """The release's .git is compressed, so its bytes are not searched (by chance they hold a
+    marker now and then); what git holds must be the one commit of the files checked."""
+    release = tmp_path / "release"
+    shutil.copytree(pristine01, release, symlinks=True)
+    args, expected = GIT_PLANTS[plant]
+    if "hash-object" in args:
+        args = [*args[:-1], str(ROOT / args[-1])]
+    subprocess.run(["git", "-c", "user.name=x", "-c", "user.email=x@x.invalid", *args],
+                   cwd=release, check=True)
+    problems = leaks.leaks(release, "01", FOLDERS)
+    assert any(expected in line for line in problems), problems
+
+
 def test_leak_check_finds_the_hidden_scene(tmp_path, pristine01):
     """The secret's scene saved among the scenes leaks the secret as surely as the secret."""
     from grading import hidden
