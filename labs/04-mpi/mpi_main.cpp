@@ -3,6 +3,7 @@
 // files, writes them and prints the summary or the error line. Not a student file.
 #include <mpi.h>
 
+#include <cstdarg>
 #include <cstdio>
 #include <cstdlib>
 
@@ -17,11 +18,38 @@ static void finalize_mpi() {
     if (!finalized) MPI_Finalize();
 }
 
+// MPI_ERRORS_ARE_FATAL, but the error is written to this rank's own stderr before the abort:
+// OpenMPI sends its own "An error occurred in MPI_Recv ... MPI_ERR_TRUNCATE" text to mpirun as
+// a message, which now and then arrives cut short when the rank aborts at once (mpirun then
+// prints only "ORTE_ERROR_LOG: ... show_help.c"), and the student is left without the cause.
+// OpenMPI passes the failing call's name after the two standard arguments.
+static void report_and_abort(MPI_Comm* comm, int* code, ...) {
+    char text[MPI_MAX_ERROR_STRING] = "";
+    int length = 0;
+    MPI_Error_string(*code, text, &length);
+    const char* call = "an MPI call";
+#ifdef OPEN_MPI
+    va_list more;
+    va_start(more, code);
+    const char* name = va_arg(more, const char*);
+    va_end(more);
+    if (name != nullptr) call = name;
+#endif
+    int rank = -1;
+    MPI_Comm_rank(MPI_COMM_WORLD, &rank);
+    std::fprintf(stderr, "rank %d: An error occurred in %s: %s\n", rank, call, text);
+    std::fflush(stderr);
+    MPI_Abort(*comm, *code);
+}
+
 int main(int argc, char** argv) {
     // FUNNELED: OpenMP threads render inside a rank, but only the main thread calls MPI.
     int provided = 0;
     MPI_Init_thread(&argc, &argv, MPI_THREAD_FUNNELED, &provided);
     std::atexit(finalize_mpi);
+    MPI_Errhandler fatal_with_cause;
+    MPI_Comm_create_errhandler(report_and_abort, &fatal_with_cause);
+    MPI_Comm_set_errhandler(MPI_COMM_WORLD, fatal_with_cause);
     int rank = 0;
     MPI_Comm_rank(MPI_COMM_WORLD, &rank);
     // Rank 0 speaks for everyone; the driver keeps the others quiet, and this keeps `--help`

@@ -38,18 +38,15 @@ def test_an_mpi_type_mismatch_is_named_with_a_command_to_rerun(tmp_path):
     assert old in source
     mutant = build_variant("04-mpi", tmp_path,
                            {"render.cpp": source.replace(old, old.replace(", 2,", ", 1,"))})
-    # Inside the sandbox OpenMPI sometimes fails to print its own error ("ORTE_ERROR_LOG: Out
-    # of resource in file ... show_help.c"), and then there is no MPI error to name: up to
-    # three runs, the first whose text came through.
-    for _ in range(3):
-        with policy(UNTRUSTED), rerun_as("./lab04"), pytest.raises(RunError) as failed:
-            run_lab(mutant, scene=ROOT / "common/scenes/cornell.json", width=16, height=12,
-                    spp=2, launcher=checks.mpirun(2))
-        message = str(failed.value)
-        if "show_help.c" not in message:
-            break
+    # OpenMPI's own report of the error reaches mpirun cut short now and then when the rank
+    # aborts at once (most often on a busy machine); lab 04's driver writes the error to the
+    # rank's stderr first (mpi_main.cpp), so it is named every time, in one run.
+    with policy(UNTRUSTED), rerun_as("./lab04"), pytest.raises(RunError) as failed:
+        run_lab(mutant, scene=ROOT / "common/scenes/cornell.json", width=16, height=12,
+                spp=2, launcher=checks.mpirun(2))
+    message = str(failed.value)
     assert "MPI_ERR_TRUNCATE" in message.split("; rerun: ")[0], message  # named first
-    assert "An error occurred in MPI_Recv" in message  # mpirun's own text reaches the student
+    assert "An error occurred in MPI_Recv" in message  # the rank's own words reach the student
     words = rerun_words(message)
     assert words[:1] == ["mpirun"] and "./lab04" in words, message
     scene = words[words.index("--scene") + 1]
