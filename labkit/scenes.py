@@ -167,44 +167,56 @@ def glass_slab_radiance(scene: dict, bounces: int, angle_deg: float = 0.0) -> fl
     return value
 
 
+# How each list of primitives in a scene file is written: what each field of an entry is (a
+# point, a list of points, a length or a unit direction), so that a move, a rotation or a scale
+# changes it as it should. The C++ kinds declare theirs in common/core/ (primitive_kinds.h).
+PRIMITIVE_FIELDS = {
+    "spheres": {"center": "point", "radius": "length"},
+    "triangles": {"vertices": "points"},
+    "quads": {"vertices": "points"},
+}
+
+
+def _mapped(scene: dict, point, scale: float, direction=None) -> dict:
+    """A copy of `scene` with every point mapped by `point`, every length multiplied by `scale`
+    (the light's intensity by its square) and, given `direction`, every direction (the camera's
+    up included) mapped by it."""
+    s = json.loads(json.dumps(scene))
+    s["camera"]["position"] = point(s["camera"]["position"])
+    s["camera"]["look_at"] = point(s["camera"]["look_at"])
+    if direction is not None:
+        s["camera"]["up"] = direction(s["camera"].get("up", [0, 1, 0]))
+    if "light" in s:
+        s["light"]["position"] = point(s["light"]["position"])
+        if scale != 1:
+            s["light"]["intensity"] = [c * scale**2 for c in s["light"]["intensity"]]
+    for key, fields in PRIMITIVE_FIELDS.items():
+        for prim in s.get(key, []):
+            for name, what in fields.items():
+                if what == "point":
+                    prim[name] = point(prim[name])
+                elif what == "points":
+                    prim[name] = [point(v) for v in prim[name]]
+                elif what == "length" and scale != 1:
+                    prim[name] *= scale
+                elif what == "direction" and direction is not None:
+                    prim[name] = direction(prim[name])
+    return s
+
+
 def scaled(scene: dict, factor: float) -> dict:
     """The same scene with every length multiplied by `factor` and the light's intensity by
     factor^2, so that the image should not change at all."""
-    s = json.loads(json.dumps(scene))
-    mul = lambda p: [c * factor for c in p]  # noqa: E731
-    s["camera"]["position"] = mul(s["camera"]["position"])
-    s["camera"]["look_at"] = mul(s["camera"]["look_at"])
-    if "light" in s:
-        s["light"]["position"] = mul(s["light"]["position"])
-        s["light"]["intensity"] = [c * factor**2 for c in s["light"]["intensity"]]
-    for sp in s.get("spheres", []):
-        sp["center"] = mul(sp["center"])
-        sp["radius"] *= factor
-    for kind in ("triangles", "quads"):
-        for prim in s.get(kind, []):
-            prim["vertices"] = [mul(v) for v in prim["vertices"]]
-    return s
+    return _mapped(scene, lambda p: [c * factor for c in p], factor)
 
 
 def transformed(scene: dict, matrix=np.eye(3), offset=(0, 0, 0), scale=1.0) -> dict:  # noqa: B008
     """The scene rotated by `matrix`, scaled by `scale` (intensity by its square) and moved by
     `offset`, computed in double: the image should not change. scaled() and
     translated() are its two special cases as the grader's checks compute them."""
-    s = json.loads(json.dumps(scene))
     point = lambda p: [float(c) for c in scale * (matrix @ np.asarray(p, float)) + offset]  # noqa: E731
-    s["camera"]["position"] = point(s["camera"]["position"])
-    s["camera"]["look_at"] = point(s["camera"]["look_at"])
-    s["camera"]["up"] = [float(c) for c in matrix @ np.asarray(s["camera"].get("up", [0, 1, 0]))]
-    if "light" in s:
-        s["light"]["position"] = point(s["light"]["position"])
-        s["light"]["intensity"] = [c * scale**2 for c in s["light"]["intensity"]]
-    for sp in s.get("spheres", []):
-        sp["center"] = point(sp["center"])
-        sp["radius"] *= scale
-    for kind in ("triangles", "quads"):
-        for prim in s.get(kind, []):
-            prim["vertices"] = [point(v) for v in prim["vertices"]]
-    return s
+    direction = lambda d: [float(c) for c in matrix @ np.asarray(d, float)]  # noqa: E731
+    return _mapped(scene, point, scale, direction)
 
 
 def load(name: str) -> dict:
@@ -214,18 +226,7 @@ def load(name: str) -> dict:
 def translated(scene: dict, offset) -> dict:
     """The same scene moved by `offset` (camera, light and every primitive): the image should
     not change, up to float rounding at the new place."""
-    s = json.loads(json.dumps(scene))
-    add = lambda p: [c + o for c, o in zip(p, offset)]  # noqa: E731
-    s["camera"]["position"] = add(s["camera"]["position"])
-    s["camera"]["look_at"] = add(s["camera"]["look_at"])
-    if "light" in s:
-        s["light"]["position"] = add(s["light"]["position"])
-    for sp in s.get("spheres", []):
-        sp["center"] = add(sp["center"])
-    for kind in ("triangles", "quads"):
-        for prim in s.get(kind, []):
-            prim["vertices"] = [add(v) for v in prim["vertices"]]
-    return s
+    return _mapped(scene, lambda p: [c + o for c, o in zip(p, offset)], 1)
 
 
 # The view of floor_view: a camera 1 above the floor y = 0 looking down at 14 degrees, the

@@ -14,6 +14,7 @@ struct alignas(16) AxisRect {
     // What the scene report calls this kind: one of them (plural: +"s"), its --json key.
     static constexpr const char* kName = "rectangle";
     static constexpr const char* kReportKey = "rects";
+    static constexpr bool kShearsRay = false;  // its test takes no RayShear
 
     real plane;       // the coordinate on `axis` of every point
     real lo_u, lo_v;  // the lower bounds on axes u and v
@@ -221,3 +222,15 @@ RT_HD inline bool rect_blocks(const Ray& ray, const AxisRect& r, real t_max) {
     }
     return rect_blocks_on_axis<kConverged>(ray, r, t_max, a);
 }
+
+// The kind's hooks (primitive_kinds.h); step_off_edges is above.
+template <bool kConverged = kConvergedTests>
+RT_HD inline real intersect(const Ray& ray, const AxisRect& r, real t_max) {
+    return intersect_rect<kConverged>(ray, r, t_max);
+}
+template <bool kConverged = kConvergedTests>
+RT_HD inline bool occludes(const Ray& ray, const AxisRect& r, real t_max) {
+    return rect_blocks<kConverged>(ray, r, t_max);
+}
+RT_HD inline Vec3 normal_at(const AxisRect& r, Vec3) { return rect_normal(r); }
+RT_HD inline real surface_extent(const AxisRect& r) { return r.extent; }

@@ -16,6 +16,7 @@ struct alignas(16) ConvexQuad {
     // What the scene report calls this kind: one of them (plural: +"s"), its --json key.
     static constexpr const char* kName = "convex quad";
     static constexpr const char* kReportKey = "quads";
+    static constexpr bool kShearsRay = true;  // its test takes the ray's RayShear
 
     Vec3 normal;        // unit normal of the fitted plane; the front side as a triangle's
     real plane_offset;  // the plane is dot(normal, p) == plane_offset
@@ -159,3 +160,17 @@ RT_HD inline real intersect_quad(const Ray& ray, const RayShear& shear, const Co
     const bool hit = !(culled | outside) & (t > 0.0f) & (t < t_max);  // NaN fails too
     return hit ? t : t_max;
 }
+
+// The kind's hooks (primitive_kinds.h); step_off_edges is above.
+template <bool kConverged = kConvergedTests>
+RT_HD inline real intersect(const Ray& ray, const RayShear& shear, const ConvexQuad& quad,
+                            real t_max) {
+    return intersect_quad<kConverged>(ray, shear, quad, t_max);
+}
+template <bool kConverged = kConvergedTests>
+RT_HD inline bool occludes(const Ray& ray, const RayShear& shear, const ConvexQuad& quad,
+                           real t_max) {
+    return intersect_quad<kConverged>(ray, shear, quad, t_max) < t_max;
+}
+RT_HD inline Vec3 normal_at(const ConvexQuad& quad, Vec3) { return quad.normal; }
+RT_HD inline real surface_extent(const ConvexQuad& quad) { return quad.extent; }

@@ -29,10 +29,53 @@ constexpr PrimitiveKind primitive_kind = PrimitiveKindOf<K>::value;
 using AnyGeometry = AllPrimitives;             // every scene: the default
 using BoxGeometry = Kinds<Sphere, AxisRect>;   // spheres and rectangles (Cornell)
 
-// Whether a set holds a kind whose test shears the ray (RayShear, triangle.h): the loops
-// build the shear once per ray for all of them.
+// Whether a set holds a kind whose test shears the ray (K::kShearsRay; RayShear, triangle.h).
+template <class... K>
+constexpr int first_shearing_index(Kinds<K...>) {
+    const bool shears[] = {K::kShearsRay..., false};
+    for (int i = 0; i < static_cast<int>(sizeof...(K)); ++i)
+        if (shears[i]) return i;
+    return -1;
+}
 template <class Set>
-constexpr bool needs_shear = has_kind<Set, Triangle> || has_kind<Set, ConvexQuad>;
+constexpr int first_shearing = first_shearing_index(Set{});  // -1: none
+template <class Set>
+constexpr bool needs_shear = first_shearing<Set> >= 0;
+
+// Whether the scene has primitives of a kind of Set whose test shears the ray: only then is
+// the shear built (a scene of spheres and rectangles pays nothing for it).
+template <class Set>
+RT_HD inline bool has_sheared_primitives(const SceneView& scene) {
+    bool any = false;
+    for_each_kind(Set{}, [&](auto kind) {
+        using K = typename decltype(kind)::type;
+        if constexpr (K::kShearsRay) any = any || scene.of<K>().count > 0;
+    });
+    return any;
+}
+
+// Calls visit(KindTag<K>{}) for every kind K of Set, in the list's order but that the kinds
+// whose test shears the ray are visited together, at the first of them, as
+// visit(KindTag<K>{}, shear) with one RayShear of the ray, built only when the scene has
+// primitives of such a kind. The shear is alive only while those kinds are tested: on a GPU
+// its registers would otherwise be held through every other kind's loop.
+template <class Set, class Visit>
+RT_HD RT_FORCE_INLINE void for_each_kind_with_shear(const SceneView& scene, const Ray& ray,
+                                                    Visit&& visit) {
+    for_each_kind(Set{}, [&](auto kind) {
+        using K = typename decltype(kind)::type;
+        if constexpr (!K::kShearsRay) {
+            visit(kind);
+        } else if constexpr (kind_index<Set, K> == first_shearing<Set>) {
+            if (has_sheared_primitives<Set>(scene)) {
+                const RayShear shear(ray.direction);
+                for_each_kind(Set{}, [&](auto sheared) {
+                    if constexpr (decltype(sheared)::type::kShearsRay) visit(sheared, shear);
+                });
+            }
+        }
+    });
+}
 
 // The kinds of primitive a scene holds (has_specular_material's twin): one flag per kind of
 // AllPrimitives, in its order.

@@ -44,6 +44,28 @@ struct Position<Kinds<First, Rest...>, K> {
     static constexpr int value = Same<First, K>::value ? 0 : (rest < 0 ? -1 : rest + 1);
 };
 
+template <bool kFirst, class A, class B>
+struct Conditional {
+    using type = A;
+};
+template <class A, class B>
+struct Conditional<false, A, B> {
+    using type = B;
+};
+
+template <class Set, class K, class Kept = Kinds<>>
+struct Without;
+template <class K, class... Kept>
+struct Without<Kinds<>, K, Kinds<Kept...>> {
+    using type = Kinds<Kept...>;
+};
+template <class First, class... Rest, class K, class... Kept>
+struct Without<Kinds<First, Rest...>, K, Kinds<Kept...>> {
+    using type = typename Without<Kinds<Rest...>, K,
+                                  typename Conditional<Same<First, K>::value, Kinds<Kept...>,
+                                                       Kinds<Kept..., First>>::type>::type;
+};
+
 template <class Sub, class Set>
 struct Within;
 template <class... K, class Set>
@@ -52,6 +74,10 @@ struct Within<Kinds<K...>, Set> {
 };
 
 }  // namespace kinds_detail
+
+// Set without the kind K, in Set's order.
+template <class Set, class K>
+using without_kind = typename kinds_detail::Without<Set, K>::type;
 
 // K's position in Set, -1 when Set does not hold it.
 template <class Set, class K>

@@ -1,32 +1,64 @@
-// The three materials and how each turns an incoming direction into an outgoing one.
+// The material kinds and how each turns an incoming direction into an outgoing one.
 #pragma once
 
 #include <cmath>
 
 #include <kinds.h>
+#include <ray.h>
 #include <real.h>
+#include <rng.h>
 #include <vec3.h>
+
+// A material's kind: its position in AllMaterials (material_type<Glass> is 2).
+enum class MaterialType : int {};
+
+struct Material {
+    MaterialType type;  // which BSDF: material_type<K> for a kind K of AllMaterials
+    Vec3 albedo;        // diffuse reflectance or mirror tint (unused by glass)
+    real ior;           // index of refraction inside glass (unused otherwise)
+};
+
+// A number a material kind reads from its entry in a scene file (host/scene_loader.cpp): its
+// key, the field of Material it sets and the closed range it must lie in. A null key: none.
+using MaterialField = real Material::*;
+struct MaterialNumber {
+    const char* key = nullptr;
+    MaterialField field = nullptr;
+    double lo = 0, hi = 0;
+    const char* what = nullptr;  // what the error calls it: "an index of refraction"
+};
 
 // The material kinds, declared here once: AllMaterials lists them, a material's type is its
 // kind's position in the list, and every set a renderer is compiled for names its kinds
-// (material_set.h). kName: what the scene report calls one; kReportKey: its --json key.
+// (material_set.h). A kind has
+//   kName          its "type" in a scene file and what the scene report calls one;
+//   kReportKey     its --json key;
+//   kAlbedo        whether its entry has an "albedo" (in [0, 1] per channel);
+//   kNumber        the one number more its entry has, if any (MaterialNumber);
+// and, but for Diffuse (the kind that samples the light: path_tracer.h's bounce step), a hook
+//   scatter(K{}, material, SpecularHit, rng, bounce, throughput, next)
+// that continues the path: the next ray and the throughput's weight (below).
 struct Diffuse {  // Lambertian: albedo / pi
     static constexpr const char* kName = "diffuse";
     static constexpr const char* kReportKey = "diffuse";
+    static constexpr bool kAlbedo = true;
+    static constexpr MaterialNumber kNumber{};
 };
 struct Mirror {  // perfect specular reflection, tinted by the albedo
     static constexpr const char* kName = "mirror";
     static constexpr const char* kReportKey = "mirrors";
+    static constexpr bool kAlbedo = true;
+    static constexpr MaterialNumber kNumber{};
 };
 struct Glass {  // smooth dielectric: Fresnel reflection or refraction by the ior
     static constexpr const char* kName = "glass";
     static constexpr const char* kReportKey = "glass";
+    static constexpr bool kAlbedo = false;
+    static constexpr MaterialNumber kNumber{"ior", &Material::ior, 1.0, 5.0,
+                                            "an index of refraction"};
 };
 
 using AllMaterials = Kinds<Diffuse, Mirror, Glass>;
-
-// A material's kind: its position in AllMaterials (material_type<Glass> is 2).
-enum class MaterialType : int {};
 
 template <class K>
 struct MaterialTypeOf {
@@ -35,12 +67,6 @@ struct MaterialTypeOf {
 };
 template <class K>
 constexpr MaterialType material_type = MaterialTypeOf<K>::value;
-
-struct Material {
-    MaterialType type;  // which BSDF: material_type<K> for a kind K of AllMaterials
-    Vec3 albedo;        // diffuse reflectance or mirror tint (unused by glass)
-    real ior;           // index of refraction inside glass (unused otherwise)
-};
 
 constexpr real kPi = real(3.14159265358979323846);
 
@@ -107,4 +133,56 @@ RT_HD inline real fresnel_dielectric(real cos_i, real eta, real& cos_t) {
 RT_HD inline Vec3 refract(Vec3 d, Vec3 n, real eta, real cos_t) {
     const real cos_i = -dot(d, n);
     return normalize(d * eta + n * (eta * cos_i - cos_t));
+}
+
+// What a kind's scatter hook reads of a specular hit (path_tracer.h's bounce step fills it in).
+struct SpecularHit {
+    Vec3 incoming;  // the ray's unit direction
+    Vec3 facing;  // the unit geometric normal on the ray's side
+    bool entering;  // whether the ray meets the outward (front) side
+    Vec3 above;  // the next ray's origin on the ray's side (offset_ray_origin, ray.h)
+    Vec3 off_edges;  // the step off the primitive's edges every next origin adds
+    Vec3 position;  // the hit point, its distance along the ray and the primitive's extent:
+    real t;  // what an origin on the other side is offset by
+    real extent;
+};
+
+// The mirror: the reflected direction, renormalised (unnormalised, its length drifts by ~1e-7
+// a bounce; the sphere test assumes a unit direction, and after ~10 bounces its hits overshoot
+// the ray offset: the paths escaped a closed mirror sphere).
+template <class Rng>
+RT_HD RT_FORCE_INLINE void scatter(Mirror, const Material& material, const SpecularHit& hit,
+                                   const Rng&, int, Vec3& throughput, Ray& next) {
+    throughput *= material.albedo;
+    next = {hit.above + hit.off_edges, normalize(reflect(hit.incoming, hit.facing))};
+}
+
+// Glass: reflect or refract, chosen with the Fresnel reflectance. refract() normalises.
+template <class Rng>
+RT_HD RT_FORCE_INLINE void scatter(Glass, const Material& material, const SpecularHit& hit,
+                                   const Rng& rng, int bounce, Vec3&, Ray& next) {
+    const real eta = hit.entering ? real(1) / material.ior : material.ior;
+    real cos_t;
+    const real reflectance = fresnel_dielectric(-dot(hit.incoming, hit.facing), eta, cos_t);
+    if (rng.at(bounce_dimension(bounce, 0)) < reflectance) {
+        next = {hit.above + hit.off_edges, normalize(reflect(hit.incoming, hit.facing))};
+    } else {
+        const Vec3 below = offset_ray_origin(hit.position, -hit.facing, hit.t, hit.extent);
+        next = {below + hit.off_edges, refract(hit.incoming, hit.facing, eta, cos_t)};
+    }
+}
+
+// The scatter hook of the material's kind among Kinds<K, Rest...>: an if-chain
+// over the kinds, the last taken without a test.
+template <class Rng, class K, class... Rest>
+RT_HD RT_FORCE_INLINE void scatter_of(const Material& material, const SpecularHit& hit,
+                                      const Rng& rng, int bounce, Vec3& throughput, Ray& next,
+                                      Kinds<K, Rest...>) {
+    if constexpr (sizeof...(Rest) > 0) {
+        if (material.type == material_type<K>)
+            scatter(K{}, material, hit, rng, bounce, throughput, next);
+        else scatter_of(material, hit, rng, bounce, throughput, next, Kinds<Rest...>{});
+    } else {
+        scatter(K{}, material, hit, rng, bounce, throughput, next);
+    }
 }

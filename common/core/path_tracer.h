@@ -44,6 +44,18 @@ struct SurfacePoint {
     int material;   // index into the material table
 };
 
+// The surface of a hit on a kind of Kinds<K, Rest...>: an if-chain over the kinds, the last
+// taken without a test (a hit names a kind of the set).
+template <class K, class... Rest>
+RT_HD inline SurfacePoint surface_of(const SceneView& scene, Vec3 p, const Hit& hit,
+                                     Kinds<K, Rest...>) {
+    if constexpr (sizeof...(Rest) > 0) {
+        if (hit.kind != primitive_kind<K>) return surface_of(scene, p, hit, Kinds<Rest...>{});
+    }
+    const K& item = scene.of<K>()[hit.index];
+    return {p, normal_at(item, p), surface_extent(item), item.material};
+}
+
 // The position is ray.at(t), not re-projected onto the primitive (pbrt re-projects sphere hits,
 // p = c + r * normalize(p - c)): p - c already rounds to the spacing of floats at |c| + r, the
 // error the offset's extent term covers, and measured on sphere floors of radius 1e3..1e6 the
@@ -51,62 +63,29 @@ struct SurfacePoint {
 // kinds that can have been hit.
 template <class Primitives = AnyGeometry>
 RT_HD inline SurfacePoint surface_at(const SceneView& scene, const Ray& ray, const Hit& hit) {
-    const Vec3 p = ray.at(hit.t);
-    if (has_kind<Primitives, Sphere> && hit.kind == primitive_kind<Sphere>) {
-        const Sphere& s = scene.of<Sphere>()[hit.index];
-        return {p, normalize(p - s.center), sphere_extent(s), s.material};
-    }
-    if (has_kind<Primitives, AxisRect> && hit.kind == primitive_kind<AxisRect>) {
-        const AxisRect& r = scene.of<AxisRect>()[hit.index];
-        return {p, rect_normal(r), r.extent, r.material};
-    }
-    if (has_kind<Primitives, ConvexQuad> && hit.kind == primitive_kind<ConvexQuad>) {
-        const ConvexQuad& q = scene.of<ConvexQuad>()[hit.index];
-        return {p, q.normal, q.extent, q.material};
-    }
-    const Triangle& tri = scene.of<Triangle>()[hit.index];
-    return {p, tri.normal, tri.extent, tri.material};
+    return surface_of(scene, ray.at(hit.t), hit, Primitives{});
 }
 
 // Closest hit by brute force over every primitive: the scenes of this course are small.
-// Primitives (geometry_set.h) is the set of kinds compiled in; each loop keeps the nearest hit
-// with a select, no branch out of the loop, so a GPU warp stays converged.
+// Primitives (geometry_set.h) is the set of kinds compiled in, each visited with its
+// intersect() (primitive_kinds.h) in the order for_each_kind_with_shear gives; each loop keeps
+// the nearest hit with a select, no branch out of the loop, so a GPU warp stays converged.
 template <class Primitives = AnyGeometry>
 RT_HD inline Hit closest_hit(const SceneView& scene, const Ray& ray) {
     Hit hit;
     // BEGIN SOLUTION
-    if constexpr (has_kind<Primitives, Sphere>) {
-        for (int i = 0; i < scene.of<Sphere>().count; ++i) {
-            const real t = intersect_sphere(ray, scene.of<Sphere>()[i], hit.t);
-            if (t < hit.t) hit = {t, primitive_kind<Sphere>, i};
+    for_each_kind_with_shear<Primitives>(scene, ray, [&](auto kind, const auto&... shear) {
+        using K = typename decltype(kind)::type;
+        for (int i = 0; i < scene.of<K>().count; ++i) {
+            const real t = intersect(ray, shear..., scene.of<K>()[i], hit.t);
+            if (t < hit.t) hit = {t, primitive_kind<K>, i};
         }
-    }
-    if constexpr (needs_shear<Primitives>) {
-        // The same for every ray.
-        if (scene.of<Triangle>().count > 0 || scene.of<ConvexQuad>().count > 0) {
-            const RayShear shear(ray.direction);
-            for (int i = 0; has_kind<Primitives, Triangle> && i < scene.of<Triangle>().count; ++i) {
-                const real t = intersect_triangle(ray, shear, scene.of<Triangle>()[i], hit.t);
-                if (t < hit.t) hit = {t, primitive_kind<Triangle>, i};
-            }
-            for (int i = 0; has_kind<Primitives, ConvexQuad> && i < scene.of<ConvexQuad>().count;
-                 ++i) {
-                const real t = intersect_quad(ray, shear, scene.of<ConvexQuad>()[i], hit.t);
-                if (t < hit.t) hit = {t, primitive_kind<ConvexQuad>, i};
-            }
-        }
-    }
-    if constexpr (has_kind<Primitives, AxisRect>) {
-        for (int i = 0; i < scene.of<AxisRect>().count; ++i) {
-            const real t = intersect_rect(ray, scene.of<AxisRect>()[i], hit.t);
-            if (t < hit.t) hit = {t, primitive_kind<AxisRect>, i};
-        }
-    }
+    });
     // SKELETON
-    //> // TODO(lab01): this finds spheres only. Loop over the other primitives too, in this
-    //> // order, keeping the nearest hit: the triangles and the quads (build one RayShear per
-    //> // ray, then intersect_triangle and intersect_quad), then the axis-aligned rectangles
-    //> // (intersect_rect: the Cornell box's walls). Each hit records its kind and index.
+    //> // TODO(lab01): this finds spheres only. Visit every kind of Primitives
+    //> // (for_each_kind_with_shear, geometry_set.h: it hands each kind the ray's shear),
+    //> // keeping the nearest hit over each kind's array (scene.of<K>()) with the kind's
+    //> // intersect(): a hit records its kind and index.
     //> for (int i = 0; has_kind<Primitives, Sphere> && i < scene.of<Sphere>().count; ++i) {
     //>     const real t = intersect_sphere(ray, scene.of<Sphere>()[i], hit.t);
     //>     if (t < hit.t) hit = {t, primitive_kind<Sphere>, i};
@@ -123,36 +102,15 @@ RT_HD inline bool occluded(const SceneView& scene, const Ray& ray, real t_max) {
     // On a GPU every lane tests every primitive and the answer comes after the loops: an exit
     // at the first blocker would only split the warp (kConvergedTests, rt_hd.h).
     bool blocked = false;
-    if constexpr (has_kind<Primitives, Sphere>) {
-        for (int i = 0; i < scene.of<Sphere>().count; ++i) {
-            blocked |= intersect_sphere(ray, scene.of<Sphere>()[i], t_max) < t_max;
-            if (!kConvergedTests && blocked) return true;
-        }
-    }
-    if constexpr (needs_shear<Primitives>) {
-        if (scene.of<Triangle>().count > 0 || scene.of<ConvexQuad>().count > 0) {
-            const RayShear shear(ray.direction);
-            for (int i = 0; has_kind<Primitives, Triangle> && i < scene.of<Triangle>().count; ++i) {
-                blocked |= intersect_triangle(ray, shear, scene.of<Triangle>()[i], t_max) < t_max;
-                if (!kConvergedTests && blocked) return true;
-            }
-            for (int i = 0; has_kind<Primitives, ConvexQuad> && i < scene.of<ConvexQuad>().count;
-                 ++i) {
-                blocked |= intersect_quad(ray, shear, scene.of<ConvexQuad>()[i], t_max) < t_max;
-                if (!kConvergedTests && blocked) return true;
-            }
-        }
-    }
-    if constexpr (has_kind<Primitives, AxisRect>) {
-        for (int i = 0; i < scene.of<AxisRect>().count; ++i) {
-            blocked |= rect_blocks(ray, scene.of<AxisRect>()[i], t_max);
-            if (!kConvergedTests && blocked) return true;
-        }
-    }
+    for_each_kind_with_shear<Primitives>(scene, ray, [&](auto kind, const auto&... shear) {
+        using K = typename decltype(kind)::type;
+        for (int i = 0; (kConvergedTests || !blocked) && i < scene.of<K>().count; ++i)
+            blocked |= occludes(ray, shear..., scene.of<K>()[i], t_max);
+    });
     return blocked;
     // SKELETON
-    //> // TODO(lab01): return true when any primitive (sphere, triangle, quad, rectangle) lies
-    //> // on the ray before t_max.
+    //> // TODO(lab01): return true when any primitive (of every kind of Primitives, as in
+    //> // closest_hit, with the kind's occludes()) lies on the ray before t_max.
     //> (void)scene;
     //> (void)ray;
     //> (void)t_max;
@@ -160,17 +118,21 @@ RT_HD inline bool occluded(const SceneView& scene, const Ray& ray, real t_max) {
     // END SOLUTION
 }
 
-// A specular path's step off the edges of the primitive it hit (step_off_edges, triangle.h,
-// convex_quad.h, axis_rect.h); zero on a sphere, which has none.
+// A specular path's step off the edges of the primitive it hit (each kind's step_off_edges:
+// zero on a sphere, which has none): an if-chain over the kinds of Kinds<K, Rest...>.
+template <class K, class... Rest>
+RT_HD inline Vec3 step_off_edges_of(const SceneView& scene, const Hit& hit, Vec3 p, real margin,
+                                    Kinds<K, Rest...>) {
+    if (hit.kind == primitive_kind<K>) return step_off_edges(scene.of<K>()[hit.index], p, margin);
+    if constexpr (sizeof...(Rest) > 0) {
+        return step_off_edges_of(scene, hit, p, margin, Kinds<Rest...>{});
+    } else {
+        return Vec3(0.0f);
+    }
+}
 template <class Primitives = AnyGeometry>
 RT_HD inline Vec3 step_off_hit_edges(const SceneView& scene, const Hit& hit, Vec3 p, real margin) {
-    if (has_kind<Primitives, Triangle> && hit.kind == primitive_kind<Triangle>)
-        return step_off_edges(scene.of<Triangle>()[hit.index], p, margin);
-    if (has_kind<Primitives, ConvexQuad> && hit.kind == primitive_kind<ConvexQuad>)
-        return step_off_edges(scene.of<ConvexQuad>()[hit.index], p, margin);
-    if (has_kind<Primitives, AxisRect> && hit.kind == primitive_kind<AxisRect>)
-        return step_off_edges(scene.of<AxisRect>()[hit.index], p, margin);
-    return Vec3(0.0f);
+    return step_off_edges_of(scene, hit, p, margin, Primitives{});
 }
 
 // g++ calls a function as big as the bounce step out of line, and the path state then lives in
@@ -291,36 +253,21 @@ RT_HD RT_FORCE_INLINE bool bounce_step(const SceneView& scene, const Hit& hit, c
     if constexpr (has_specular<Materials>) {
         if (!path.alive) return false;
         // A specular path may bounce 64 times inside a closed mirror or glass room, and must
-        // stay inside: its origin also steps off any edge of the triangle, quad
-        // or other flat primitive (step_off_hit_edges), and a reflected direction is renormalised. Unnormalised,
-        // its length drifts by ~1e-7 a bounce; the sphere test assumes a unit direction, and
-        // after ~10 bounces its hits overshoot the ray offset (the paths escaped a closed mirror
-        // sphere). refract() normalises already.
+        // stay inside: its origin also steps off any edge of the primitive it hit.
         const Vec3 off_edges = step_off_hit_edges<Primitives>(
             scene, hit, surface.position, ray_offset(surface.position, hit.t, surface.extent));
-        if (!has_kind<Materials, Glass> ||
-            (has_kind<Materials, Mirror> && material.type == material_type<Mirror>)) {
-            path.throughput *= material.albedo;
-            path.ray = {above + off_edges, normalize(reflect(incoming, facing))};
-        } else {  // glass: reflect or refract, chosen with the Fresnel reflectance
-            const real eta = entering ? real(1) / material.ior : material.ior;
-            real cos_t;
-            const real reflectance = fresnel_dielectric(-dot(incoming, facing), eta, cos_t);
-            if (rng.at(bounce_dimension(bounce, 0)) < reflectance) {
-                path.ray = {above + off_edges, normalize(reflect(incoming, facing))};
-            } else {
-                const Vec3 below =
-                    offset_ray_origin(surface.position, -facing, hit.t, surface.extent);
-                path.ray = {below + off_edges, refract(incoming, facing, eta, cos_t)};
-            }
-        }
+        scatter_of(
+            material,
+            {incoming, facing, entering, above, off_edges, surface.position, hit.t, surface.extent},
+            rng, bounce, path.throughput, path.ray, without_kind<Materials, Diffuse>{});
     }
     return false;
     // SKELETON
     //> // TODO(lab01): the bounce step. Escaped paths pick up the background and end; at a
     //> // surface, request next-event estimation at diffuse ones (sample_light, weighted by
-    //> // the throughput), then continue the path (cosine-sampled, mirrored or refracted) with
-    //> // a new ray and weight, unless this was interaction number max_bounces.
+    //> // the throughput), then continue the path with a new ray and weight (cosine-sampled
+    //> // at diffuse ones; at the others, scatter_of calls their kind's hook, material.h),
+    //> // unless this was interaction number max_bounces.
     //> // Until then: flat colour of the first surface seen, no lighting.
     //> (void)rng;
     //> (void)max_bounces;

@@ -3,6 +3,18 @@
 // distances are decided; a kind's position numbers it in a Hit and a packed hit. The scene's
 // arrays, their upload, the sets a renderer is compiled for and the report's counters follow
 // the list (DESIGN.md §6, "Only what the scene uses").
+//
+// A kind is a struct with a `material` index and
+//   kName, kReportKey  what the scene report calls one, and its --json key;
+//   kShearsRay         whether its test takes the ray's RayShear (triangle.h), which the loops
+//                      build once per ray for every kind that does;
+// and these functions of it (its hooks), which the loops of path_tracer.h call by kind (with
+// the shear after the ray where kShearsRay, as `intersect(ray, shear, k, t_max)`):
+//   intersect<kConverged>(ray, k, t_max)  the distance in (0, t_max), else t_max;
+//   occludes<kConverged>(ray, k, t_max)   whether it lies on the ray before t_max;
+//   normal_at(k, p)        the unit geometric normal at the hit point p (outward, or front);
+//   surface_extent(k)      its largest |coordinate|: what a hit's rounding error grows with;
+//   step_off_edges(k, p, margin)  a specular path's step off its edges (zero without edges).
 #pragma once
 
 #include <axis_rect.h>

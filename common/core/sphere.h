@@ -3,6 +3,8 @@
 
 #include <cmath>
 
+#include <file_fields.h>
+#include <kinds.h>
 #include <ray.h>
 
 // 16-byte aligned, centre and radius in the first row: the intersection test reads them with
@@ -11,6 +13,11 @@ struct alignas(16) Sphere {
     // What the scene report calls this kind: one of them (plural: +"s"), its --json key.
     static constexpr const char* kName = "sphere";
     static constexpr const char* kReportKey = "spheres";
+    static constexpr bool kShearsRay = false;  // its test takes no RayShear
+    // Its entry in a scene file (file_fields.h): under "spheres", a centre and a radius.
+    static constexpr const char* kFileKey = "spheres";
+    static constexpr FileField kFields[] = {{"center", FieldRole::Point},
+                                            {"radius", FieldRole::Length}};
 
     Vec3 center;    // world-space centre
     real radius;    // > 0
@@ -49,4 +56,28 @@ RT_HD inline real intersect_sphere(const Ray& ray, const Sphere& s, real t_max) 
     const bool near_ok = (t_near > 0.0f) & (t_near < t_max);
     const bool far_ok = (t_far > 0.0f) & (t_far < t_max);
     return !meets ? t_max : near_ok ? t_near : far_ok ? t_far : t_max;
+}
+
+// The kind's hooks (primitive_kinds.h).
+template <bool kConverged = kConvergedTests>
+RT_HD inline real intersect(const Ray& ray, const Sphere& s, real t_max) {
+    return intersect_sphere<kConverged>(ray, s, t_max);
+}
+template <bool kConverged = kConvergedTests>
+RT_HD inline bool occludes(const Ray& ray, const Sphere& s, real t_max) {
+    return intersect_sphere<kConverged>(ray, s, t_max) < t_max;
+}
+RT_HD inline Vec3 normal_at(const Sphere& s, Vec3 p) { return normalize(p - s.center); }
+RT_HD inline real surface_extent(const Sphere& s) { return sphere_extent(s); }
+RT_HD inline Vec3 step_off_edges(const Sphere&, Vec3, real) { return Vec3(0.0f); }  // no edges
+
+// Its entry's values (file_fields.h): the centre's three, then the radius.
+inline Sphere from_fields(KindTag<Sphere>, const real* v, int material) {
+    return {Vec3(v[0], v[1], v[2]), v[3], material};
+}
+inline void fields_of(const Sphere& s, real* v) {
+    v[0] = s.center.x;
+    v[1] = s.center.y;
+    v[2] = s.center.z;
+    v[3] = s.radius;
 }

@@ -14,6 +14,7 @@ struct alignas(16) Triangle {
     // What the scene report calls this kind: one of them (plural: +"s"), its --json key.
     static constexpr const char* kName = "triangle";
     static constexpr const char* kReportKey = "triangles";
+    static constexpr bool kShearsRay = true;  // its test takes the ray's RayShear
 
     Vec3 normal;         // unit geometric normal, or zero for a degenerate triangle
     real plane_offset;   // dot(normal, v0): the plane is dot(normal, p) == plane_offset
@@ -215,3 +216,16 @@ RT_HD inline real intersect_triangle(const Ray& ray, const RayShear& shear, cons
     const real t = t_scaled / det;
     return hit ? t : t_max;
 }
+
+// The kind's hooks (primitive_kinds.h).
+template <bool kConverged = kConvergedTests>
+RT_HD inline real intersect(const Ray& ray, const RayShear& shear, const Triangle& tri,
+                            real t_max) {
+    return intersect_triangle<kConverged>(ray, shear, tri, t_max);
+}
+template <bool kConverged = kConvergedTests>
+RT_HD inline bool occludes(const Ray& ray, const RayShear& shear, const Triangle& tri, real t_max) {
+    return intersect_triangle<kConverged>(ray, shear, tri, t_max) < t_max;
+}
+RT_HD inline Vec3 normal_at(const Triangle& tri, Vec3) { return tri.normal; }
+RT_HD inline real surface_extent(const Triangle& tri) { return tri.extent; }

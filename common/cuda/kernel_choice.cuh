@@ -11,7 +11,7 @@
 
 // Every primitive kind but the axis-aligned rectangle: a scene whose quads are not aligned
 // with the axes (and the Cornell box rendered with its walls as convex quads).
-using GeneralGeometry = Kinds<Sphere, Triangle, ConvexQuad>;
+using GeneralGeometry = without_kind<AllPrimitives, AxisRect>;
 
 // A kernel's compile-time choices, as one type a renderer's templates take.
 template <SceneMemory kSceneMemory, class MaterialKinds, class PrimitiveKinds>

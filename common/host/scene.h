@@ -19,6 +19,12 @@ constexpr long long kMaxSeed = (1LL << 53) - 1;
 struct WrittenPoint {
     double x = 0.0, y = 0.0, z = 0.0;
 
+    void store(double* v) const {  // as three numbers
+        v[0] = x;
+        v[1] = y;
+        v[2] = z;
+    }
+
     // Whether this point, rounded, is `p`: whether p still stands for it.
     bool rounds_to(Vec3 p) const {
         return static_cast<real>(x) == p.x && static_cast<real>(y) == p.y &&
@@ -56,11 +62,23 @@ struct CameraSpec {
 // error of ulp(1e4) ~ 1e-3 of its size through the move (a lamp 1e-2 above a floor rendered it
 // 4.9% too bright). A point the scene no longer holds (changed after loading, or a scene built
 // in code) is moved from the scene's own.
+// The numbers of a kind written as fields (file_fields.h), in double: field_values<K>() per
+// entry of Scene::of<K>(), in its kFields' order (unused by the other kinds).
+template <class K>
+struct WrittenFields {
+    std::vector<double> values;
+
+    // Field value `offset` of entry i, as a point (the three numbers there).
+    WrittenPoint point(size_t i, int offset) const {
+        const double* v = &values[i * field_values<K>() + offset];
+        return {v[0], v[1], v[2]};
+    }
+};
+
 struct WrittenCoordinates {
     bool present = false;
     WrittenPoint light_position;
-    std::vector<WrittenPoint> sphere_centres;     // parallel to Scene::of<Sphere>()
-    std::vector<double> sphere_radii;             // parallel to Scene::of<Sphere>()
+    PerKind<WrittenFields, AllPrimitives> fields;  // the kinds written as fields: of<Sphere>()
     std::vector<WrittenPoint> triangle_vertices;  // 3 per entry of Scene::of<Triangle>()
     std::vector<WrittenPoint> quad_vertices;      // 4 per entry of Scene::of<ConvexQuad>()
     std::vector<WrittenPoint> rect_vertices;  // 4 per entry of Scene::of<AxisRect>(), as written

@@ -39,23 +39,42 @@ WrittenPoint pick(bool have, const WrittenPoint& written, Vec3 own) {
 struct ExactPoints {
     const Scene& scene;
     bool sized() const {
-        return scene.written.present &&
-               scene.written.sphere_centres.size() == scene.of<Sphere>().size() &&
+        bool fields_sized = true;
+        for_each_kind(AllPrimitives{}, [&](auto kind) {
+            using K = typename decltype(kind)::type;
+            if constexpr (written_as_fields<K>)
+                fields_sized = fields_sized && scene.written.fields.of<K>().values.size() ==
+                                                   field_values<K>() * scene.of<K>().size();
+        });
+        return scene.written.present && fields_sized &&
                scene.written.triangle_vertices.size() == 3 * scene.of<Triangle>().size() &&
                scene.written.quad_vertices.size() == 4 * scene.of<ConvexQuad>().size() &&
                scene.written.rect_vertices.size() == 4 * scene.of<AxisRect>().size();
     }
-    WrittenPoint sphere(size_t i) const {
-        return pick(sized(), sized() ? scene.written.sphere_centres[i] : WrittenPoint{},
-                    scene.of<Sphere>()[i].center);
-    }
-    // The radius as rendered (which keeps every centre as it was), unless `real` cannot hold
-    // it: a radius past float's range is placed by the file's number (scene_limits.h then
-    // says float cannot render it).
-    double sphere_radius(size_t i) const {
-        const bool have = sized() && scene.written.sphere_radii.size() == scene.of<Sphere>().size();
-        const real own = scene.of<Sphere>()[i].radius;
-        return have && !std::isfinite(own) ? scene.written.sphere_radii[i] : double(own);
+    // Entry i of a kind written as fields (file_fields.h), its values in double: a point or
+    // direction as written while its rounded numbers still stand for it, else its own; a length
+    // as rendered (which keeps every centre as it was), unless `real` cannot hold it: a radius
+    // past float's range is placed by the file's number (scene_limits.h then says float cannot
+    // render it).
+    template <class K>
+    void field_values_of(size_t i, double* out) const {
+        real own[field_values<K>()];
+        fields_of(scene.of<K>()[i], own);
+        const bool have = sized();
+        const WrittenFields<K>& written = scene.written.fields.of<K>();
+        int at = 0;
+        for (const FileField& field : K::kFields) {
+            if (field.role == FieldRole::Length) {
+                out[at] = have && !std::isfinite(own[at])
+                              ? written.values[i * field_values<K>() + at]
+                              : double(own[at]);
+            } else {
+                const WrittenPoint p = pick(have, have ? written.point(i, at) : WrittenPoint{},
+                                            Vec3(own[at], own[at + 1], own[at + 2]));
+                p.store(out + at);
+            }
+            at += field_size(field.role);
+        }
     }
     WrittenPoint vertex(size_t i, int k) const {
         const Triangle& t = scene.of<Triangle>()[i];
@@ -103,8 +122,27 @@ struct ExactPoints {
 void centre_of_bounds(const Scene& scene, double centre[3]) {
     const ExactPoints points{scene};
     BoundsD box;
-    for (size_t i = 0; i < scene.of<Sphere>().size(); ++i)
-        box.add(points.sphere(i), points.sphere_radius(i));
+    for_each_kind(AllPrimitives{}, [&](auto kind) {  // each point, by its entry's largest length
+        using K = typename decltype(kind)::type;
+        if constexpr (written_as_fields<K>) {
+            for (size_t i = 0; i < scene.of<K>().size(); ++i) {
+                double v[field_values<K>()];
+                points.template field_values_of<K>(i, v);
+                double margin = 0.0;
+                int at = 0;
+                for (const FileField& field : K::kFields) {
+                    if (field.role == FieldRole::Length) margin = std::max(margin, v[at]);
+                    at += field_size(field.role);
+                }
+                at = 0;
+                for (const FileField& field : K::kFields) {
+                    if (field.role == FieldRole::Point)
+                        box.add({v[at], v[at + 1], v[at + 2]}, margin);
+                    at += field_size(field.role);
+                }
+            }
+        }
+    });
     for (size_t i = 0; i < scene.of<Triangle>().size(); ++i) {
         for (int k = 0; k < 3; ++k) box.add(points.vertex(i, k));
     }
@@ -150,9 +188,27 @@ Scene centre_scene(Scene scene) {
     const ExactPoints points{scene};
     WrittenCoordinates moved;
     moved.present = true;
-    moved.sphere_radii = scene.written.sphere_radii;
-    for (size_t i = 0; i < scene.of<Sphere>().size(); ++i)
-        moved.sphere_centres.push_back(minus(points.sphere(i), centre));
+    for_each_kind(AllPrimitives{}, [&](auto kind) {  // the points moved, the rest as they are
+        using K = typename decltype(kind)::type;
+        if constexpr (written_as_fields<K>) {
+            for (size_t i = 0; i < scene.of<K>().size(); ++i) {
+                double v[field_values<K>()];
+                points.template field_values_of<K>(i, v);
+                int at = 0;
+                for (const FileField& field : K::kFields) {
+                    if (field.role == FieldRole::Point) {
+                        const WrittenPoint p = minus({v[at], v[at + 1], v[at + 2]}, centre);
+                        p.store(v + at);
+                    } else if (field.role == FieldRole::Length && points.sized()) {
+                        v[at] = scene.written.fields.of<K>().values[i * field_values<K>() + at];
+                    }
+                    at += field_size(field.role);
+                }
+                std::vector<double>& values = moved.fields.of<K>().values;
+                values.insert(values.end(), v, v + field_values<K>());
+            }
+        }
+    });
     for (size_t i = 0; i < scene.of<Triangle>().size(); ++i) {
         for (int k = 0; k < 3; ++k)
             moved.triangle_vertices.push_back(minus(points.vertex(i, k), centre));
@@ -169,8 +225,24 @@ Scene centre_scene(Scene scene) {
     const WrittenPoint camera_look_at = minus(points.camera_look_at(), centre);
     moved.light_position = minus(points.light(), centre);
 
-    for (size_t i = 0; i < scene.of<Sphere>().size(); ++i)
-        scene.of<Sphere>()[i].center = rounded(moved.sphere_centres[i]);
+    for_each_kind(AllPrimitives{}, [&](auto kind) {  // each rebuilt with its points moved
+        using K = typename decltype(kind)::type;
+        if constexpr (written_as_fields<K>) {
+            for (size_t i = 0; i < scene.of<K>().size(); ++i) {
+                real v[field_values<K>()];
+                fields_of(scene.of<K>()[i], v);
+                int at = 0;
+                for (const FileField& field : K::kFields) {
+                    if (field.role == FieldRole::Point) {
+                        const Vec3 p = rounded(moved.fields.of<K>().point(i, at));
+                        for (int axis = 0; axis < 3; ++axis) v[at + axis] = p[axis];
+                    }
+                    at += field_size(field.role);
+                }
+                scene.of<K>()[i] = from_fields(KindTag<K>{}, v, scene.of<K>()[i].material);
+            }
+        }
+    });
     for (size_t i = 0; i < scene.of<Triangle>().size(); ++i) {
         const WrittenPoint* v = &moved.triangle_vertices[3 * i];
         scene.of<Triangle>()[i] = make_triangle(rounded(v[0]), rounded(v[1]), rounded(v[2]),

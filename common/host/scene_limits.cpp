@@ -64,6 +64,36 @@ double largest(const WrittenPoint& p) {
     return std::fmax(std::fabs(p.x), std::fmax(std::fabs(p.y), std::fabs(p.z)));
 }
 
+// Calls f(KindTag<K>{}, pointer, written, i) for every entry i of every kind K written as fields
+// (file_fields.h), in AllPrimitives' order: pointer is where the file writes it ("/spheres/0").
+template <class F>
+void for_each_fields_entry(const WrittenCoordinates& w, F&& f) {
+    for_each_kind(AllPrimitives{}, [&](auto kind) {
+        using K = typename decltype(kind)::type;
+        if constexpr (written_as_fields<K>) {
+            const WrittenFields<K>& written = w.fields.of<K>();
+            for (size_t i = 0; i < written.values.size() / field_values<K>(); ++i)
+                f(kind, std::string("/") + K::kFileKey + "/" + std::to_string(i), written, i);
+        }
+    });
+}
+
+// An entry's largest |coordinate| once centred: its points' plus its largest length (a
+// sphere's centre and radius).
+template <class K, class Centred>
+double fields_extent(const WrittenFields<K>& written, size_t i, const Centred& centred) {
+    double points = 0.0, length = 0.0;
+    int at = 0;
+    for (const FileField& field : K::kFields) {
+        if (field.role == FieldRole::Point)
+            points = std::fmax(points, largest(centred(written.point(i, at))));
+        if (field.role == FieldRole::Length)
+            length = std::fmax(length, written.values[i * field_values<K>() + at]);
+        at += field_size(field.role);
+    }
+    return points + length;
+}
+
 }  // namespace
 
 PlacementProblem placement_problem(const Scene& scene, size_t file_triangles,
@@ -101,11 +131,17 @@ PlacementProblem placement_problem(const Scene& scene, size_t file_triangles,
         }
         return PlacementProblem{};
     };
-    for (size_t i = 0; i < w.sphere_centres.size(); ++i) {
-        const PlacementProblem problem =
-            coordinate(w.sphere_centres[i], "/spheres/" + std::to_string(i) + "/center");
-        if (!problem.empty()) return problem;
-    }
+    PlacementProblem first;  // the first problem found
+    for_each_fields_entry(w, [&](auto kind, const std::string& p, const auto& written, size_t i) {
+        using K = typename decltype(kind)::type;
+        int at = 0;
+        for (const FileField& field : K::kFields) {
+            if (first.empty() && field.role == FieldRole::Point)
+                first = coordinate(written.point(i, at), p + "/" + field.key);
+            at += field_size(field.role);
+        }
+    });
+    if (!first.empty()) return first;
     for (size_t i = 0; i < w.triangle_vertices.size(); ++i) {
         const PlacementProblem problem =
             coordinate(w.triangle_vertices[i], vertex_pointer(i / 3, static_cast<int>(i % 3)));
@@ -126,23 +162,35 @@ PlacementProblem placement_problem(const Scene& scene, size_t file_triangles,
     }
     // The scene's extent once centred: its largest |coordinate|.
     double extent = 0.0;
-    for (size_t i = 0; i < w.sphere_centres.size(); ++i)
-        extent = std::fmax(extent, largest(centred(w.sphere_centres[i])) + w.sphere_radii[i]);
+    for_each_fields_entry(w, [&](auto kind, const std::string&, const auto& written, size_t i) {
+        extent =
+            std::fmax(extent, fields_extent<typename decltype(kind)::type>(written, i, centred));
+    });
     for (const WrittenPoint& v : w.triangle_vertices)
         extent = std::fmax(extent, largest(centred(v)));
 
-    for (size_t i = 0; i < w.sphere_centres.size(); ++i) {
-        const std::string pointer = "/spheres/" + std::to_string(i) + "/radius";
-        const double radius = w.sphere_radii[i];
-        if (radius > limits.max_coordinate)
-            return {pointer, "a radius of " + format_number(radius) + " is above " +
-                                 limits.max_coordinate_text + ", too large for the renderer's " +
-                                 limits.name + " arithmetic: scale the scene down"};
-        std::string problem = size_problem("a radius", radius,
-                                           largest(centred(w.sphere_centres[i])) + radius, limits);
-        if (problem.empty()) problem = scene_scale_problem("a radius", radius, extent, limits);
-        if (!problem.empty()) return {pointer, problem};
-    }
+    // Each length against the type's range, its own entry's extent and the scene's.
+    for_each_fields_entry(w, [&](auto kind, const std::string& p, const auto& written, size_t i) {
+        using K = typename decltype(kind)::type;
+        const double own_extent = fields_extent<K>(written, i, centred);
+        int at = 0;
+        for (const FileField& field : K::kFields) {
+            if (first.empty() && field.role == FieldRole::Length) {
+                const std::string what = std::string("a ") + field.key;
+                const double size = written.values[i * field_values<K>() + at];
+                std::string found;
+                if (size > limits.max_coordinate)
+                    found = what + " of " + format_number(size) + " is above " +
+                            limits.max_coordinate_text + ", too large for the renderer's " +
+                            limits.name + " arithmetic: scale the scene down";
+                if (found.empty()) found = size_problem(what.c_str(), size, own_extent, limits);
+                if (found.empty()) found = scene_scale_problem(what.c_str(), size, extent, limits);
+                if (!found.empty()) first = {p + "/" + field.key, found};
+            }
+            at += field_size(field.role);
+        }
+    });
+    if (!first.empty()) return first;
     for (size_t i = 0; 3 * i < w.triangle_vertices.size(); ++i) {
         const WrittenPoint v[3] = {centred(w.triangle_vertices[3 * i]),
                                    centred(w.triangle_vertices[3 * i + 1]),

@@ -36,7 +36,7 @@ public:
 
     // Rejects keys outside `allowed`, naming the first unknown one.
     void check_keys(const json& obj, const std::string& pointer,
-                    std::initializer_list<const char*> allowed) const {
+                    const std::vector<const char*>& allowed) const {
         if (!obj.is_object()) fail(pointer, "expected an object, found " + type_of(obj));
         for (auto it = obj.begin(); it != obj.end(); ++it) {
             bool known = false;
@@ -212,24 +212,39 @@ void read_light(const SceneReader& r, const json& root, Scene& scene) {
         r.non_negative_vec3(r.require(light, "/light", "intensity"), "/light/intensity");
 }
 
+// A material of the kind whose kName is its "type" (AllMaterials, material.h), with the
+// albedo and the number its kind reads.
 Material read_material(const SceneReader& r, const json& m, const std::string& p) {
     if (!m.is_object()) r.fail(p, "expected an object, found " + SceneReader::type_of(m));
     const json& type = r.require(m, p, "type");
     Material mat{material_type<Diffuse>, Vec3(0.0f), 1.0f};
-    if (type == "diffuse" || type == "mirror") {
-        r.check_keys(m, p, {"type", "albedo"});
-        mat.type = type == "diffuse" ? material_type<Diffuse> : material_type<Mirror>;
-        mat.albedo = r.albedo(r.require(m, p, "albedo"), p + "/albedo");
-    } else if (type == "glass") {
-        r.check_keys(m, p, {"type", "ior"});
-        mat.type = material_type<Glass>;
-        mat.ior = r.number(r.require(m, p, "ior"), p + "/ior");
-        if (!(mat.ior >= 1.0f && mat.ior <= 5.0f))
-            r.fail(p + "/ior", "expected an index of refraction in [1, 5]");
-    } else {
-        r.fail(p + "/type", "unknown material type " + type.dump() +
-                                " (expected \"diffuse\", \"mirror\" or \"glass\")");
-    }
+    bool known = false;
+    std::string names;  // the types a file may name: "\"diffuse\", \"mirror\" or \"glass\""
+    for_each_kind(AllMaterials{}, [&](auto kind) {
+        using K = typename decltype(kind)::type;
+        const bool last = kind_index<AllMaterials, K> + 1 == AllMaterials::kCount;
+        names += (names.empty() ? "\"" : last ? " or \"" : ", \"") + std::string(K::kName) + '"';
+        if (known || type != K::kName) return;
+        known = true;
+        mat.type = material_type<K>;
+        std::vector<const char*> keys = {"type"};
+        if (K::kAlbedo) keys.push_back("albedo");
+        if (K::kNumber.key) keys.push_back(K::kNumber.key);
+        r.check_keys(m, p, keys);
+        if (K::kAlbedo) mat.albedo = r.albedo(r.require(m, p, "albedo"), p + "/albedo");
+        if (K::kNumber.key) {
+            const std::string at = p + "/" + K::kNumber.key;
+            const real value = r.number(r.require(m, p, K::kNumber.key), at);
+            if (!(value >= K::kNumber.lo && value <= K::kNumber.hi)) {
+                std::ostringstream range;  // [1, 5]
+                range << '[' << K::kNumber.lo << ", " << K::kNumber.hi << ']';
+                r.fail(at, std::string("expected ") + K::kNumber.what + " in " + range.str());
+            }
+            mat.*K::kNumber.field = value;
+        }
+    });
+    if (!known)
+        r.fail(p + "/type", "unknown material type " + type.dump() + " (expected " + names + ")");
     return mat;
 }
 
@@ -295,22 +310,46 @@ private:
     const std::map<std::string, int> materials_;  // material name -> index
 };
 
-void read_spheres(const SceneReader& r, const PrimitiveReader& prims, Scene& scene) {
-    const json& spheres = prims.list("spheres");
-    for (size_t i = 0; i < spheres.size(); ++i) {
-        const std::string p = "/spheres/" + std::to_string(i);
-        r.check_keys(spheres[i], p, {"center", "radius", "material"});
-        Sphere s{};
-        WrittenPoint centre;
-        s.center = read_position(r, r.require(spheres[i], p, "center"), p + "/center", centre);
-        const double radius =
-            r.written_number(r.require(spheres[i], p, "radius"), p + "/radius", true);
-        if (!(radius > 0.0)) r.fail(p + "/radius", "expected a radius > 0");
-        s.radius = static_cast<real>(radius);
-        s.material = prims.material(spheres[i], p);
-        scene.of<Sphere>().push_back(s);
-        scene.written.sphere_centres.push_back(centre);
-        scene.written.sphere_radii.push_back(radius);
+// The entries of a kind written as fields (file_fields.h): each field read as its role asks,
+// the primitive built from the values rounded to `real`, the file's numbers kept for centring.
+template <class K>
+void read_fields_kind(const SceneReader& r, const PrimitiveReader& prims, Scene& scene) {
+    constexpr int kValues = field_values<K>();
+    const json& list = prims.list(K::kFileKey);
+    std::vector<const char*> keys;
+    for (const FileField& field : K::kFields) keys.push_back(field.key);
+    keys.push_back("material");
+    for (size_t i = 0; i < list.size(); ++i) {
+        const std::string p = std::string("/") + K::kFileKey + "/" + std::to_string(i);
+        r.check_keys(list[i], p, keys);
+        double written[kValues];
+        int at = 0;
+        for (const FileField& field : K::kFields) {
+            const std::string fp = p + "/" + field.key;
+            const json& v = r.require(list[i], p, field.key);
+            if (field.role == FieldRole::Point) {
+                WrittenPoint point;
+                read_position(r, v, fp, point);
+                point.store(written + at);
+            } else if (field.role == FieldRole::Length) {
+                written[at] = r.written_number(v, fp, true);
+                if (!(written[at] > 0.0))
+                    r.fail(fp, std::string("expected a ") + field.key + " > 0");
+            } else {  // a direction, normalised in double
+                WrittenPoint d;
+                read_position(r, v, fp, d);
+                const double length = std::sqrt(d.x * d.x + d.y * d.y + d.z * d.z);
+                if (!(length > 0.0 && std::isfinite(length)))
+                    r.fail(fp, "expected a direction (a nonzero, finite vector)");
+                WrittenPoint{d.x / length, d.y / length, d.z / length}.store(written + at);
+            }
+            at += field_size(field.role);
+        }
+        real values[kValues];
+        for (int k = 0; k < kValues; ++k) values[k] = static_cast<real>(written[k]);
+        scene.of<K>().push_back(from_fields(KindTag<K>{}, values, prims.material(list[i], p)));
+        std::vector<double>& kept = scene.written.fields.of<K>().values;
+        kept.insert(kept.end(), written, written + kValues);
     }
 }
 
@@ -465,9 +504,13 @@ Scene parse_scene(const std::string& text, const std::string& name) {
     const SceneReader r(name, text, parsed.offsets);
     if (!parsed.duplicate_key_pointer.empty())
         r.fail_key(parsed.duplicate_key_pointer, "duplicate key \"" + parsed.duplicate_key + "\"");
-    r.check_keys(
-        root, "",
-        {"camera", "background", "light", "materials", "spheres", "triangles", "quads", "render"});
+    std::vector<const char*> keys = {"camera", "background", "light", "materials"};
+    for_each_kind(AllPrimitives{}, [&](auto kind) {
+        using K = typename decltype(kind)::type;
+        if constexpr (written_as_fields<K>) keys.push_back(K::kFileKey);
+    });
+    keys.insert(keys.end(), {"triangles", "quads", "render"});
+    r.check_keys(root, "", keys);
 
     Scene scene;
     scene.name = name;
@@ -477,7 +520,10 @@ Scene parse_scene(const std::string& text, const std::string& name) {
         scene.background = r.non_negative_vec3(root["background"], "/background");
     read_light(r, root, scene);
     const PrimitiveReader prims(r, root, read_materials(r, root, scene));
-    read_spheres(r, prims, scene);
+    for_each_kind(AllPrimitives{}, [&](auto kind) {
+        using K = typename decltype(kind)::type;
+        if constexpr (written_as_fields<K>) read_fields_kind<K>(r, prims, scene);
+    });
     read_triangles(r, prims, scene);
     read_render_settings(r, root, scene.render);
     const size_t file_triangles = root.contains("triangles") ? root["triangles"].size() : 0;

@@ -32,16 +32,23 @@ double longest_edge(const AxisRect& r) {
     return std::max(double(r.hi_u) - r.lo_u, double(r.hi_v) - r.lo_v);
 }
 
-// A primitive's size as a detail (0: it shows nothing) and its largest |coordinate|.
-double detail_size(const Sphere& s) { return s.radius; }
+// A primitive's size as a detail (0: it shows nothing): a kind written as fields
+// (file_fields.h), its smallest length (a sphere's radius); any other, its longest edge.
 template <class K>
 double detail_size(const K& primitive) {
-    return longest_edge(primitive);
-}
-double extent_of(const Sphere& s) { return sphere_extent(s); }
-template <class K>
-double extent_of(const K& primitive) {
-    return primitive.extent;
+    if constexpr (written_as_fields<K>) {
+        real values[field_values<K>()];
+        fields_of(primitive, values);
+        double smallest = INFINITY;
+        int at = 0;
+        for (const FileField& field : K::kFields) {
+            if (field.role == FieldRole::Length) smallest = std::min(smallest, double(values[at]));
+            at += field_size(field.role);
+        }
+        return std::isfinite(smallest) ? smallest : 0.0;
+    } else {
+        return longest_edge(primitive);
+    }
 }
 
 }  // namespace
@@ -59,7 +66,7 @@ SceneUse scene_use(const Scene& scene) {
         for (const K& p : scene.of<K>()) {
             const double size = detail_size(p);
             if (size > 0) smallest = std::min(smallest, size);  // zero area shows nothing
-            use.extent = std::max(use.extent, extent_of(p));
+            use.extent = std::max(use.extent, double(surface_extent(p)));
         }
     });
     use.smallest = std::isfinite(smallest) ? smallest : 0.0;

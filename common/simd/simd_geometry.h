@@ -147,7 +147,8 @@ inline Float8 intersect_rects8(const BroadcastRay& r, const RectPacket& p, Float
 }
 
 // closest_hit (path_tracer.h) over every packet: 8 primitives per test, then the nearest lane;
-// the convex quads one by one, in the scalar loops' order. Primitives: the kinds compiled in
+// the convex quads, and any kind after the rectangles in AllPrimitives (one added to the list),
+// one by one with their scalar hooks (primitive_kinds.h), in the scalar loops' order. Primitives: the kinds compiled in
 // (geometry_set.h); the loops of kinds the scene lacks cost a comparison, and are kept.
 template <class Primitives = AnyGeometry>
 inline Hit closest_hit(const SimdSceneView& scene, const Ray& ray) {
@@ -169,8 +170,8 @@ inline Hit closest_hit(const SimdSceneView& scene, const Ray& ray) {
         const int lane = nearest_lane(t, hits);
         hit = {t.lane(lane), primitive_kind<Triangle>, i * kSimdWidth + lane};
     }
-    for (int i = 0; i < scene.num_quads; ++i) {
-        const float t = intersect_quad(ray, r.shear, scene.quads[i], hit.t);
+    for (int i = 0; i < scene.one_by_one.of<ConvexQuad>().count; ++i) {
+        const float t = intersect_quad(ray, r.shear, scene.one_by_one.of<ConvexQuad>()[i], hit.t);
         if (t < hit.t) hit = {t, primitive_kind<ConvexQuad>, i};
     }
     for (int i = 0; i < scene.num_rect_packets; ++i) {
@@ -181,6 +182,18 @@ inline Hit closest_hit(const SimdSceneView& scene, const Ray& ray) {
         const int lane = nearest_lane(t, hits);
         hit = {t.lane(lane), primitive_kind<AxisRect>, i * kSimdWidth + lane};
     }
+    for_each_kind(AllPrimitives{}, [&](auto kind) {
+        using K = typename decltype(kind)::type;
+        if constexpr (kind_index<AllPrimitives, K> > kind_index<AllPrimitives, AxisRect>) {
+            for (int i = 0; i < scene.one_by_one.of<K>().count; ++i) {
+                float t;
+                if constexpr (K::kShearsRay)
+                    t = intersect(ray, r.shear, scene.one_by_one.of<K>()[i], hit.t);
+                else t = intersect(ray, scene.one_by_one.of<K>()[i], hit.t);
+                if (t < hit.t) hit = {t, primitive_kind<K>, i};
+            }
+        }
+    });
     return hit;
 }
 
@@ -195,11 +208,22 @@ inline bool occluded(const SimdSceneView& scene, const Ray& ray, float t_max) {
     for (int i = 0; i < scene.num_triangle_packets; ++i) {
         if (any(intersect_triangles8(r, scene.triangles[i], limit) < limit)) return true;
     }
-    for (int i = 0; i < scene.num_quads; ++i) {
-        if (intersect_quad(ray, r.shear, scene.quads[i], t_max) < t_max) return true;
+    for (int i = 0; i < scene.one_by_one.of<ConvexQuad>().count; ++i) {
+        if (intersect_quad(ray, r.shear, scene.one_by_one.of<ConvexQuad>()[i], t_max) < t_max)
+            return true;
     }
     for (int i = 0; i < scene.num_rect_packets; ++i) {
         if (any(intersect_rects8(r, scene.rects[i], limit) < limit)) return true;
     }
-    return false;
+    bool blocked = false;
+    for_each_kind(AllPrimitives{}, [&](auto kind) {
+        using K = typename decltype(kind)::type;
+        if constexpr (kind_index<AllPrimitives, K> > kind_index<AllPrimitives, AxisRect>) {
+            for (int i = 0; !blocked && i < scene.one_by_one.of<K>().count; ++i)
+                if constexpr (K::kShearsRay)
+                    blocked = occludes(ray, r.shear, scene.one_by_one.of<K>()[i], t_max);
+                else blocked = occludes(ray, scene.one_by_one.of<K>()[i], t_max);
+        }
+    });
+    return blocked;
 }

@@ -58,12 +58,13 @@ struct SimdSceneView {
     int num_sphere_packets;
     const RectPacket* rects;  // ceil(num_rects / 8) packets
     int num_rect_packets;
-    const ConvexQuad* quads;  // the scene's own, tested one by one
-    int num_quads;
+    // The scene's own arrays: the kinds tested one by one (convex quads, and any kind with no
+    // packet here, simd_geometry.h).
+    SceneView one_by_one;
 };
 
 // The SoA copy of a scene's spheres, triangles and rectangles. Owns its packets (a copy of
-// it, say one per renderer object, shares only the scene's convex quads); building it costs
+// it, say one per renderer object, shares only the scene's arrays of the other kinds); building it costs
 // microseconds.
 class SimdScene {
 public:
@@ -71,8 +72,7 @@ public:
         : triangles_(packets_for(scene.of<Triangle>().count)),
           spheres_(packets_for(scene.of<Sphere>().count)),
           rects_(packets_for(scene.of<AxisRect>().count)),
-          quads_(scene.of<ConvexQuad>().items),
-          num_quads_(scene.of<ConvexQuad>().count) {
+          scene_(scene) {
         for (int i = 0; i < scene.of<Triangle>().count; ++i) {
             const Triangle& tri = scene.of<Triangle>()[i];
             TrianglePacket& p = triangles_[i / kSimdWidth];
@@ -117,8 +117,7 @@ public:
                 static_cast<int>(spheres_.size()),
                 rects_.data(),
                 static_cast<int>(rects_.size()),
-                quads_,
-                num_quads_};
+                scene_};
     }
 
 private:
@@ -130,6 +129,5 @@ private:
     std::vector<TrianglePacket> triangles_;  // C++17 new honours alignas(32)
     std::vector<SpherePacket> spheres_;
     std::vector<RectPacket> rects_;
-    const ConvexQuad* quads_;  // not owned: the scene's
-    int num_quads_;
+    SceneView scene_;  // its arrays are not owned: the scene's
 };

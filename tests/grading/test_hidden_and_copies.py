@@ -70,12 +70,14 @@ def test_a_grade_writes_a_page_with_the_images(lab01_ref, tmp_path):
             assert (pages / "hidden-diff.png").exists()
 
 
-def skipping(kind_loop: str) -> dict:
-    """path_tracer.h whose closest-hit loop over one primitive kind never finds anything."""
+def skipping(kind: str) -> dict:
+    """path_tracer.h whose closest-hit loop never finds a primitive of one kind."""
     from labkit.harness import ROOT as root
     text = (root / "common" / "core" / "path_tracer.h").read_text()
-    assert text.count(kind_loop) == 1, kind_loop
-    return {"path_tracer.h": text.replace(kind_loop, "(void)t;", 1)}
+    keep = "if (t < hit.t) hit = {t, primitive_kind<K>, i};"
+    assert text.count(keep) == 1, keep
+    skip = f"if (t < hit.t && !has_kind<Kinds<{kind}>, K>) hit = {{t, primitive_kind<K>, i}};"
+    return {"path_tracer.h": text.replace(keep, skip, 1)}
 
 
 def test_the_hidden_scene_holds_every_kind_of_the_lists(lab01_ref, tmp_path):
@@ -100,9 +102,8 @@ def test_a_renderer_that_skips_a_primitive_kind_fails_the_hidden_scene(lab01_ref
     from grading import hidden
     from labkit.variants import build_variant
     assert hidden.check_hidden(lab01_ref, lab01_ref, "kinds").passed
-    for name, loop in (("triangles", "if (t < hit.t) hit = {t, primitive_kind<Triangle>, i};"),
-                       ("quads", "if (t < hit.t) hit = {t, primitive_kind<ConvexQuad>, i};")):
-        binary = build_variant("01-serial", tmp_path / name, skipping(loop))
+    for name, kind in (("triangles", "Triangle"), ("quads", "ConvexQuad")):
+        binary = build_variant("01-serial", tmp_path / name, skipping(kind))
         result = hidden.check_hidden(binary, lab01_ref, "kinds")
         assert not result.passed, f"a renderer without {name} passed: {result.detail}"
 

@@ -42,6 +42,18 @@ struct SurfacePoint {
     int material;   // index into the material table
 };
 
+// The surface of a hit on a kind of Kinds<K, Rest...>: an if-chain over the kinds, the last
+// taken without a test (a hit names a kind of the set).
+template <class K, class... Rest>
+RT_HD inline SurfacePoint surface_of(const SceneView& scene, Vec3 p, const Hit& hit,
+                                     Kinds<K, Rest...>) {
+    if constexpr (sizeof...(Rest) > 0) {
+        if (hit.kind != primitive_kind<K>) return surface_of(scene, p, hit, Kinds<Rest...>{});
+    }
+    const K& item = scene.of<K>()[hit.index];
+    return {p, normal_at(item, p), surface_extent(item), item.material};
+}
+
 // The position is ray.at(t), not re-projected onto the primitive (pbrt re-projects sphere hits,
 // p = c + r * normalize(p - c)): p - c already rounds to the spacing of floats at |c| + r, the
 // error the offset's extent term covers, and measured on sphere floors of radius 1e3..1e6 the
@@ -49,33 +61,20 @@ struct SurfacePoint {
 // kinds that can have been hit.
 template <class Primitives = AnyGeometry>
 RT_HD inline SurfacePoint surface_at(const SceneView& scene, const Ray& ray, const Hit& hit) {
-    const Vec3 p = ray.at(hit.t);
-    if (has_kind<Primitives, Sphere> && hit.kind == primitive_kind<Sphere>) {
-        const Sphere& s = scene.of<Sphere>()[hit.index];
-        return {p, normalize(p - s.center), sphere_extent(s), s.material};
-    }
-    if (has_kind<Primitives, AxisRect> && hit.kind == primitive_kind<AxisRect>) {
-        const AxisRect& r = scene.of<AxisRect>()[hit.index];
-        return {p, rect_normal(r), r.extent, r.material};
-    }
-    if (has_kind<Primitives, ConvexQuad> && hit.kind == primitive_kind<ConvexQuad>) {
-        const ConvexQuad& q = scene.of<ConvexQuad>()[hit.index];
-        return {p, q.normal, q.extent, q.material};
-    }
-    const Triangle& tri = scene.of<Triangle>()[hit.index];
-    return {p, tri.normal, tri.extent, tri.material};
+    return surface_of(scene, ray.at(hit.t), hit, Primitives{});
 }
 
 // Closest hit by brute force over every primitive: the scenes of this course are small.
-// Primitives (geometry_set.h) is the set of kinds compiled in; each loop keeps the nearest hit
-// with a select, no branch out of the loop, so a GPU warp stays converged.
+// Primitives (geometry_set.h) is the set of kinds compiled in, each visited with its
+// intersect() (primitive_kinds.h) in the order for_each_kind_with_shear gives; each loop keeps
+// the nearest hit with a select, no branch out of the loop, so a GPU warp stays converged.
 template <class Primitives = AnyGeometry>
 RT_HD inline Hit closest_hit(const SceneView& scene, const Ray& ray) {
     Hit hit;
-    // TODO(lab01): this finds spheres only. Loop over the other primitives too, in this
-    // order, keeping the nearest hit: the triangles and the quads (build one RayShear per
-    // ray, then intersect_triangle and intersect_quad), then the axis-aligned rectangles
-    // (intersect_rect: the Cornell box's walls). Each hit records its kind and index.
+    // TODO(lab01): this finds spheres only. Visit every kind of Primitives
+    // (for_each_kind_with_shear, geometry_set.h: it hands each kind the ray's shear),
+    // keeping the nearest hit over each kind's array (scene.of<K>()) with the kind's
+    // intersect(): a hit records its kind and index.
     for (int i = 0; has_kind<Primitives, Sphere> && i < scene.of<Sphere>().count; ++i) {
         const real t = intersect_sphere(ray, scene.of<Sphere>()[i], hit.t);
         if (t < hit.t) hit = {t, primitive_kind<Sphere>, i};
@@ -87,25 +86,29 @@ RT_HD inline Hit closest_hit(const SceneView& scene, const Ray& ray) {
 // a shadow ray needs any hit, not the closest. Glass blocks too (no caustics).
 template <class Primitives = AnyGeometry>
 RT_HD inline bool occluded(const SceneView& scene, const Ray& ray, real t_max) {
-    // TODO(lab01): return true when any primitive (sphere, triangle, quad, rectangle) lies
-    // on the ray before t_max.
+    // TODO(lab01): return true when any primitive (of every kind of Primitives, as in
+    // closest_hit, with the kind's occludes()) lies on the ray before t_max.
     (void)scene;
     (void)ray;
     (void)t_max;
     return false;
 }
 
-// A specular path's step off the edges of the primitive it hit (step_off_edges, triangle.h,
-// convex_quad.h, axis_rect.h); zero on a sphere, which has none.
+// A specular path's step off the edges of the primitive it hit (each kind's step_off_edges:
+// zero on a sphere, which has none): an if-chain over the kinds of Kinds<K, Rest...>.
+template <class K, class... Rest>
+RT_HD inline Vec3 step_off_edges_of(const SceneView& scene, const Hit& hit, Vec3 p, real margin,
+                                    Kinds<K, Rest...>) {
+    if (hit.kind == primitive_kind<K>) return step_off_edges(scene.of<K>()[hit.index], p, margin);
+    if constexpr (sizeof...(Rest) > 0) {
+        return step_off_edges_of(scene, hit, p, margin, Kinds<Rest...>{});
+    } else {
+        return Vec3(0.0f);
+    }
+}
 template <class Primitives = AnyGeometry>
 RT_HD inline Vec3 step_off_hit_edges(const SceneView& scene, const Hit& hit, Vec3 p, real margin) {
-    if (has_kind<Primitives, Triangle> && hit.kind == primitive_kind<Triangle>)
-        return step_off_edges(scene.of<Triangle>()[hit.index], p, margin);
-    if (has_kind<Primitives, ConvexQuad> && hit.kind == primitive_kind<ConvexQuad>)
-        return step_off_edges(scene.of<ConvexQuad>()[hit.index], p, margin);
-    if (has_kind<Primitives, AxisRect> && hit.kind == primitive_kind<AxisRect>)
-        return step_off_edges(scene.of<AxisRect>()[hit.index], p, margin);
-    return Vec3(0.0f);
+    return step_off_edges_of(scene, hit, p, margin, Primitives{});
 }
 
 // g++ calls a function as big as the bounce step out of line, and the path state then lives in
@@ -175,8 +178,9 @@ RT_HD RT_FORCE_INLINE bool bounce_step(const SceneView& scene, const Hit& hit, c
                                        int max_bounces, PathState& path, ShadowRay& shadow) {
     // TODO(lab01): the bounce step. Escaped paths pick up the background and end; at a
     // surface, request next-event estimation at diffuse ones (sample_light, weighted by
-    // the throughput), then continue the path (cosine-sampled, mirrored or refracted) with
-    // a new ray and weight, unless this was interaction number max_bounces.
+    // the throughput), then continue the path with a new ray and weight (cosine-sampled
+    // at diffuse ones; at the others, scatter_of calls their kind's hook, material.h),
+    // unless this was interaction number max_bounces.
     // Until then: flat colour of the first surface seen, no lighting.
     (void)rng;
     (void)max_bounces;

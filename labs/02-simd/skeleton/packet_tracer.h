@@ -197,6 +197,54 @@ struct HitPacket {
     MaskOf<F> on(PrimitiveKind k) const { return kind == static_cast<int>(k); }
 };
 
+// ---- kinds without a packet test: lane by lane
+// The kinds this file tests N rays at a time. Any other kind of AllPrimitives (one added to the
+// list) is tested, shaded and stepped off lane by lane with its scalar hooks
+// (primitive_kinds.h): lab 01's bits at once, at a scalar kind's speed until it has a packet
+// test. Such kinds come after these in the list, so that both visit the kinds in one order.
+using PacketKinds = Kinds<Sphere, Triangle, ConvexQuad, AxisRect>;
+template <class K>
+constexpr bool lane_by_lane = !has_kind<PacketKinds, K>;
+static_assert(kinds_within<PacketKinds, AllPrimitives> &&
+                  kind_index<AllPrimitives, AxisRect> == PacketKinds::kCount - 1,
+              "the kinds without a packet test follow those with one in AllPrimitives");
+
+// An N-lane value: op(lane) in the lanes of `lanes`, `otherwise` in the others.
+template <class F, class Op>
+inline F from_lanes(MaskOf<F> lanes, F otherwise, Op&& op) {
+    alignas(64) float v[F::kLanes];
+    otherwise.store(v);
+    for (int l = 0; l < F::kLanes; ++l) {
+        if (lanes.bits() >> l & 1) v[l] = op(l);
+    }
+    return F::load(v);
+}
+template <class F, class Op>
+inline Vec3xN<F> vectors_from_lanes(MaskOf<F> lanes, const Vec3xN<F>& otherwise, Op&& op) {
+    alignas(64) float v[3][F::kLanes];
+    otherwise.x.store(v[0]);
+    otherwise.y.store(v[1]);
+    otherwise.z.store(v[2]);
+    for (int l = 0; l < F::kLanes; ++l) {
+        if (!(lanes.bits() >> l & 1)) continue;
+        const Vec3 value = op(l);
+        v[0][l] = value.x;
+        v[1][l] = value.y;
+        v[2][l] = value.z;
+    }
+    return {F::load(v[0]), F::load(v[1]), F::load(v[2])};
+}
+// A kind's scalar test on the rays of `lanes`, lane by lane; t_max in the others.
+template <class F, class K>
+inline F intersect_lanes(const RayPacket<F>& ray, const K& item, F t_max, MaskOf<F> lanes) {
+    return from_lanes(lanes, t_max, [&](int l) {
+        const Ray r = ray.lane(l);
+        if constexpr (K::kShearsRay)
+            return intersect(r, RayShear(r.direction), item, t_max.lane(l));
+        else return intersect(r, item, t_max.lane(l));
+    });
+}
+
 // closest_hit (path_tracer.h) for N rays: every primitive against all lanes, keeping each
 // lane's nearest hit with a masked update, in the scalar loops' order. Lanes outside `active`
 // find nothing (their t_max is 0, which every test rejects).
@@ -224,6 +272,13 @@ inline HitPacket<F> closest_hit(const SceneView& scene, const RayPacket<F>& ray,
     }
     for (int i = 0; i < scene.of<AxisRect>().count; ++i)
         keep(intersect_rect(ray, scene.of<AxisRect>()[i], hit.t), primitive_kind<AxisRect>, i);
+    for_each_kind(AllPrimitives{}, [&](auto kind) {
+        using K = typename decltype(kind)::type;
+        if constexpr (lane_by_lane<K>) {
+            for (int i = 0; i < scene.of<K>().count; ++i)
+                keep(intersect_lanes(ray, scene.of<K>()[i], hit.t, active), primitive_kind<K>, i);
+        }
+    });
     return hit;
 }
 
@@ -257,6 +312,14 @@ inline MaskOf<F> occluded(const SceneView& scene, const RayPacket<F>& ray, F t_m
     for (int i = 0; i < scene.of<AxisRect>().count; ++i) {
         if (block(intersect_rect(ray, scene.of<AxisRect>()[i], limit))) return blocked;
     }
+    bool all_blocked = false;
+    for_each_kind(AllPrimitives{}, [&](auto kind) {
+        using K = typename decltype(kind)::type;
+        if constexpr (lane_by_lane<K>) {
+            for (int i = 0; !all_blocked && i < scene.of<K>().count; ++i)
+                all_blocked = block(intersect_lanes(ray, scene.of<K>()[i], limit, active));
+        }
+    });
     return blocked;
 }
 
@@ -338,6 +401,24 @@ inline SurfacePacket<F> surface_at(const SceneView& scene, const RayPacket<F>& r
              gather(r0.extent, kR, hit.index, on_rect),
              gather(r0.material, kR, hit.index, on_rect));
     }
+    for_each_kind(AllPrimitives{}, [&](auto kind) {  // surface_of (path_tracer.h), lane by lane
+        using K = typename decltype(kind)::type;
+        if constexpr (lane_by_lane<K>) {
+            const auto lanes = mask & hit.on(primitive_kind<K>);
+            if (none(lanes)) return;
+            const auto item = [&](int l) -> const K& { return scene.of<K>()[hit.index.lane(l)]; };
+            alignas(64) int32_t material[F::kLanes];
+            s.material.store(material);
+            for (int l = 0; l < F::kLanes; ++l) {
+                if (lanes.bits() >> l & 1) material[l] = item(l).material;
+            }
+            take(lanes,
+                 vectors_from_lanes(lanes, s.normal,
+                                    [&](int l) { return normal_at(item(l), s.position.lane(l)); }),
+                 from_lanes(lanes, s.extent, [&](int l) { return surface_extent(item(l)); }),
+                 I::load(material));
+        }
+    });
     return s;
 }
 
@@ -375,10 +456,26 @@ inline Vec3xN<F> specular_edge_step(const SceneView& scene, const HitPacket<F>& 
     const auto on_triangle = specular & hit.on(primitive_kind<Triangle>);
     const auto on_quad = specular & hit.on(primitive_kind<ConvexQuad>);
     const auto on_rect = specular & hit.on(primitive_kind<AxisRect>);
-    if (none(on_triangle | on_quad | on_rect)) return step;
+    auto on_other = MaskOf<F>::none();  // kinds without a packet test
+    for_each_kind(AllPrimitives{}, [&](auto kind) {
+        if constexpr (lane_by_lane<typename decltype(kind)::type>)
+            on_other |= specular & hit.on(primitive_kind<typename decltype(kind)::type>);
+    });
+    if (none(on_triangle | on_quad | on_rect | on_other)) return step;
     // ray_offset (ray.h), lane by lane
     const F margin =
         (max_component(abs(surface.position)) + hit.t + surface.extent) * F(1.0f / (1 << 20));
+    for_each_kind(AllPrimitives{}, [&](auto kind) {  // step_off_hit_edges, lane by lane
+        using K = typename decltype(kind)::type;
+        if constexpr (lane_by_lane<K>) {
+            const auto lanes = specular & hit.on(primitive_kind<K>);
+            if (none(lanes)) return;
+            step = vectors_from_lanes(lanes, step, [&](int l) {
+                return step_off_edges(scene.of<K>()[hit.index.lane(l)], surface.position.lane(l),
+                                      margin.lane(l));
+            });
+        }
+    });
     if (any(on_triangle)) {
         const Triangle& t0 = scene.of<Triangle>()[0];
         const Vec3xN<F> v0 = gather_vertex(t0, t0.v0, hit, on_triangle);
@@ -475,6 +572,19 @@ inline MaskOf<F> sample_light(const SceneView& scene, const Vec3xN<F>& position,
     return lit;
 }
 
+// The material kinds this file has a branch for; any other kind of AllMaterials (one added to
+// the list) scatters lane by lane with its kind's hook (material.h): lab 01's bits at once.
+using PacketMaterials = Kinds<Diffuse, Mirror, Glass>;
+static_assert(kinds_within<PacketMaterials, AllMaterials>, "the packet materials are kinds");
+
+// One lane of a packet's random numbers, as a scalar Rng for a scatter hook.
+template <class F>
+struct LaneStream {
+    const SampleStreamN<F>& streams;
+    int lane;
+    float at(uint32_t dimension) const { return streams.at(dimension).lane(lane); }
+};
+
 // bounce_step (path_tracer.h) for the alive lanes of a packet: returns the lanes that ask for
 // a shadow ray. Each material is handled in turn, each for its own lanes only. Forced inline
 // as the scalar step is (out of line: +7% instructions per path).
@@ -506,6 +616,12 @@ RT_PACKET_INLINE MaskOf<F> bounce_step(const SceneView& scene, const HitPacket<F
     const Mask diffuse = path.alive & (type == static_cast<int>(material_type<Diffuse>));
     const Mask mirror = path.alive & (type == static_cast<int>(material_type<Mirror>));
     const Mask glass = path.alive & (type == static_cast<int>(material_type<Glass>));
+    Mask other = Mask::none();  // lanes of a kind without a branch here
+    for_each_kind(AllMaterials{}, [&](auto kind) {
+        using K = typename decltype(kind)::type;
+        if constexpr (!has_kind<PacketMaterials, K>)
+            other |= path.alive & (type == static_cast<int>(material_type<K>));
+    });
 
     Mask lit = Mask::none();
     if (scene.has_light && any(diffuse)) {
@@ -528,7 +644,8 @@ RT_PACKET_INLINE MaskOf<F> bounce_step(const SceneView& scene, const HitPacket<F
     // Specular lanes, as the scalar bounce step: the origin steps off triangle edges, and a
     // reflected direction is renormalised.
     Vec3xN<F> off_edges(Vec3(0.0f));
-    if (any(mirror | glass)) off_edges = specular_edge_step(scene, hit, surface, mirror | glass);
+    if (any(mirror | glass | other))
+        off_edges = specular_edge_step(scene, hit, surface, mirror | glass | other);
     if (any(mirror)) {
         path.throughput = select(mirror, path.throughput * albedo, path.throughput);
         next.origin = select(mirror, above + off_edges, next.origin);
@@ -546,6 +663,28 @@ RT_PACKET_INLINE MaskOf<F> bounce_step(const SceneView& scene, const HitPacket<F
                                 select(reflects, normalize(reflect(ray.direction, facing)),
                                        refract(ray.direction, facing, eta, cos_t)),
                                 next.direction);
+    }
+    if (any(other)) {  // scatter_of (path_tracer.h), lane by lane
+        Vec3 throughput[F::kLanes], origin[F::kLanes], direction[F::kLanes];
+        for (int l = 0; l < F::kLanes; ++l) {
+            if (!(other.bits() >> l & 1)) continue;
+            const int material = surface.material.lane(l);
+            const SpecularHit at{
+                ray.direction.lane(l), facing.lane(l),        (entering.bits() >> l & 1) != 0,
+                above.lane(l),         off_edges.lane(l),     surface.position.lane(l),
+                hit.t.lane(l),         surface.extent.lane(l)};
+            throughput[l] = path.throughput.lane(l);
+            Ray lane_next = next.lane(l);
+            scatter_of(scene.materials[material], at, LaneStream<F>{rng, l}, bounce, throughput[l],
+                       lane_next, without_kind<AllMaterials, Diffuse>{});
+            origin[l] = lane_next.origin;
+            direction[l] = lane_next.direction;
+        }
+        path.throughput =
+            vectors_from_lanes(other, path.throughput, [&](int l) { return throughput[l]; });
+        next.origin = vectors_from_lanes(other, next.origin, [&](int l) { return origin[l]; });
+        next.direction =
+            vectors_from_lanes(other, next.direction, [&](int l) { return direction[l]; });
     }
     path.ray = next;
     return lit;
