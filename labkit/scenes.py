@@ -257,20 +257,18 @@ def floor_view(half: float, albedo: float = 0.5, intensity: float = 2.0,
     return scene
 
 
-def floor_view_expected(scene: dict, width: int, height: int, subsamples: int = 8):
-    """Per-pixel expected radiance of floor_view (one bounce; the scene may be scaled or
-    translated, not rotated), computed in double for the exact plane or sphere, by a midpoint
-    rule over subsamples^2 points of each pixel. Also returns, per pixel, whether every one of
-    those points sees the floor (pixels across the horizon are not smooth: compare the rest)."""
+def camera_rays(camera: dict, width: int, height: int, subsamples: int):
+    """Unit directions, in double, from the camera through the midpoints of subsamples^2
+    cells of every pixel, as the renderer's Camera maps pixels: an array of shape
+    (height * subsamples, width * subsamples, 3), row by row from the top."""
     import numpy as np
-    cam = scene["camera"]
-    pos = np.array(cam["position"], float)
-    forward = np.array(cam["look_at"], float) - pos
+    pos = np.array(camera["position"], float)
+    forward = np.array(camera["look_at"], float) - pos
     forward /= np.linalg.norm(forward)
-    right = np.cross(forward, cam["up"])
+    right = np.cross(forward, camera.get("up", [0, 1, 0]))
     right /= np.linalg.norm(right)
     up = np.cross(right, forward)
-    half_h = math.tan(math.radians(cam["vfov"]) / 2)
+    half_h = math.tan(math.radians(camera["vfov"]) / 2)
     half_w = half_h * width / height
     offs = (np.arange(subsamples) + 0.5) / subsamples
     xs = (np.arange(width)[:, None] + offs[None, :]).ravel()
@@ -278,7 +276,17 @@ def floor_view_expected(scene: dict, width: int, height: int, subsamples: int = 
     gx, gy = np.meshgrid(xs, ys)
     d = (forward + right * (-half_w + 2 * half_w * gx / width)[..., None]
          + up * (half_h - 2 * half_h * gy / height)[..., None])
-    d /= np.linalg.norm(d, axis=-1, keepdims=True)
+    return d / np.linalg.norm(d, axis=-1, keepdims=True)
+
+
+def floor_view_expected(scene: dict, width: int, height: int, subsamples: int = 8):
+    """Per-pixel expected radiance of floor_view (one bounce; the scene may be scaled or
+    translated, not rotated), computed in double for the exact plane or sphere, by a midpoint
+    rule over subsamples^2 points of each pixel. Also returns, per pixel, whether every one of
+    those points sees the floor (pixels across the horizon are not smooth: compare the rest)."""
+    import numpy as np
+    pos = np.array(scene["camera"]["position"], float)
+    d = camera_rays(scene["camera"], width, height, subsamples)
     if "spheres" in scene:
         sphere = scene["spheres"][0]
         centre, radius = np.array(sphere["center"], float), float(sphere["radius"])

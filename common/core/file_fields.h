@@ -44,3 +44,13 @@ constexpr int field_values() {
     for (const FileField& field : K::kFields) count += field_size(field.role);
     return count;
 }
+
+// Calls f(field, at) for each field of K in order, `at` where its values start (host code).
+template <class K, class F>
+void for_each_field(F&& f) {
+    int at = 0;
+    for (const FileField& field : K::kFields) {
+        f(field, at);
+        at += field_size(field.role);
+    }
+}

@@ -19,8 +19,18 @@
 
 #include <axis_rect.h>
 #include <convex_quad.h>
+#include <file_fields.h>
 #include <kinds.h>
 #include <sphere.h>
 #include <triangle.h>
 
 using AllPrimitives = Kinds<Sphere, Triangle, ConvexQuad, AxisRect>;
+
+// Calls f(KindTag<K>{}) for every kind of AllPrimitives written as fields (file_fields.h), in
+// the list's order (host code: the loader, centring, limits).
+template <class F>
+void for_each_fields_kind(F&& f) {
+    for_each_kind(AllPrimitives{}, [&](auto kind) {
+        if constexpr (written_as_fields<typename decltype(kind)::type>) f(kind);
+    });
+}

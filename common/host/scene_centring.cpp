@@ -40,11 +40,10 @@ struct ExactPoints {
     const Scene& scene;
     bool sized() const {
         bool fields_sized = true;
-        for_each_kind(AllPrimitives{}, [&](auto kind) {
+        for_each_fields_kind([&](auto kind) {
             using K = typename decltype(kind)::type;
-            if constexpr (written_as_fields<K>)
-                fields_sized = fields_sized && scene.written.fields.of<K>().values.size() ==
-                                                   field_values<K>() * scene.of<K>().size();
+            fields_sized = fields_sized && scene.written.fields.of<K>().values.size() ==
+                                               field_values<K>() * scene.of<K>().size();
         });
         return scene.written.present && fields_sized &&
                scene.written.triangle_vertices.size() == 3 * scene.of<Triangle>().size() &&
@@ -62,8 +61,7 @@ struct ExactPoints {
         fields_of(scene.of<K>()[i], own);
         const bool have = sized();
         const WrittenFields<K>& written = scene.written.fields.of<K>();
-        int at = 0;
-        for (const FileField& field : K::kFields) {
+        for_each_field<K>([&](const FileField& field, int at) {
             if (field.role == FieldRole::Length) {
                 out[at] = have && !std::isfinite(own[at])
                               ? written.values[i * field_values<K>() + at]
@@ -73,8 +71,7 @@ struct ExactPoints {
                                             Vec3(own[at], own[at + 1], own[at + 2]));
                 p.store(out + at);
             }
-            at += field_size(field.role);
-        }
+        });
     }
     WrittenPoint vertex(size_t i, int k) const {
         const Triangle& t = scene.of<Triangle>()[i];
@@ -122,25 +119,18 @@ struct ExactPoints {
 void centre_of_bounds(const Scene& scene, double centre[3]) {
     const ExactPoints points{scene};
     BoundsD box;
-    for_each_kind(AllPrimitives{}, [&](auto kind) {  // each point, by its entry's largest length
+    for_each_fields_kind([&](auto kind) {  // each point, by its entry's largest length
         using K = typename decltype(kind)::type;
-        if constexpr (written_as_fields<K>) {
-            for (size_t i = 0; i < scene.of<K>().size(); ++i) {
-                double v[field_values<K>()];
-                points.template field_values_of<K>(i, v);
-                double margin = 0.0;
-                int at = 0;
-                for (const FileField& field : K::kFields) {
-                    if (field.role == FieldRole::Length) margin = std::max(margin, v[at]);
-                    at += field_size(field.role);
-                }
-                at = 0;
-                for (const FileField& field : K::kFields) {
-                    if (field.role == FieldRole::Point)
-                        box.add({v[at], v[at + 1], v[at + 2]}, margin);
-                    at += field_size(field.role);
-                }
-            }
+        for (size_t i = 0; i < scene.of<K>().size(); ++i) {
+            double v[field_values<K>()];
+            points.template field_values_of<K>(i, v);
+            double margin = 0.0;
+            for_each_field<K>([&](const FileField& field, int at) {
+                if (field.role == FieldRole::Length) margin = std::max(margin, v[at]);
+            });
+            for_each_field<K>([&](const FileField& field, int at) {
+                if (field.role == FieldRole::Point) box.add({v[at], v[at + 1], v[at + 2]}, margin);
+            });
         }
     });
     for (size_t i = 0; i < scene.of<Triangle>().size(); ++i) {
@@ -188,25 +178,21 @@ Scene centre_scene(Scene scene) {
     const ExactPoints points{scene};
     WrittenCoordinates moved;
     moved.present = true;
-    for_each_kind(AllPrimitives{}, [&](auto kind) {  // the points moved, the rest as they are
+    for_each_fields_kind([&](auto kind) {  // the points moved, the rest as they are
         using K = typename decltype(kind)::type;
-        if constexpr (written_as_fields<K>) {
-            for (size_t i = 0; i < scene.of<K>().size(); ++i) {
-                double v[field_values<K>()];
-                points.template field_values_of<K>(i, v);
-                int at = 0;
-                for (const FileField& field : K::kFields) {
-                    if (field.role == FieldRole::Point) {
-                        const WrittenPoint p = minus({v[at], v[at + 1], v[at + 2]}, centre);
-                        p.store(v + at);
-                    } else if (field.role == FieldRole::Length && points.sized()) {
-                        v[at] = scene.written.fields.of<K>().values[i * field_values<K>() + at];
-                    }
-                    at += field_size(field.role);
+        for (size_t i = 0; i < scene.of<K>().size(); ++i) {
+            double v[field_values<K>()];
+            points.template field_values_of<K>(i, v);
+            for_each_field<K>([&](const FileField& field, int at) {
+                if (field.role == FieldRole::Point) {
+                    const WrittenPoint p = minus({v[at], v[at + 1], v[at + 2]}, centre);
+                    p.store(v + at);
+                } else if (field.role == FieldRole::Length && points.sized()) {
+                    v[at] = scene.written.fields.of<K>().values[i * field_values<K>() + at];
                 }
-                std::vector<double>& values = moved.fields.of<K>().values;
-                values.insert(values.end(), v, v + field_values<K>());
-            }
+            });
+            std::vector<double>& values = moved.fields.of<K>().values;
+            values.insert(values.end(), v, v + field_values<K>());
         }
     });
     for (size_t i = 0; i < scene.of<Triangle>().size(); ++i) {
@@ -225,22 +211,18 @@ Scene centre_scene(Scene scene) {
     const WrittenPoint camera_look_at = minus(points.camera_look_at(), centre);
     moved.light_position = minus(points.light(), centre);
 
-    for_each_kind(AllPrimitives{}, [&](auto kind) {  // each rebuilt with its points moved
+    for_each_fields_kind([&](auto kind) {  // each rebuilt with its points moved
         using K = typename decltype(kind)::type;
-        if constexpr (written_as_fields<K>) {
-            for (size_t i = 0; i < scene.of<K>().size(); ++i) {
-                real v[field_values<K>()];
-                fields_of(scene.of<K>()[i], v);
-                int at = 0;
-                for (const FileField& field : K::kFields) {
-                    if (field.role == FieldRole::Point) {
-                        const Vec3 p = rounded(moved.fields.of<K>().point(i, at));
-                        for (int axis = 0; axis < 3; ++axis) v[at + axis] = p[axis];
-                    }
-                    at += field_size(field.role);
+        for (size_t i = 0; i < scene.of<K>().size(); ++i) {
+            real v[field_values<K>()];
+            fields_of(scene.of<K>()[i], v);
+            for_each_field<K>([&](const FileField& field, int at) {
+                if (field.role == FieldRole::Point) {
+                    const Vec3 p = rounded(moved.fields.of<K>().point(i, at));
+                    for (int axis = 0; axis < 3; ++axis) v[at + axis] = p[axis];
                 }
-                scene.of<K>()[i] = from_fields(KindTag<K>{}, v, scene.of<K>()[i].material);
-            }
+            });
+            scene.of<K>()[i] = from_fields(KindTag<K>{}, v, scene.of<K>()[i].material);
         }
     });
     for (size_t i = 0; i < scene.of<Triangle>().size(); ++i) {

@@ -68,13 +68,11 @@ double largest(const WrittenPoint& p) {
 // (file_fields.h), in AllPrimitives' order: pointer is where the file writes it ("/spheres/0").
 template <class F>
 void for_each_fields_entry(const WrittenCoordinates& w, F&& f) {
-    for_each_kind(AllPrimitives{}, [&](auto kind) {
+    for_each_fields_kind([&](auto kind) {
         using K = typename decltype(kind)::type;
-        if constexpr (written_as_fields<K>) {
-            const WrittenFields<K>& written = w.fields.of<K>();
-            for (size_t i = 0; i < written.values.size() / field_values<K>(); ++i)
-                f(kind, std::string("/") + K::kFileKey + "/" + std::to_string(i), written, i);
-        }
+        const WrittenFields<K>& written = w.fields.of<K>();
+        for (size_t i = 0; i < written.values.size() / field_values<K>(); ++i)
+            f(kind, std::string("/") + K::kFileKey + "/" + std::to_string(i), written, i);
     });
 }
 
@@ -83,14 +81,12 @@ void for_each_fields_entry(const WrittenCoordinates& w, F&& f) {
 template <class K, class Centred>
 double fields_extent(const WrittenFields<K>& written, size_t i, const Centred& centred) {
     double points = 0.0, length = 0.0;
-    int at = 0;
-    for (const FileField& field : K::kFields) {
+    for_each_field<K>([&](const FileField& field, int at) {
         if (field.role == FieldRole::Point)
             points = std::fmax(points, largest(centred(written.point(i, at))));
         if (field.role == FieldRole::Length)
             length = std::fmax(length, written.values[i * field_values<K>() + at]);
-        at += field_size(field.role);
-    }
+    });
     return points + length;
 }
 
@@ -134,12 +130,10 @@ PlacementProblem placement_problem(const Scene& scene, size_t file_triangles,
     PlacementProblem first;  // the first problem found
     for_each_fields_entry(w, [&](auto kind, const std::string& p, const auto& written, size_t i) {
         using K = typename decltype(kind)::type;
-        int at = 0;
-        for (const FileField& field : K::kFields) {
+        for_each_field<K>([&](const FileField& field, int at) {
             if (first.empty() && field.role == FieldRole::Point)
                 first = coordinate(written.point(i, at), p + "/" + field.key);
-            at += field_size(field.role);
-        }
+        });
     });
     if (!first.empty()) return first;
     for (size_t i = 0; i < w.triangle_vertices.size(); ++i) {
@@ -173,8 +167,7 @@ PlacementProblem placement_problem(const Scene& scene, size_t file_triangles,
     for_each_fields_entry(w, [&](auto kind, const std::string& p, const auto& written, size_t i) {
         using K = typename decltype(kind)::type;
         const double own_extent = fields_extent<K>(written, i, centred);
-        int at = 0;
-        for (const FileField& field : K::kFields) {
+        for_each_field<K>([&](const FileField& field, int at) {
             if (first.empty() && field.role == FieldRole::Length) {
                 const std::string what = std::string("a ") + field.key;
                 const double size = written.values[i * field_values<K>() + at];
@@ -187,8 +180,7 @@ PlacementProblem placement_problem(const Scene& scene, size_t file_triangles,
                 if (found.empty()) found = scene_scale_problem(what.c_str(), size, extent, limits);
                 if (!found.empty()) first = {p + "/" + field.key, found};
             }
-            at += field_size(field.role);
-        }
+        });
     });
     if (!first.empty()) return first;
     for (size_t i = 0; 3 * i < w.triangle_vertices.size(); ++i) {

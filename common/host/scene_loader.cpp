@@ -323,8 +323,7 @@ void read_fields_kind(const SceneReader& r, const PrimitiveReader& prims, Scene&
         const std::string p = std::string("/") + K::kFileKey + "/" + std::to_string(i);
         r.check_keys(list[i], p, keys);
         double written[kValues];
-        int at = 0;
-        for (const FileField& field : K::kFields) {
+        for_each_field<K>([&](const FileField& field, int at) {
             const std::string fp = p + "/" + field.key;
             const json& v = r.require(list[i], p, field.key);
             if (field.role == FieldRole::Point) {
@@ -343,8 +342,7 @@ void read_fields_kind(const SceneReader& r, const PrimitiveReader& prims, Scene&
                     r.fail(fp, "expected a direction (a nonzero, finite vector)");
                 WrittenPoint{d.x / length, d.y / length, d.z / length}.store(written + at);
             }
-            at += field_size(field.role);
-        }
+        });
         real values[kValues];
         for (int k = 0; k < kValues; ++k) values[k] = static_cast<real>(written[k]);
         scene.of<K>().push_back(from_fields(KindTag<K>{}, values, prims.material(list[i], p)));
@@ -505,10 +503,7 @@ Scene parse_scene(const std::string& text, const std::string& name) {
     if (!parsed.duplicate_key_pointer.empty())
         r.fail_key(parsed.duplicate_key_pointer, "duplicate key \"" + parsed.duplicate_key + "\"");
     std::vector<const char*> keys = {"camera", "background", "light", "materials"};
-    for_each_kind(AllPrimitives{}, [&](auto kind) {
-        using K = typename decltype(kind)::type;
-        if constexpr (written_as_fields<K>) keys.push_back(K::kFileKey);
-    });
+    for_each_fields_kind([&](auto kind) { keys.push_back(decltype(kind)::type::kFileKey); });
     keys.insert(keys.end(), {"triangles", "quads", "render"});
     r.check_keys(root, "", keys);
 
@@ -520,10 +515,8 @@ Scene parse_scene(const std::string& text, const std::string& name) {
         scene.background = r.non_negative_vec3(root["background"], "/background");
     read_light(r, root, scene);
     const PrimitiveReader prims(r, root, read_materials(r, root, scene));
-    for_each_kind(AllPrimitives{}, [&](auto kind) {
-        using K = typename decltype(kind)::type;
-        if constexpr (written_as_fields<K>) read_fields_kind<K>(r, prims, scene);
-    });
+    for_each_fields_kind(
+        [&](auto kind) { read_fields_kind<typename decltype(kind)::type>(r, prims, scene); });
     read_triangles(r, prims, scene);
     read_render_settings(r, root, scene.render);
     const size_t file_triangles = root.contains("triangles") ? root["triangles"].size() : 0;

@@ -40,11 +40,9 @@ double detail_size(const K& primitive) {
         real values[field_values<K>()];
         fields_of(primitive, values);
         double smallest = INFINITY;
-        int at = 0;
-        for (const FileField& field : K::kFields) {
+        for_each_field<K>([&](const FileField& field, int at) {
             if (field.role == FieldRole::Length) smallest = std::min(smallest, double(values[at]));
-            at += field_size(field.role);
-        }
+        });
         return std::isfinite(smallest) ? smallest : 0.0;
     } else {
         return longest_edge(primitive);

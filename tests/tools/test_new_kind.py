@@ -26,6 +26,7 @@ import pytest
 
 from labkit.harness import ROOT
 from labkit.pfm import read_pfm
+from labkit.scenes import camera_rays
 from tests.tools.test_new_lab import run, scratch_copy
 
 EXAMPLES = pathlib.Path(__file__).parent / "new_kind"
@@ -56,25 +57,6 @@ def render(root: pathlib.Path, lab: str, scene: pathlib.Path, out: pathlib.Path,
         args += [f"--{key}", str(value)]
     run(root, *args)
     return read_pfm(out).astype(np.float64).mean(axis=2)
-
-
-def camera_rays(camera: dict, width: int, height: int, subsamples: int) -> np.ndarray:
-    """Unit directions through subsamples^2 points of every pixel, as labkit.scenes'
-    floor_view_expected lays them out (the renderer's Camera)."""
-    pos = np.array(camera["position"], float)
-    forward = np.array(camera["look_at"], float) - pos
-    forward /= np.linalg.norm(forward)
-    right = np.cross(forward, camera["up"])
-    right /= np.linalg.norm(right)
-    up = np.cross(right, forward)
-    half_h = math.tan(math.radians(camera["vfov"]) / 2)
-    half_w = half_h * width / height
-    offs = (np.arange(subsamples) + 0.5) / subsamples
-    gx, gy = np.meshgrid((np.arange(width)[:, None] + offs).ravel(),
-                         (np.arange(height)[:, None] + offs).ravel())
-    d = (forward + right * (-half_w + 2 * half_w * gx / width)[..., None]
-         + up * (half_h - 2 * half_h * gy / height)[..., None])
-    return d / np.linalg.norm(d, axis=-1, keepdims=True)
 
 
 def per_pixel(values: np.ndarray, width: int, height: int, subsamples: int) -> np.ndarray:
