@@ -301,6 +301,14 @@ constexpr bool lane_by_lane = !has_kind<PacketKinds, K>;
 static_assert(kinds_within<PacketKinds, AllPrimitives> &&
                   kind_index<AllPrimitives, AxisRect> == PacketKinds::kCount - 1,
               "the kinds without a packet test follow those with one in AllPrimitives");
+// And take no RayShear: the scalar loops visit the kinds that do together with the triangles
+// (for_each_kind_with_shear), which would put such a kind in another place of the order.
+template <class... K>
+constexpr bool lane_by_lane_kinds_shear(Kinds<K...>) {
+    return (false || ... || (lane_by_lane<K> && K::kShearsRay));
+}
+static_assert(!lane_by_lane_kinds_shear(AllPrimitives{}),
+              "a kind without a packet test takes no RayShear");
 
 // An N-lane value: op(lane) in the lanes of `lanes`, `otherwise` in the others.
 template <class F, class Op>
