@@ -29,7 +29,8 @@ constexpr PrimitiveKind primitive_kind = PrimitiveKindOf<K>::value;
 using AnyGeometry = AllPrimitives;             // every scene: the default
 using BoxGeometry = Kinds<Sphere, AxisRect>;   // spheres and rectangles (Cornell)
 
-// Whether a set holds a kind whose test shears the ray (K::kShearsRay; RayShear, triangle.h).
+// The position in Set of the first kind whose test shears the ray (K::kShearsRay; RayShear,
+// triangle.h).
 template <class... K>
 constexpr int first_shearing_index(Kinds<K...>) {
     const bool shears[] = {K::kShearsRay..., false};
@@ -39,8 +40,6 @@ constexpr int first_shearing_index(Kinds<K...>) {
 }
 template <class Set>
 constexpr int first_shearing = first_shearing_index(Set{});  // -1: none
-template <class Set>
-constexpr bool needs_shear = first_shearing<Set> >= 0;
 
 // Whether the scene has primitives of a kind of Set whose test shears the ray: only then is
 // the shear built (a scene of spheres and rectangles pays nothing for it).
