@@ -14,6 +14,7 @@ import argparse
 import dataclasses
 import os
 import pathlib
+import re
 import signal
 import sys
 import time
@@ -475,11 +476,24 @@ def print_table(lab: str, binary: pathlib.Path, results: dict) -> None:
         print(results["output"])
 
 
+# A line that says why a build stopped: the compilers' errors and fatal errors ("nvcc fatal",
+# "ptxas fatal"), a crash or a limit the shell reports, the sandbox's own verdict.
+STOP_WORDS = re.compile(r"error|fatal|segmentation fault|killed|aborted|terminate called|"
+                        r"limit exceeded|timed out", re.IGNORECASE)
+MAKE_STOPPED = re.compile(r"^make(\[\d+\])?: \*\*\* ")
+
+
 def first_errors(text: str, lines: int = 20) -> str:
-    """The compiler's first error lines (what a student needs to see first)."""
+    """The compiler's first error lines (what a student needs to see first). Where nothing but
+    make's own "*** ... Error N" says why (nvcc running its compilers in parallel threads
+    prints nothing when one of them crashes), the build's last lines stand in, said as such."""
     all_lines = text.splitlines()
-    errors = [line for line in all_lines if "error" in line.lower()] or all_lines
-    return "\n".join(errors[:lines])[:4000]
+    errors = [line for line in all_lines if STOP_WORDS.search(line)]
+    if errors and all(MAKE_STOPPED.match(line) for line in errors):
+        kept = [line for line in all_lines if line.strip()][-lines:]
+        return "\n".join(["the compiler stopped without an error message; the build's last "
+                           "lines:", *kept])[:4000]
+    return "\n".join((errors or all_lines)[:lines])[:4000]
 
 
 def build_warnings(text: str, lines: int = 20) -> str:

@@ -148,3 +148,18 @@ def test_build_warnings_are_kept():
     text = "render.cpp:12:9: warning: unused variable 'x' [-Wunused-variable]\n   12 | int x;\n"
     assert "unused variable" in build_warnings(text)
     assert build_warnings("") == "" and build_warnings("g++ -O2 -c render.cpp\n") == ""
+
+
+def test_a_build_that_stopped_without_a_message_shows_its_last_lines():
+    """nvcc, running its compilers in parallel threads, exits 255 and prints nothing when one
+    of them crashes: make's own line alone would name no cause."""
+    from grading.grade import first_errors
+    silent = "exited with status 2\nnvcc -O3 render.cu -o lab\nmake: *** [cuda.mk:103: x] Error 255"
+    shown = first_errors(silent)
+    assert "without an error message" in shown and "exited with status 2" in shown, shown
+    assert "nvcc -O3 render.cu" in shown, shown
+    fatal = "exited with status 2\nptxas fatal   : Memory allocation failure\n" \
+            "make: *** [cuda.mk:103: x] Error 255"
+    assert first_errors(fatal).splitlines()[0].startswith("ptxas fatal"), first_errors(fatal)
+    compiler = "render.cpp:3:1: error: expected ';'\nmake: *** [Makefile:9: variant] Error 1"
+    assert first_errors(compiler).splitlines()[0] == "render.cpp:3:1: error: expected ';'"
