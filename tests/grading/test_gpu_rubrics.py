@@ -99,8 +99,8 @@ def test_speed_is_measured_against_the_labs_own_reference(lab, monkeypatch):
     assert seen["binary"] == "student-binary"
     assert seen["baseline"] == seen["overhead_reference"] == ROOT / f"lab{lab}-ref"
     assert seen["scale"] == GPU_TIMED_SCALE >= 8 and 0 < seen["bar"] < 1
-    # At least 8e8 paths: 0.3-0.4 s of each reference's kernel time on the H200 (lab 06, the
-    # slowest, renders 2.5 Gpaths/s there; grading/grade.py), far above the ~0.3 s start-up.
+    # At least 8e8 paths: far above the ~0.3 s start-up on any GPU the kit targets (each
+    # lab's spp gives GPU_TIMED_SECONDS at the record's throughput: test_gpu_figures.py).
     assert seen["spp"] * (64 * seen["scale"]) ** 2 >= 8e8
 
 
