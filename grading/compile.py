@@ -22,7 +22,7 @@ from labkit import gpu
 from labkit.sandbox import Limits, Runner
 
 COMPILE_LIMITS = Limits(wall_seconds=300, cpu_seconds=600, output_bytes=1 << 20)
-COMPILE_CHECK_ARCH = "-gencode arch=compute_90,code=sm_90"  # CUDA sources where no GPU is
+COMPILE_CHECK_ARCH = "-gencode arch=compute_90,code=sm_90"  # a CUDA build where no GPU is
 
 _kept: list[pathlib.Path] = []
 
