@@ -30,15 +30,18 @@ os.environ.setdefault("OMPI_ALLOW_RUN_AS_ROOT", "1")
 os.environ.setdefault("OMPI_ALLOW_RUN_AS_ROOT_CONFIRM", "1")
 
 
+# lab02-ref runs the widest packets the CPU has (AVX-512 or AVX2): the ISA it ran is in the
+# row's `device` and under the table.
+PACKETS = "SIMD B: packets"
+
+
 def rows(cores: int):
     """(label, binary, threads, launcher, cores used)"""
     mpirun = ["mpirun", "--oversubscribe", "--bind-to", "none", "-np", str(cores)]
     return [
         ("serial (lab 01)", "lab01-ref", None, [], 1),
         ("SIMD A: SSE vec3", "lab02a-ref", None, [], 1),
-        # lab02-ref runs the widest packets the CPU has (AVX-512 or AVX2): the ISA it ran is
-        # in the row's `device` and under the table.
-        ("SIMD B: packets", "lab02-ref", None, [], 1),
+        (PACKETS, "lab02-ref", None, [], 1),
         (f"OpenMP, {cores} threads", "lab03-ref", cores, [], cores),
         (f"OpenMP + SIMD, {cores} threads", "lab03-simd-ref", cores, [], cores),
         (f"MPI, {cores} ranks", "lab04-ref", 1, mpirun, cores),
@@ -86,7 +89,7 @@ def main() -> int:
             ran[label] = run.json.get("device", "")
             best[label] = s if best[label] is None else min(best[label], s)
     serial = best["serial (lab 01)"]
-    device = run_lab(ROOT / "lab01-ref", width=8, height=8, spp=1).json["device"]
+    device = ran["serial (lab 01)"]
     capacity = measure_parallel(
         lambda: run_lab(ROOT / "lab01-ref", width=size // 4, height=size // 4, spp=spp,
                         bounces=4).json["seconds"], {}, rounds=a.repeat).capacity
@@ -104,8 +107,8 @@ def main() -> int:
             continue
         speedup = serial / best[label]
         print(f"{label:<32} {best[label]:>8.3f} {speedup:>7.2f}x {speedup / used:>9.0%}")
-    if ran.get("SIMD B: packets"):
-        print(f"SIMD B ran on {ran['SIMD B: packets']}")
+    if ran.get(PACKETS):
+        print(f"SIMD B ran on {ran[PACKETS]}")
     if a.record:
         record = {
             "what": f"Cornell {size}x{size}, {spp} spp, 4 bounces, best of {a.repeat}",
