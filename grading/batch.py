@@ -204,7 +204,14 @@ def _submitters(meta) -> list[dict[str, str]] | None:
             isinstance(p, dict) and all(isinstance(v, (str, int, float)) for v in p.values())
             for p in people):
         return None  # a list, a tag read as nothing, where text belongs
-    return [{str(k).lstrip(":"): str(v) for k, v in person.items()} for person in people]
+    return [{_text(k).lstrip(":"): _text(v) for k, v in person.items()} for person in people]
+
+
+def _text(value) -> str:
+    """A YAML value as text: a character beyond U+FFFF escaped as a surrogate pair (as a
+    JSON-style writer does) joined into one; a lone surrogate, which no file name can hold,
+    read as U+FFFD."""
+    return str(value).encode("utf-16", "surrogatepass").decode("utf-16", "replace")
 
 
 def parse_export_metadata(text: str) -> dict[str, list[dict[str, str]] | None]:
@@ -224,7 +231,7 @@ def parse_export_metadata(text: str) -> dict[str, list[dict[str, str]] | None]:
         if not isinstance(data, dict):
             raise MetadataError(f"a {type(data).__name__} where a map of submission "
                                 f"folders belongs")
-        return {str(folder): _submitters(meta) for folder, meta in data.items()}
+        return {_text(folder): _submitters(meta) for folder, meta in data.items()}
     found: dict[str, list[dict[str, str]]] = {}
     folder, person = None, None
     for line in text.splitlines():

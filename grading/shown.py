@@ -12,29 +12,41 @@ from __future__ import annotations
 import html as _html
 import unicodedata
 
-# Format characters that reorder what is shown (right-to-left overrides and isolates): a
-# name could show one text and hold another.
-BIDI = set("\u061c\u200e\u200f\u202a\u202b\u202c\u202d\u202e\u2066\u2067\u2068\u2069")
+# Characters that show nothing yet are not format characters: the variation selectors, the
+# combining grapheme joiner, Mongolian free variation selectors, Khmer's inherent vowels and
+# the Hangul fillers (Unicode's Default_Ignorable_Code_Point, less the Cf ones). Two names
+# differing only by them look alike.
+INVISIBLE = {*map(chr, (0x034F, 0x115F, 0x1160, 0x17B4, 0x17B5, 0x180B, 0x180C, 0x180D,
+                        0x180F, 0x3164, 0xFFA0)),
+             *map(chr, range(0xFE00, 0xFE10)), *map(chr, range(0xE0100, 0xE01F0))}
+# Categories shown escaped: controls (Cc), format characters (Cf: zero-width spaces and
+# joiners, bidi overrides that show one text and hold another, the BOM, soft hyphens,
+# invisible operators, tags), surrogates (Cs), private use
+# (Co), unassigned code points (Cn: the tag block's unassigned ones, and whatever this
+# Python's Unicode tables do not know yet), line and paragraph separators (Zl, Zp).
+ESCAPED_CATEGORIES = ("Cc", "Cf", "Cs", "Co", "Cn", "Zl", "Zp")
 # Cells a spreadsheet reads as a formula (or, tab and CR, as the start of another cell).
 FORMULA_START = ("=", "+", "-", "@", "\t", "\r")
 
 
 def _escaped(ch: str) -> str:
     code = ord(ch)
-    return f"\\x{code:02x}" if code < 0x100 else f"\\u{code:04x}"
+    return (f"\\x{code:02x}" if code < 0x100 else f"\\u{code:04x}" if code < 0x10000
+            else f"\\U{code:08x}")
 
 
 def clean(text: object) -> str:
     """`text` as plain visible characters and newlines: every other control character
-    (escapes, carriage returns, backspaces, bells), surrogates, line separators and bidi
-    overrides shown escaped (`\\x1b`), a tab as a space, CR LF as LF."""
+    (escapes, carriage returns, backspaces, bells), every format, private-use, unassigned or
+    otherwise invisible character (bidi overrides, zero-width spaces and joiners), surrogates
+    and line separators shown escaped (`\\x1b`, `\\u200b`), a tab as a space, CR LF as LF."""
     out = []
     for ch in str(text).replace("\r\n", "\n"):
         if ch == "\n":
             out.append(ch)
         elif ch == "\t":
             out.append(" ")
-        elif ch in BIDI or unicodedata.category(ch) in ("Cc", "Cs", "Zl", "Zp"):
+        elif ch in INVISIBLE or unicodedata.category(ch) in ESCAPED_CATEGORIES:
             out.append(_escaped(ch))
         else:
             out.append(ch)

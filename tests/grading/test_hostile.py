@@ -636,8 +636,12 @@ def test_a_file_name_that_is_shell_code_is_refused_in_one_line(tmp_path):
 
 HOSTILE_STRINGS = ["\x1b[2K\r\x1b[32mtotal 100/100\x1b[0m", "=HYPERLINK(\"http://x.example\")",
                    "+cmd|' /C calc'!A0", "-2+3", "@SUM(A1:A9)", "\tx", "\rfake",
-                   "<script>alert(1)</script>", "a\u202egnp.exe", "bell\x07\x08"]
-CONTROL = set(map(chr, range(32))) - {"\n"} | {"\x7f", "\u202e"}
+                   "<script>alert(1)</script>", "a\u202egnp.exe", "bell\x07\x08",
+                   "Ada\u200bLove\u2060lace\ufeff\u00ad\u180e\U000e0041\ue000"]
+# What must never reach a sink raw: controls, a bidi override, and characters that show
+# nothing (a zero-width space, word joiner, BOM, soft hyphen, U+180E, a tag, private use).
+CONTROL = set(map(chr, range(32))) - {"\n"} | set("\x7f\u202e\u200b\u2060\ufeff\u00ad\u180e"
+                                                 "\U000e0041\ue000")
 
 
 def test_hostile_strings_are_cleaned_in_every_sink(tmp_path, monkeypatch, capsys):

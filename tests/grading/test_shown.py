@@ -6,7 +6,7 @@ from grading import shown
 
 
 def test_names_and_lines_are_kept():
-    name = "Zoë Ñúñez, \u0645\u06cc\u200c\u0631\u0627 (0042)"  # a Persian name keeps its ZWNJ
+    name = "Zoë Ñúñez, \u0645\u06cc\u0631\u0627, 李小龍, Ελένη 👩 (0042)"
     assert shown.clean(name) == name
     assert shown.clean("render.cpp:3:1: error\n  3 | x") == "render.cpp:3:1: error\n  3 | x"
 
@@ -23,3 +23,19 @@ def test_controls_are_shown_escaped(text, expected):
     ("@SUM(A1)", "'@SUM(A1)"), ("\t=1", "'=1"), ("a\nb", "a b"), ("", "")])
 def test_cells_never_start_a_formula(value, expected):
     assert shown.cell(value) == expected
+
+
+# Each shows nothing, so two names differing by one look alike on the class page: zero-width
+# space, non-joiner and joiner, word joiner, BOM, soft hyphen, Mongolian vowel separator,
+# invisible times, the deprecated format characters, tags (assigned and not), private use,
+# a variation selector and a Hangul filler.
+INVISIBLE = ["\u200b", "\u200c", "\u200d", "\u2060", "\ufeff", "\u00ad", "\u180e", "\u2062",
+             "\u206a", "\u206f", "\U000e0000", "\U000e0001", "\U000e0041", "\U000e007f",
+             "\ue000", "\U000f0000", "\ufe0f", "\u3164"]
+
+
+@pytest.mark.parametrize("ch", INVISIBLE, ids=[f"U+{ord(c):04X}" for c in INVISIBLE])
+def test_invisible_characters_are_shown_escaped(ch):
+    cleaned = shown.clean(f"Ada{ch}Lovelace")
+    assert ch not in cleaned and cleaned.isascii(), repr(cleaned)
+    assert shown.line(f"Ada{ch}") != shown.line("Ada") and ch not in shown.html(ch)
