@@ -44,7 +44,7 @@ from grading import class_page, hidden, references, shown
 from grading.grade import BUDGET_SECONDS, RUBRICS
 from grading.speed_numbers import speed_numbers
 from grading.verdicts import failure_cause, flagged, provisional_points
-from labkit import gpu
+from labkit import gpu, sandbox
 from labkit.harness import ROOT
 
 # A grade ends within the grader's budget (grade.BUDGET_SECONDS) plus a compile; a grader
@@ -489,6 +489,22 @@ def write_report(out: pathlib.Path, lab: str, rows: dict[str, dict | None],
           f"{count} flagged{' (regrade them: make grade-batch ... ONLY=flagged)' if count else ''}")
 
 
+def exposure_problem(folders: list[pathlib.Path]) -> str | None:
+    """One line refusing the batch where a student's run could read the class's hand-ins or
+    results (the user sandbox without Landlock: labkit/sandbox.py, exposed), else None."""
+    if sandbox.probe() is not None:
+        return None  # each grader refuses in its own results.json, saying why
+    for folder in folders:
+        folder.mkdir(parents=True, exist_ok=True)
+        if sandbox.exposed(folder):
+            return (f"refusing to grade the class: this kernel has no Landlock, so each run, "
+                    f"in the user sandbox, could read {shown.line(folder.resolve())}, which "
+                    f"every user may enter; close it to other users (chmod 700 "
+                    f"{shown.line(folder.resolve())}) or grade where bubblewrap or Landlock "
+                    f"works")
+    return None
+
+
 def main(argv=None) -> int:
     p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     p.add_argument("lab", choices=sorted(RUBRICS))
@@ -510,6 +526,9 @@ def main(argv=None) -> int:
     if (a.only or a.task is not None) and not (a.out / SECRET_FILE).is_file():
         print(f"error: {'ONLY=flagged' if a.only else '--task'} needs an earlier batch's "
               f"report in {a.out} (its secret and results); none there", file=sys.stderr)
+        return 2
+    if not a.merge and (line := exposure_problem([a.submissions, a.out])):
+        print(f"error: {line}", file=sys.stderr)
         return 2
     # One secret for the batch, saved for regrades: every student gets the same hidden scene.
     env = {**os.environ, "GRADING_SECRET": batch_secret(a.out)}

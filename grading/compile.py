@@ -17,8 +17,8 @@ import pathlib
 import shutil
 import tempfile
 
-from grading import students_tree
-from labkit import gpu
+from grading import source_rules, students_tree
+from labkit import double_twin, gpu, registry
 from labkit.sandbox import Limits, Runner
 
 COMPILE_LIMITS = Limits(wall_seconds=300, cpu_seconds=600, output_bytes=1 << 20)
@@ -35,12 +35,13 @@ def _remove_kept() -> None:
 
 def keep_binary(binary: pathlib.Path) -> pathlib.Path:
     """A copy of `binary` in a folder removed when the grader exits."""
-    folder = pathlib.Path(tempfile.mkdtemp(prefix="graded-binary-"))
-    folder.chmod(0o755)
+    folder = pathlib.Path(tempfile.mkdtemp(prefix="graded-binary-"))  # the grader's alone:
+    folder.chmod(0o700)  # each run gets a copy (labkit/sandbox.py, Runner.input)
     _kept.append(folder)
     kept = folder / "lab"
     shutil.copyfile(binary, kept)
     kept.chmod(0o755)
+    double_twin.built_from_a_handin(kept)  # whatever it holds, it runs as it was built
     return kept
 
 
@@ -57,6 +58,11 @@ def build_in_sandbox(variant_lab: str, handin: pathlib.Path, target: str = "vari
         files, missing = (files, []) if files is not None else \
             students_tree.collect(handin, variant_lab)
     except students_tree.HandInError as e:
+        return None, f"refused: {e}", students_tree.ignored(handin)
+    lab = students_tree.lab_number(variant_lab)
+    try:
+        source_rules.check(files, registry.lab(lab).handin_kib, lab)
+    except source_rules.SourceError as e:
         return None, f"refused: {e}", students_tree.ignored(handin)
     note = "\n".join(line for line in (
         students_tree.ignored(handin),  # programs and other files: never run, only named
@@ -75,10 +81,13 @@ def build_in_sandbox(variant_lab: str, handin: pathlib.Path, target: str = "vari
             # show whether the sources compile, which one architecture shows as well as six.
             extra.append(f"CUDA_ARCH={gpu.cuda_arch_flags() or COMPILE_CHECK_ARCH}")
         with Runner(trusted=trusted) as r:
+            r.close_to_others(work)
             r.bind(tree)
             r.bind(src, writable=True)
             out = r.run(["make", "-s", "-C", str(tree), target, f"VARIANT_LAB={variant_lab}",
                          f"VARIANT={src}", *extra], COMPILE_LIMITS)
+        if out.foreign:  # the compiler and make are the system's: nothing else may run
+            return None, f"refused: its build ran a program it was not given: {out.foreign}", note
         binary = src / "lab"
         if out.failure is None and binary.is_file() and not binary.is_symlink():
             return keep_binary(binary), "", note

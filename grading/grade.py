@@ -287,17 +287,29 @@ def grade(lab: str, binary: pathlib.Path, heatmap_dir: pathlib.Path, *, trusted:
             results.refuse(reason, regrade=True)
             return results.as_dict()
     start = time.perf_counter()
+    foreign_seen, sweeps_seen = len(sandbox.FOREIGN_CODE), len(sandbox.SWEEP_PROBLEMS)
+
+    def foreign_code() -> str | None:
+        return (sandbox.FOREIGN_CODE[foreign_seen:] or [None])[0]
     with draws.secret(secret), symptoms.grading(lab), rerun_as(f"./lab{lab}"):
         grade_items(rubric, binary, heatmap_dir, secret, results, run_policy, limits,
-                    budget_seconds, start, progress, lambda: references.problem(lab), parts)
+                    budget_seconds, start, progress, lambda: references.problem(lab), parts,
+                    stop=foreign_code)
+    if what := foreign_code():
+        results.ran_foreign_code(what)
+    for problem in sandbox.SWEEP_PROBLEMS[sweeps_seen:]:
+        results.for_staff.append(f"the sandbox could not remove everything a run left "
+                                 f"({problem}); the grade stands")
+        results.notes.append(results.for_staff[-1])
     results.complete(time.perf_counter() - start)
     return results.as_dict()
 
 
 def grade_items(rubric, binary, heatmap_dir, secret, results, run_policy, limits,
                 budget_seconds, start, progress=None, reference_problem=None,
-                parts=None) -> None:
-    """Each item of the rubric in grading order, results updated after each. A check whose
+                parts=None, stop=None) -> None:
+    """Each item of the rubric in grading order, results updated after each, until `stop()`
+    says why the grade ends (a foreign program ran: nothing after it counts). A check whose
     requirements failed is not run (untrusted: the grade's time goes to what counts), unless
     the grade is trusted or the check always runs: then it runs and shows what it saw, its
     points "not counted until" the requirements pass. A check that failed while a reference
@@ -351,6 +363,8 @@ def grade_items(rubric, binary, heatmap_dir, secret, results, run_policy, limits
             if progress:
                 progress(item, test)
         results.changed()
+        if stop and stop():
+            return
 
 
 def gate_unconfirmed(test: Test) -> bool:

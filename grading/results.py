@@ -79,6 +79,7 @@ class Results:
         self.refused = False
         self.start = time.perf_counter()
         self.sandbox = "none (--trusted)"  # which sandbox ran the submission (labkit/sandbox.py)
+        self.for_staff: list[str] = []  # what course staff must look at (a foreign program)
 
     def add(self, test: Test) -> None:
         if not any(t.id == test.id for t in self.tests):
@@ -103,6 +104,17 @@ class Results:
         for t in self.tests:
             if not t.finished:
                 t.finish(0, f"not graded: {reason}", regrade=regrade)
+        self.changed()
+
+    def ran_foreign_code(self, what: str) -> None:
+        """A run of the submission mapped code it did not build (labkit/sandbox.py, ExecCheck):
+        a copy of a program it was given is no hand-in, whatever its images. Every test
+        scores 0, finished or not, and the grade is marked for course staff."""
+        reason = f"ran a program it did not build ({what}): scored 0 and marked for course staff"
+        self.for_staff.append(reason)
+        self.notes.append(reason)
+        for t in self.tests:
+            t.finish(0, f"not graded: {reason}")
         self.changed()
 
     def interrupt(self, reason: str) -> None:
@@ -133,6 +145,7 @@ class Results:
              "execution_time": round(time.perf_counter() - self.start, 3),
              "output": shown.clean("\n".join(self.notes)), "visibility": "visible",
              "sandbox": self.sandbox,
+             **({"for_staff": shown.clean("\n".join(self.for_staff))} if self.for_staff else {}),
              "tests": [t.as_dict() for t in self.tests]}
         board = leaderboard(d)  # labs 02-07, once their speed was measured on a correct image
         if board:

@@ -30,9 +30,10 @@ def provisional_points(results: dict) -> int:
 
 def flagged(results: dict) -> bool:
     """To be graded again on a quiet machine: provisional points, or refused for the
-    machine's sake (no GPU), or no results at all."""
+    machine's sake (no GPU), or no results at all; or for course staff to look at (a
+    program it did not build ran, or a run's leftovers could not be removed)."""
     return (any(t.get("extra_data", {}).get("regrade") for t in results.get("tests", []))
-            or not results.get("tests"))
+            or not results.get("tests") or bool(results.get("for_staff")))
 
 
 def waiting(test: dict) -> bool:

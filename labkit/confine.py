@@ -1,37 +1,50 @@
-"""The innermost wrapper of the user sandbox (labkit/sandbox.py, where namespaces cannot be
-had): run by the system's Python as the sandbox user, after setpriv and prlimit, it loads a
-libseccomp filter (python3-seccomp) and execs the submitted command, which inherits the
-filter and cannot remove it.
+"""The innermost wrapper of every sandboxed run (labkit/sandbox.py), in both sandboxes: run by
+the system's Python as the sandbox's user (inside bubblewrap, or after setpriv and prlimit
+where namespaces cannot be had), it confines the file system with Landlock, loads a
+libseccomp filter (python3-seccomp) and execs the command, which inherits both and can
+remove neither.
 
-    /usr/bin/python3 -I confine.py [--ro PATH]... [--rw PATH]... [--fixed-affinity]
-                                   [--ip-sockets] -- COMMAND...
-    /usr/bin/python3 -I confine.py --export-affinity-filter > FILTER.bpf
+    /usr/bin/python3 -I confine.py [--ro PATH]... [--exec PATH]... [--rw PATH]...
+                                   [--device PATH]... [--fixed-affinity] [--ip-sockets]
+                                   -- COMMAND...
 
-Where the kernel offers Landlock (and the container's seccomp profile lets it through), the
-file system is confined too: read and execute only under the system's folders (/usr, /bin,
-/lib*, /etc, /proc, /sys, /dev) and each --ro PATH, write only under each --rw PATH (its
-scratch folder, the build's output folder), /dev/shm and device files such as /dev/null.
-Without Landlock the permissions alone keep the grader's files from the sandbox user.
+Only what the run was given may run. Where the kernel offers Landlock (and a container's
+seccomp profile lets it through), files may be executed only from the system's folders (/usr,
+/bin, /sbin, /lib*) and each --exec PATH (the staged binary's read-only folder); read only
+there, under /etc, /proc, /sys, /dev and /run, and under each --ro PATH; written (never
+executed) only under each --rw PATH (its scratch folder; inside bubblewrap its private /tmp
+and /dev/shm), each --device PATH (a GPU's nodes) and device files such as /dev/null. So
+nothing a run writes can be executed, and in the user sandbox nothing is written where a
+later run could read it (/dev/shm and /tmp are shared there: the run's TMPDIR is its scratch).
+Without Landlock the permissions alone keep the grader's files from the sandbox user, and the
+grader's check of every executable mapping (labkit/sandbox.py, ExecCheck) finds a program
+run from a written file.
 
-Refused, with EPERM: sockets other than AF_UNIX (no network), ptrace and reading or writing
-other processes' memory, the kernel keyrings, every namespace and mount call (unshare,
-setns, clone with a CLONE_NEW* flag, mount and the new mount API, pivot_root, chroot), bpf,
-perf events, userfaultfd, module and kexec loading, reboot, swap and clock setting, and
-POSIX message queues (mq_open: the queues live outside any folder the grader sweeps after a
-run, labkit/boxes.py). clone3,
-whose flags sit in memory a filter cannot read, answers ENOSYS, so the C library falls back
-to clone, whose flags it can.
+The filter refuses, with EPERM, what would run code that is no file of the system's or the
+staged binary: memfd_create without MFD_NOEXEC_SEAL (an executable memory file), execveat
+(fexecve), anonymous memory mapped executable (mmap with PROT_EXEC and MAP_ANONYMOUS, and
+mprotect or pkey_mprotect adding PROT_EXEC, which a loader of its own would need), and SysV
+shared memory attached executable (shmat with SHM_EXEC). A file mapped executable by hand
+(ld.so run on a written file) is what the grader's check sees.
+
+Refused too: sockets other than AF_UNIX (no network), ptrace and reading or writing other
+processes' memory, the kernel keyrings, every namespace and mount call (unshare, setns, clone
+with a CLONE_NEW* flag, mount and the new mount API, pivot_root, chroot: so no run can show
+the grader's check another file at a system path), bpf, perf events, userfaultfd, module and
+kexec loading, reboot, swap and clock setting, and POSIX message queues (mq_open: the queues
+live outside any folder the grader sweeps after a run, labkit/boxes.py). clone3, whose flags
+sit in memory a filter cannot read, answers ENOSYS, so the C library falls back to clone,
+whose flags it can.
 
 A run under mpirun needs IP sockets (--ip-sockets): OpenMPI's PMIx server, which every rank
 reaches from MPI_Init, listens on loopback TCP only (PMIx 4 has no Unix-socket transport), so
 there AF_INET and AF_INET6 are let through and no filter can tell loopback from the network
 (the address a connect names lies in memory a filter cannot read). grading/README.md says
-what that leaves open and where lab 04 is graded without it.
+what that leaves open and where lab 04 is graded without it. Inside bubblewrap, whose network
+namespace holds only its own loopback, IP sockets are always let through.
 
 A run confined to some CPUs (Limits.cpu: lab 02's timed runs, on one) must not widen its
-affinity again: with --fixed-affinity sched_setaffinity answers EPERM as well. Bubblewrap's
-runs get that one rule alone, as the compiled filter --export-affinity-filter writes (bwrap
---seccomp FD): its namespaces are their other walls.
+affinity again: with --fixed-affinity sched_setaffinity answers EPERM as well.
 """
 import errno
 import os
@@ -53,11 +66,22 @@ REFUSED = ("ptrace", "process_vm_readv", "process_vm_writev", "kcmp", "add_key",
            "open_by_handle_at", "iopl", "ioperm", "mq_open")
 
 
+PROT_EXEC, MAP_ANONYMOUS, MFD_NOEXEC_SEAL, SHM_EXEC = 0x4, 0x20, 0x8, 0o100000
+
+
 def build_filter(fixed_affinity: bool = False, ip_sockets: bool = False) -> "seccomp.SyscallFilter":
     f = seccomp.SyscallFilter(defaction=seccomp.ALLOW)
     deny = seccomp.ERRNO(errno.EPERM)
     if fixed_affinity:
         f.add_rule(deny, "sched_setaffinity")
+    # Code that is no file: an executable memory file, fexecve, anonymous executable memory.
+    f.add_rule(deny, "memfd_create", seccomp.Arg(1, seccomp.MASKED_EQ, MFD_NOEXEC_SEAL, 0))
+    f.add_rule(deny, "execveat")
+    f.add_rule(deny, "mmap", seccomp.Arg(2, seccomp.MASKED_EQ, PROT_EXEC, PROT_EXEC),
+               seccomp.Arg(3, seccomp.MASKED_EQ, MAP_ANONYMOUS, MAP_ANONYMOUS))
+    for name in ("mprotect", "pkey_mprotect"):
+        f.add_rule(deny, name, seccomp.Arg(2, seccomp.MASKED_EQ, PROT_EXEC, PROT_EXEC))
+    f.add_rule(deny, "shmat", seccomp.Arg(2, seccomp.MASKED_EQ, SHM_EXEC, SHM_EXEC))
     for name in REFUSED:
         try:
             f.add_rule(deny, name)
@@ -77,25 +101,19 @@ def build_filter(fixed_affinity: bool = False, ip_sockets: bool = False) -> "sec
     return f
 
 
-def affinity_filter() -> "seccomp.SyscallFilter":
-    """sched_setaffinity refused and nothing else (a call of another architecture's ABI, such
-    as int 0x80, kills the process: libseccomp's default for a foreign architecture)."""
-    f = seccomp.SyscallFilter(defaction=seccomp.ALLOW)
-    f.add_rule(seccomp.ERRNO(errno.EPERM), "sched_setaffinity")
-    return f
-
-
 # Landlock (linux/landlock.h), through the system calls: no Python binding ships with Debian.
 LANDLOCK_CREATE_RULESET, LANDLOCK_ADD_RULE, LANDLOCK_RESTRICT_SELF = 444, 445, 446  # x86-64
 EXECUTE, WRITE_FILE, READ_FILE, READ_DIR = 1, 2, 4, 8
 ALL_ABI1 = (1 << 13) - 1      # every file-system right of Landlock's first ABI
-READ = EXECUTE | READ_FILE | READ_DIR
-SYSTEM_READ = ("/usr", "/bin", "/sbin", "/lib", "/lib32", "/lib64", "/libx32", "/etc",
-               "/proc", "/sys", "/dev", "/run")
-DEVICE_WRITE = READ | WRITE_FILE
+READ = READ_FILE | READ_DIR
+RUN = EXECUTE | READ
+WRITE = ALL_ABI1 & ~EXECUTE   # everything of a folder but running what is in it
+SYSTEM_EXEC = ("/usr", "/bin", "/sbin", "/lib", "/lib32", "/lib64", "/libx32")
+SYSTEM_READ = ("/etc", "/proc", "/sys", "/dev", "/run")
+DEVICES = ("/dev/null", "/dev/zero", "/dev/full", "/dev/tty", "/dev/urandom", "/dev/random")
 
 
-def landlock(read_only, writable) -> bool:
+def landlock(read_only, runnable, writable, devices=()) -> bool:
     """Confines the file system (see the module's docstring); False where Landlock is not
     available, so nothing was confined."""
     import ctypes
@@ -127,33 +145,40 @@ def landlock(read_only, writable) -> bool:
         libc.syscall(LANDLOCK_ADD_RULE, ruleset, 1, ctypes.byref(rule), 0)
         os.close(fd)
 
+    for path in SYSTEM_EXEC:
+        allow(path, RUN)
     for path in SYSTEM_READ:
         allow(path, READ)
-    for path in ("/dev/null", "/dev/zero", "/dev/full", "/dev/tty"):
-        allow(path, DEVICE_WRITE)
-    allow("/dev/shm", ALL_ABI1)
+    for path in (*DEVICES, *devices):
+        allow(path, READ_FILE | WRITE_FILE)
     for path in read_only:
         allow(path, READ)
+    for path in runnable:
+        allow(path, RUN)
     for path in writable:
-        allow(path, ALL_ABI1)
+        allow(path, WRITE)
     ok = libc.syscall(LANDLOCK_RESTRICT_SELF, ruleset, 0) == 0
     os.close(ruleset)
     return ok
 
 
+PR_SET_NO_NEW_PRIVS = 38
+
+
 def main(argv) -> int:
-    if argv == ["--export-affinity-filter"]:
-        sys.stdout.flush()
-        affinity_filter().export_bpf(sys.stdout)
-        return 0
     if "--" not in argv:
-        print("usage: confine.py [--ro PATH]... [--rw PATH]... [--fixed-affinity] "
-              "[--ip-sockets] -- COMMAND...", file=sys.stderr)
+        print("usage: confine.py [--ro PATH]... [--exec PATH]... [--rw PATH]... "
+              "[--device PATH]... [--fixed-affinity] [--ip-sockets] -- COMMAND...",
+              file=sys.stderr)
         return 2
     options, command = argv[:argv.index("--")], argv[argv.index("--") + 1:]
-    read_only = [options[i + 1] for i, o in enumerate(options) if o == "--ro"]
-    writable = [options[i + 1] for i, o in enumerate(options) if o == "--rw"]
-    landlock(read_only, writable)
+
+    def paths(flag):
+        return [options[i + 1] for i, o in enumerate(options) if o == flag]
+    import ctypes
+    # Landlock and an unprivileged filter need it; setpriv and bubblewrap set it already.
+    ctypes.CDLL(None).prctl(PR_SET_NO_NEW_PRIVS, 1, 0, 0, 0)
+    landlock(paths("--ro"), paths("--exec"), paths("--rw"), paths("--device"))
     build_filter(fixed_affinity="--fixed-affinity" in options,
                  ip_sockets="--ip-sockets" in options).load()
     # Python ignores SIGXFSZ and SIGPIPE, and an ignored signal stays ignored across exec: the

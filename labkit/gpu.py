@@ -63,6 +63,12 @@ def device_nodes(dev: str = DEV) -> list[str]:
     return sorted(os.path.basename(p) for p in glob.glob(os.path.join(dev, "nvidia*")))
 
 
+def node_paths(dev: str = DEV) -> list[str]:
+    """Every NVIDIA device node's path, which a sandboxed CUDA program opens for writing (its
+    driver's requests go through them: labkit/confine.py lets it)."""
+    return [os.path.join(dev, name) for name in device_nodes(dev)]
+
+
 def lib_dirs(candidates=DRIVER_LIB_DIRS, environment: str | None = None) -> list[str]:
     """The folders, of `candidates` and of the LD_LIBRARY_PATH `environment` (default: the
     grader's), that hold the driver's library libcuda.so*, in that order, each once."""

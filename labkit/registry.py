@@ -48,6 +48,7 @@ class Lab:
     extras: tuple[str, ...]      # variants and benchmarks
     ships: tuple[str, ...]       # prebuilt in a release of this lab or an earlier one
     handin: tuple[str, ...]      # skeleton/ files students hand in
+    handin_kib: int              # the most its hand-in's sources may hold together
     shared: tuple[str, ...]      # shared files whose solution regions are this lab's
     rubric: str
     try_command: str
@@ -72,8 +73,8 @@ class Lab:
 
 
 FIELDS = {"number": str, "folder": str, "kind": str, "student": list, "reference": list,
-          "extras": list, "ships": list, "handin": list, "shared": list, "rubric": str,
-          "try": str}
+          "extras": list, "ships": list, "handin": list, "handin_kib": int, "shared": list,
+          "rubric": str, "try": str}
 OPTIONAL = {"timed_spp": int}
 TARGET = re.compile(r"^lab(\d\d)[a-z0-9-]*$")
 
@@ -161,7 +162,8 @@ def parse(text: str, where: str = "labs/labs.toml") -> tuple[Lab, ...]:
         labs.append(Lab(number=number, folder=folder, kind=entry["kind"],
                         student=tuple(entry["student"]), reference=tuple(entry["reference"]),
                         extras=tuple(entry["extras"]), ships=tuple(entry["ships"]),
-                        handin=tuple(entry["handin"]), shared=tuple(entry["shared"]),
+                        handin=tuple(entry["handin"]), handin_kib=entry["handin_kib"],
+                        shared=tuple(entry["shared"]),
                         rubric=entry["rubric"], try_command=entry["try"],
                         timed_spp=entry.get("timed_spp")))
     numbers = [lab.number for lab in labs]

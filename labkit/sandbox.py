@@ -10,6 +10,12 @@ lie about its own speed. Every process the grader starts from a submission goes 
   PID, network, IPC and mount namespaces, seeing read-only exactly the files it was given, the
   system's libraries and MPI's files (and, for a GPU lab, the GPU: labkit/gpu.py), and
   writing only to a scratch folder of its own;
+- runs nothing but what it was given: inside either sandbox labkit/confine.py confines the
+  file system with Landlock (execute only the system's programs and the staged binary) and
+  loads a seccomp filter refusing code that is no file (memory files, fexecve, anonymous
+  executable memory); and while the run lasts the grader reads every executable mapping of
+  every process of its tree (`ExecCheck`): one that is neither the staged binary nor a file
+  of the system's stops the run as "ran a program it did not build";
 - applies resource limits inside (CPU seconds, memory, file size, processes, open files);
 - ends every process of its user after the run, whatever its state, and removes what that
   user left in the places anyone may write (/dev/shm, /tmp, SysV IPC: labkit/boxes.py), so
@@ -37,7 +43,7 @@ import tempfile
 import time
 from typing import Sequence
 
-from labkit import boxes
+from labkit import boxes, double_twin
 
 NOBODY = 65534
 # The sandbox's fixed layout: inputs appear read-only under /job, the scratch folder is the
@@ -77,6 +83,8 @@ class Outcome:
     cut: tuple[str, ...] = ()   # streams cut at the output cap
     busiest_thread_share: float = float("nan")  # of the tree's CPU time, its busiest thread's
                                                 # (sampled by the grader: TreeClock)
+    foreign: str | None = None  # what it ran that it was not given (ExecCheck), e.g.
+                                # "/tmp/x mapped executable by pid 12"
 
     @property
     def failure(self) -> str | None:
@@ -122,7 +130,8 @@ def bwrap_path() -> str | None:
 # works where a container's seccomp profile refuses namespaces (Docker's default, Gradescope).
 BUBBLEWRAP, USER = "bubblewrap", "user"
 DESCRIPTIONS = {
-    BUBBLEWRAP: "bubblewrap (user, PID, network, IPC and mount namespaces)",
+    BUBBLEWRAP: "bubblewrap (user, PID, network, IPC and mount namespaces; seccomp filter"
+                "{landlock})",
     USER: "a user of its own for each run (setpriv, prlimit, seccomp filter{landlock}; no "
           "namespaces here; IP sockets only under mpirun)",
 }
@@ -199,9 +208,22 @@ def _trial_run(isolation):
         _isolation.clear()
 
 
+def _confinement_missing() -> str | None:
+    """Why labkit/confine.py, which every sandboxed run goes through, cannot run here."""
+    if not os.path.exists(SYSTEM_PYTHON):
+        return f"{SYSTEM_PYTHON} is missing (the sandbox's seccomp filter runs on it)"
+    check = subprocess.run([SYSTEM_PYTHON, "-I", "-c", "import seccomp"], capture_output=True)
+    if check.returncode != 0:
+        return "python3-seccomp is not installed: run `make deps`"
+    return None
+
+
 def _probe_bubblewrap() -> str | None:
     if not bwrap_path():
         return "bubblewrap (bwrap) is not installed: run `make deps`"
+    reason = _confinement_missing()
+    if reason:
+        return reason
     out = _trial_run(BUBBLEWRAP)
     if isinstance(out, OSError):
         return f"bubblewrap cannot start: {out}"
@@ -220,11 +242,9 @@ def _probe_user() -> str | None:
     for tool in ("setpriv", "prlimit"):
         if not shutil.which(tool):
             return f"{tool} (util-linux) is not installed: run `make deps`"
-    if not os.path.exists(SYSTEM_PYTHON):
-        return f"{SYSTEM_PYTHON} is missing (the user sandbox's seccomp filter runs on it)"
-    check = subprocess.run([SYSTEM_PYTHON, "-I", "-c", "import seccomp"], capture_output=True)
-    if check.returncode != 0:
-        return "python3-seccomp is not installed: run `make deps`"
+    reason = _confinement_missing()
+    if reason:
+        return reason
     out = _trial_run(USER)
     if isinstance(out, OSError):
         return f"the user sandbox cannot start: {out}"
@@ -243,6 +263,16 @@ def unreachable(folder: pathlib.Path, uid: int, gid: int) -> pathlib.Path | None
         if not st.st_mode & bits:
             return part
     return None
+
+
+def exposed(folder: pathlib.Path) -> bool:
+    """Whether a sandboxed run could read `folder`: in the user sandbox without Landlock
+    (labkit/confine.py) only permissions keep a run from a file, so a folder every user may
+    enter is open to it. bubblewrap shows a run only what it mounts; Landlock only what it
+    allows."""
+    ids = boxes.pool()
+    return (isolation() == USER and ids is not None and not landlock_available()
+            and unreachable(folder, ids.start, ids.start) is None)
 
 
 def hide_from_sandbox(folder: pathlib.Path) -> None:
@@ -334,7 +364,9 @@ class Runner:
             raise OSError("the user sandbox needs the grader to run as root")
         self.root = pathlib.Path(tempfile.mkdtemp(prefix="grading-"))
         os.chmod(self.root, 0o755)  # the unprivileged sandbox user must reach staged inputs
+        self.close_to_others(self.root)
         self.inputs: dict[str, pathlib.Path] = {}
+        self.env: dict[str, str] = {}  # set for every run (a staged double build's path)
         self.binds: list[tuple[str, bool]] = []  # (path, writable), mounted at the same path
         self._scratch: pathlib.Path | None = None
 
@@ -343,6 +375,14 @@ class Runner:
 
     def __exit__(self, *exc):
         shutil.rmtree(self.root, ignore_errors=True)
+
+    def close_to_others(self, folder: os.PathLike | str) -> None:
+        """Only this run's user may enter `folder` (group of its box, mode 750): another run,
+        another student's, finds nothing of this one's inputs or build there. Where the grader
+        is not root there is no box, and bubblewrap's mounts alone show a run its files."""
+        if self.box:
+            os.chown(folder, -1, self.box[1])
+            os.chmod(folder, 0o750)
 
     # ---- what the command may see ---------------------------------------------------------
     def input(self, path: os.PathLike | str) -> str:
@@ -357,12 +397,17 @@ class Runner:
         staged = self.root / "inputs" / name
         staged.parent.mkdir(mode=0o755, exist_ok=True)
         shutil.copyfile(path, staged)
-        os.chmod(staged, 0o555 if os.access(path, os.X_OK) else 0o444)
-        if self.user_mode:  # no mounts: the staged copy is read where it lies
-            self.inputs[str(staged)] = staged
-            return str(staged)
-        self.inputs[f"{JOB}/{name}"] = staged
-        return f"{JOB}/{name}"
+        program = os.access(path, os.X_OK)
+        os.chmod(staged, 0o555 if program else 0o444)
+        if program and (twin := double_twin.stage(path, staged.parent, f"{name}-double")):
+            self.env[double_twin.ENVIRONMENT] = self._inside(twin)
+        return self._inside(staged)
+
+    def _inside(self, staged: pathlib.Path) -> str:
+        """Show a file staged in inputs/ to the command; its path as the command sees it."""
+        inside = str(staged) if self.user_mode else f"{JOB}/{staged.name}"
+        self.inputs[inside] = staged  # user sandbox: no mounts, read where it lies
+        return inside
 
     def bind(self, path: os.PathLike | str, writable: bool = False) -> str:
         """Show a file or folder at its own path, without copying (a build needs the tree's
@@ -400,46 +445,39 @@ class Runner:
             return f.read(limit + 1)[:limit + 1]
 
     # ---- running --------------------------------------------------------------------------
-    def command(self, argv: Sequence[str], limits: Limits, env: dict[str, str],
-                seccomp_fd: int | None = None) -> list[str]:
-        """The full command line: taskset (for limits.cpu), bubblewrap (unless trusted; with
-        the filter read from `seccomp_fd`), then prlimit, then argv."""
+    def command(self, argv: Sequence[str], limits: Limits, env: dict[str, str]) -> list[str]:
+        """The full command line: taskset (for limits.cpu), bubblewrap or setpriv (unless
+        trusted), prlimit, labkit/confine.py (unless trusted), then argv."""
         nproc = limits.processes  # a box's user runs nothing else: the run's alone
         if self.box is None and os.geteuid() != 0:
             nproc += _threads_of(os.geteuid())
         # SIGXCPU at the CPU limit, SIGKILL a second later (for a program that ignores it)
-        inner = [shutil.which("prlimit") or "prlimit",
+        limit = [shutil.which("prlimit") or "prlimit",
                  f"--cpu={limits.cpu_seconds}:{limits.cpu_seconds + 1}",
                  f"--fsize={limits.file_bytes}", f"--nofile={limits.open_files}", "--core=0"]
         if limits.memory_bytes:
-            inner.append(f"--as={limits.memory_bytes}")
+            limit.append(f"--as={limits.memory_bytes}")
         if self.box or os.geteuid() != 0:  # root ignores RLIMIT_NPROC
-            inner.append(f"--nproc={nproc}")
-        inner += ["--", *argv]
+            limit.append(f"--nproc={nproc}")
         pin = [] if limits.cpu is None else [shutil.which("taskset") or "taskset", "-c",
                                              str(limits.cpu)]
         if self.trusted:
-            return pin + inner
+            return pin + limit + ["--", *argv]
+        confine = [SYSTEM_PYTHON, "-I", _confine_script(), *self._confinement(argv, limits),
+                   "--", *argv]
         if self.user_mode:
             uid, gid = self.box
-            paths = ["--ro", str(pathlib.Path(_confine_script()).parent),
-                     "--ro", str(self.root / "inputs"), "--rw", str(self._scratch_dir())]
-            for path, writable in self.binds:
-                paths += ["--rw" if writable else "--ro", path]
-            if limits.cpu is not None:
-                paths.append("--fixed-affinity")
-            if os.path.basename(argv[0]) in MPI_LAUNCHERS:  # the grader's launcher, never a
-                paths.append("--ip-sockets")                 # hand-in's name (confine.py)
             return [*pin, shutil.which("setpriv") or "setpriv", f"--reuid={uid}",
                     f"--regid={gid}", "--clear-groups", "--no-new-privs", "--inh-caps=-all", "--",
-                    *inner[:inner.index("--") + 1],
-                    SYSTEM_PYTHON, "-I", _confine_script(), *paths, "--", *argv]
+                    *limit, "--", *confine]
         scratch = self._scratch_dir()
+        confine_folder = str(pathlib.Path(_confine_script()).parent)
         cmd = [bwrap_path() or "bwrap", "--unshare-all", "--unshare-user",
                "--uid", str(NOBODY), "--gid", str(NOBODY), "--die-with-parent", "--new-session",
                "--cap-drop", "ALL", *system_mounts(), "--proc", "/proc", "--dev", "/dev",
                "--size", str(limits.tmp_bytes), "--tmpfs", "/tmp",
-               "--bind", str(scratch), SCRATCH, "--chdir", SCRATCH, "--clearenv"]
+               "--bind", str(scratch), SCRATCH, "--chdir", SCRATCH,
+               "--ro-bind", confine_folder, confine_folder, "--clearenv"]
         for inside, outside in self.inputs.items():
             cmd += ["--ro-bind", str(outside), inside]
         for path, writable in self.binds:
@@ -448,16 +486,46 @@ class Runner:
             from labkit.gpu import sandbox_args
             cmd += sandbox_args()
         cmd += ["--remount-ro", "/"]  # bubblewrap's root is a tmpfs: no files may go there
-        if seccomp_fd is not None:
-            cmd += ["--seccomp", str(seccomp_fd)]
         for key, value in {"PATH": "/usr/local/bin:/usr/bin:/bin", "HOME": SCRATCH,
                            "TMPDIR": "/tmp", "LANG": "C.UTF-8", **env}.items():
             cmd += ["--setenv", key, value]
-        return pin + cmd + ["--", *inner]
+        return pin + cmd + ["--", *limit, "--", *confine]
+
+    def _confinement(self, argv: Sequence[str], limits: Limits) -> list[str]:
+        """labkit/confine.py's options for this run: what it may read, run and write."""
+        options = ["--ro", str(pathlib.Path(_confine_script()).parent)]
+        if self.user_mode:
+            options += ["--exec", str(self.root / "inputs"), "--rw", str(self._scratch_dir())]
+            if os.path.basename(argv[0]) in MPI_LAUNCHERS:  # the grader's launcher, never a
+                options.append("--ip-sockets")               # hand-in's name (confine.py)
+        else:  # its own /tmp and /dev/shm, and a network namespace of its own
+            options += ["--exec", JOB, "--rw", SCRATCH, "--rw", "/tmp", "--rw", "/dev/shm",
+                        "--ip-sockets"]
+        for path, writable in self.binds:
+            options += ["--rw" if writable else "--ro", path]
+        if self.gpu:
+            from labkit import gpu
+            options += [x for node in gpu.node_paths() for x in ("--device", node)]
+            options += [x for folder in gpu.lib_dirs() for x in ("--ro", folder)]
+        if limits.cpu is not None:
+            options.append("--fixed-affinity")
+        return options
+
+    def exec_check(self) -> ExecCheck | None:
+        """What this run's processes may map executable (None: trusted, nothing checked)."""
+        if self.trusted:
+            return None
+        programs = {inside for inside, outside in self.inputs.items()
+                    if os.access(outside, os.X_OK)}
+        folders = list(SYSTEM_FOLDERS)
+        if self.gpu:
+            from labkit import gpu
+            folders += gpu.lib_dirs()
+        return ExecCheck(programs, tuple(folders))
 
     def run(self, argv: Sequence[str], limits: Limits = Limits(),
             env: dict[str, str] | None = None) -> Outcome:
-        env = dict(env or {})
+        env = {**self.env, **(env or {})}
         if self.trusted:  # as before the sandbox: the caller's environment and folder
             full_env, cwd = {**os.environ, **env}, None
         elif self.user_mode:  # nothing of the grader's environment
@@ -467,66 +535,40 @@ class Runner:
             if self.gpu:  # no mount namespace to show one GPU's node: name the grader's GPU
                 full_env.update({k: os.environ[k] for k in
                                  ("CUDA_VISIBLE_DEVICES", "CUDA_DEVICE_ORDER") if k in os.environ})
+            if os.path.basename(argv[0]) in MPI_LAUNCHERS:
+                # OpenMPI's shared memory in the run's scratch, not in the /dev/shm every user
+                # shares (which the run may not write: labkit/confine.py)
+                full_env.setdefault("OMPI_MCA_btl_vader_backing_directory", scratch)
             cwd = scratch
         else:
             full_env, cwd = None, self.root
-        seccomp_fd = None
-        if limits.cpu is not None and not (self.trusted or self.user_mode):
-            seccomp_fd = _filter_pipe(affinity_filter())
-        cmd = self.command(argv, limits, env, seccomp_fd)
+        cmd = self.command(argv, limits, env)
         user = {}
         if self.box and not self.user_mode:  # the user sandbox switches users with setpriv
             user = dict(user=self.box[0], group=self.box[1], extra_groups=[])
         if self._reset:
             boxes.seal(*self.box)
         start = time.perf_counter()
+        p = subprocess.Popen(cmd, stdin=subprocess.DEVNULL, stdout=subprocess.PIPE,
+                             stderr=subprocess.PIPE, env=full_env, cwd=cwd,
+                             start_new_session=True, **user)
         try:
-            p = subprocess.Popen(cmd, stdin=subprocess.DEVNULL, stdout=subprocess.PIPE,
-                                 stderr=subprocess.PIPE, env=full_env, cwd=cwd,
-                                 start_new_session=True,
-                                 pass_fds=() if seccomp_fd is None else (seccomp_fd,), **user)
-        finally:
-            if seccomp_fd is not None:
-                os.close(seccomp_fd)
-        try:
-            outcome = _supervise(p, start, limits)
+            outcome = _supervise(p, start, limits, self.exec_check())
         finally:
             if self.box:  # nothing of this run outlives it
-                boxes.seal(*self.box)
+                problems = boxes.seal(*self.box)
                 self._reset = False
+                if problems:
+                    SWEEP_PROBLEMS.append(f"after a run of user {self.box[0]}: "
+                                          + "; ".join(problems))
+        if outcome.foreign:
+            FOREIGN_CODE.append(outcome.foreign)
         if outcome.killed is None and outcome.returncode == 0:
             used = _tree_size(self._scratch_dir())
             if used > limits.scratch_bytes:
                 outcome.killed = (f"left {used / 2**20:.0f} MiB in its scratch folder "
                                   f"(allowed {limits.scratch_bytes / 2**20:.0f} MiB)")
         return outcome
-
-
-_affinity_filter: list[bytes] = []
-
-
-def affinity_filter() -> bytes:
-    """The compiled seccomp filter refusing sched_setaffinity (labkit/confine.py), made once by
-    the system's Python, whose python3-seccomp the grader's own environment may lack."""
-    if not _affinity_filter:
-        p = subprocess.run([SYSTEM_PYTHON, "-I", _confine_script(), "--export-affinity-filter"],
-                           capture_output=True)
-        if p.returncode != 0 or not p.stdout:
-            raise OSError("a run confined to one CPU needs python3-seccomp for "
-                          f"{SYSTEM_PYTHON} (its filter refuses widening the affinity): "
-                          "run `make deps`")
-        _affinity_filter.append(p.stdout)
-    return _affinity_filter[0]
-
-
-def _filter_pipe(program: bytes) -> int:
-    """A pipe's read end holding `program` (smaller than a pipe's buffer), for bwrap --seccomp."""
-    read_end, write_end = os.pipe()
-    try:
-        os.write(write_end, program)
-    finally:
-        os.close(write_end)
-    return read_end
 
 
 SAMPLE_SECONDS = 0.05
@@ -539,6 +581,51 @@ _CLOCK_TICKS = os.sysconf("SC_CLK_TCK")
 # lower its own priority again (setsid, nice), never raise it. Not a real-time class: the
 # grader and the system still run.
 RUN_NICE = -10
+
+
+# Where the system's programs and libraries lie: read-only in both sandboxes, and no run can
+# mount anything over them (labkit/confine.py refuses every mount and namespace call).
+SYSTEM_FOLDERS = ("/usr", "/bin", "/sbin", "/lib", "/lib32", "/lib64", "/libx32")
+# The kernel's own executable mappings, which every process has.
+KERNEL_MAPPINGS = ("[vdso]", "[vsyscall]", "[uprobes]")
+# Every run that mapped code it was not given (ExecCheck), and every sweep after a run that
+# left something (labkit/boxes.py), in this grader process: the grade reads them (grading/grade.py).
+FOREIGN_CODE: list[str] = []
+SWEEP_PROBLEMS: list[str] = []
+
+
+class ExecCheck:
+    """What a sandboxed run may have mapped executable: the staged programs (as the run sees
+    their paths: /job/N in bubblewrap) and the files under the system's folders (and a GPU
+    lab's driver library folders). The kernel shows each process's mappings with the paths of
+    its own mount namespace (/proc/PID/maps); the sandbox's processes can change neither what
+    lies at those paths nor the namespace. Anything else, an anonymous executable mapping
+    (code made in memory), a memory file (/memfd:...), a file the run wrote, is foreign."""
+
+    def __init__(self, programs: set[str], folders: tuple[str, ...]):
+        self.programs = programs
+        self.prefixes = tuple(folder.rstrip("/") + "/" for folder in folders)
+
+    def foreign(self, pid: int) -> str | None:
+        """The first executable mapping of `pid` the run was not given, described; None when
+        every one is allowed or the process has gone."""
+        try:
+            with open(f"/proc/{pid}/maps", "rb") as f:
+                maps = f.read()
+        except OSError:
+            return None  # it has ended (the next sample sees its children, if any)
+        for line in maps.splitlines():
+            fields = line.split(maxsplit=5)
+            if len(fields) < 5 or b"x" not in fields[1]:
+                continue
+            path = fields[5].decode("utf-8", "replace") if len(fields) == 6 else ""
+            if path in self.programs or path.startswith(self.prefixes):
+                continue
+            if fields[4] == b"0" and path in KERNEL_MAPPINGS:
+                continue
+            what = path or "executable memory that is no file"
+            return f"{what} (mapped executable by process {pid})"
+        return None
 
 
 class TreeClock:
@@ -559,10 +646,12 @@ class TreeClock:
     With `nice` (the grader is root) each sample also raises the tree's new sessions and
     threads to that priority (RUN_NICE says why)."""
 
-    def __init__(self, pid: int, nice: int | None = None):
+    def __init__(self, pid: int, nice: int | None = None, exec_check: ExecCheck | None = None):
         self.pid = pid
         self.seconds = 0.0
         self.nice = nice
+        self.exec_check = exec_check
+        self.foreign: str | None = None  # the first foreign mapping seen (ExecCheck)
         self._threads: dict[tuple[int, int, int], int] = {}  # (pid, tid, start) -> ticks
         self._sessions: set[int] = set()  # sessions whose autogroup was raised
         self.busiest_thread_share = float("nan")
@@ -598,6 +687,8 @@ class TreeClock:
         for pid in tree:
             if pid in times:
                 self._sample_threads(pid, sessions[pid])
+                if self.exec_check and self.foreign is None:
+                    self.foreign = self.exec_check.foreign(pid)
         work = max(self.seconds * _CLOCK_TICKS, sum(self._threads.values()))
         if work > 0:
             self.busiest_thread_share = min(1.0, max(self._threads.values(), default=0) / work)
@@ -641,9 +732,11 @@ def _kill_tree(p: subprocess.Popen) -> None:
         pass
 
 
-def _supervise(p: subprocess.Popen, start: float, limits: Limits) -> Outcome:
-    """Read both streams up to the cap and wait for the exit within the wall limit. The
-    rusage holds the whole tree's CPU time in trusted mode only (see Outcome.cpu_seconds)."""
+def _supervise(p: subprocess.Popen, start: float, limits: Limits,
+               exec_check: ExecCheck | None = None) -> Outcome:
+    """Read both streams up to the cap and wait for the exit within the wall limit; with
+    `exec_check`, stop the tree at the first foreign executable mapping. The rusage holds the
+    whole tree's CPU time in trusted mode only (see Outcome.cpu_seconds)."""
     deadline = start + limits.wall_seconds
     streams = {
         p.stdout.fileno(): ("stdout", bytearray()),
@@ -652,7 +745,7 @@ def _supervise(p: subprocess.Popen, start: float, limits: Limits) -> Outcome:
     for fd in streams:
         os.set_blocking(fd, False)
     pidfd = os.pidfd_open(p.pid)
-    clock = TreeClock(p.pid, RUN_NICE if os.geteuid() == 0 else None)
+    clock = TreeClock(p.pid, RUN_NICE if os.geteuid() == 0 else None, exec_check)
     killed, cut, exited_at, status, usage = None, [], None, None, None
     try:
         open_fds = set(streams)
@@ -673,6 +766,9 @@ def _supervise(p: subprocess.Popen, start: float, limits: Limits) -> Outcome:
             if exited_at is None:
                 clock.sample()
                 limit = min(limit, SAMPLE_SECONDS)
+                if clock.foreign and killed is None:
+                    killed = f"ran a program it did not build: {clock.foreign}"
+                    _kill_tree(p)
             ready, _, _ = select.select(wait_on, [], [], limit)
             if not ready and exited_at is not None:
                 _kill_tree(p)
@@ -711,4 +807,4 @@ def _supervise(p: subprocess.Popen, start: float, limits: Limits) -> Outcome:
     cpu = max(usage.ru_utime + usage.ru_stime if usage else 0.0, clock.seconds)
     (_, out), (_, err) = streams.values()
     return Outcome(p.returncode, decode(bytes(out)), decode(bytes(err)), end - start, cpu,
-                   killed, tuple(cut), clock.busiest_thread_share)
+                   killed, tuple(cut), clock.busiest_thread_share, clock.foreign)

@@ -1,7 +1,10 @@
 """Hostile and broken "submissions" for the grader's tests: each is one executable file, which
-is all the grader runs. Most are shell scripts; those that must render correctly carry a copy
-of the lab-01 reference inside themselves (the sandbox shows a submission nothing of the
-repository, so a script cannot just exec ./lab01-ref) and unpack it into their scratch folder.
+is all the grader runs. Most are shell scripts; those that must render correctly are course
+staff's kind of binary: a small program running a shell script, carrying the lab-01
+reference as the double build a reference carries (labkit/double_twin.py). The sandbox runs
+only what the grader staged (the sandbox shows a submission nothing of the repository, and
+runs nothing a run wrote), and the grader stages a carried build of a binary it was given
+beside it, naming it in RT_DOUBLE_TWIN.
 """
 from __future__ import annotations
 
@@ -24,17 +27,37 @@ def script(folder: pathlib.Path, body: str, name: str = "lab") -> pathlib.Path:
     return path
 
 
+# A program that runs its script (a C string) with /bin/sh, with its own arguments in "$@".
+RUNS_A_SCRIPT = r"""
+#include <unistd.h>
+static const char script[] = SCRIPT;
+int main(int argc, char** argv) {
+    char* args[argc + 3];
+    args[0] = (char*)"sh";
+    args[1] = (char*)"-c";
+    args[2] = (char*)script;
+    for (int i = 0; i < argc; ++i) args[i + 3] = argv[i];
+    args[argc + 3] = 0;
+    execv("/bin/sh", args);
+    return 127;
+}
+"""
+
+
 def carrying_reference(folder: pathlib.Path, body: str, name: str = "lab",
                        reference: pathlib.Path = REFERENCE) -> pathlib.Path:
-    """A script whose payload is the lab-01 reference (or `reference`): `body` runs after
-    `./ref` (the unpacked binary) exists in the working folder, with the script's arguments
-    in "$@"."""
-    payload = reference.read_bytes()
-    head = (f"tail -c {len(payload)} \"$0\" > ./ref && chmod +x ./ref || exit 99\n"
-            f"{body}\nexit $?\n")
+    """A program running `body` with /bin/sh, with its arguments in "$@" and the lab-01
+    reference (or `reference`) at ./ref's place: the staged copy of the reference it carries
+    in the sandbox, the reference itself where the run is trusted."""
+    import json
+    head = (f'ref="${{RT_DOUBLE_TWIN:-{reference}}}"; unset RT_DOUBLE_TWIN\n'
+            + body.replace("./ref", '"$ref"') + "\nexit $?\n")
+    source = folder / f"{name}.c"
+    source.write_text(RUNS_A_SCRIPT.replace("SCRIPT", json.dumps(head)))
     path = folder / name
-    path.write_bytes(b"#!/bin/sh\n" + head.encode() + payload)
-    path.chmod(0o755)
+    subprocess.run(["cc", "-O1", "-o", str(path), str(source)], check=True)
+    subprocess.run(["objcopy", "--add-section", f"rt_double_twin={reference}", str(path)],
+                   check=True)
     return path
 
 

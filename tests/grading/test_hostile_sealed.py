@@ -9,39 +9,9 @@ import signal
 import pytest
 
 from labkit import sandbox
-from labkit.harness import ROOT
 from labkit.sandbox import Limits, Runner
 from tests.grading import submissions as sub
-
-QUICK = Limits(wall_seconds=10)
-
-
-@pytest.fixture(params=[sandbox.BUBBLEWRAP, sandbox.USER])
-def mode(request, monkeypatch):
-    """This process's runs in one sandbox, picked as GRADING_SANDBOX picks it."""
-    if request.param == sandbox.USER and os.geteuid() != 0:
-        pytest.skip("the user sandbox needs the grader to run as root")
-    monkeypatch.setenv("GRADING_SANDBOX", request.param)
-    monkeypatch.setattr(sandbox, "_probe_result", [])
-    monkeypatch.setattr(sandbox, "_isolation", [])
-    reason = sandbox.probe()
-    if reason and request.param == sandbox.BUBBLEWRAP:  # a container refusing namespaces
-        pytest.skip(f"bubblewrap cannot run here: {reason}")
-    assert reason is None and sandbox.isolation() == request.param, reason
-    if request.param == sandbox.USER:
-        sandbox.hide_from_sandbox(ROOT)
-    return request.param
-
-
-def sh(script: str, limits: Limits = QUICK):
-    """One run in a Runner of its own, as the grader makes one per run."""
-    with Runner(trusted=False) as r:
-        return r.run(["/bin/sh", "-c", script], limits)
-
-
-def py(code: str, limits: Limits = QUICK):
-    with Runner(trusted=False) as r:
-        return r.run(["/usr/bin/python3", "-I", "-c", code], limits)
+from tests.grading.sandbox_modes import QUICK, py, sh
 
 
 @pytest.mark.parametrize("place", ["/dev/shm", "/tmp", "/var/tmp", "/run/lock"])

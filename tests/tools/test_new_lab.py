@@ -34,6 +34,7 @@ reference = ["lab{LAB}-ref"]
 extras = []
 ships = ["lab{LAB}-ref"]
 handin = ["render.cpp"]
+handin_kib = 64
 shared = []
 rubric = "serial"
 try = "./lab{LAB} --width 128 --height 128 --spp 16 --out quick.ppm"
