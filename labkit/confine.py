@@ -1,8 +1,8 @@
 """The innermost wrapper of every sandboxed run (labkit/sandbox.py), in both sandboxes: run by
 the system's Python as the sandbox's user (inside bubblewrap, or after setpriv and prlimit
-where namespaces cannot be had), it confines the file system with Landlock, loads a
-libseccomp filter (python3-seccomp) and execs the command, which inherits both and can
-remove neither.
+where namespaces cannot be had), it confines the file system with Landlock, loads a seccomp
+filter (a classic BPF program written here, so any Python 3 runs it, without a binding to
+libseccomp) and execs the command, which inherits both and can remove neither.
 
     /usr/bin/python3 -I confine.py [--ro PATH]... [--exec PATH]... [--rw PATH]...
                                    [--device PATH]... [--fixed-affinity] [--ip-sockets]
@@ -46,16 +46,34 @@ namespace holds only its own loopback, IP sockets are always let through.
 A run confined to some CPUs (Limits.cpu: lab 02's timed runs, on one) must not widen its
 affinity again: with --fixed-affinity sched_setaffinity answers EPERM as well.
 """
+import ctypes
 import errno
 import os
 import signal
+import struct
 import sys
 
-import seccomp  # python3-seccomp (Debian): the system's Python, not a virtual environment's
-
+# The system calls the filter names, by their x86-64 numbers (the filter is written as a
+# classic BPF program here, so any Python 3 runs it without a binding to libseccomp).
+SYSCALLS = {
+    "mmap": 9, "mprotect": 10, "shmat": 30, "socket": 41, "clone": 56, "ptrace": 101,
+    "personality": 135, "pivot_root": 155, "adjtimex": 159, "chroot": 161, "acct": 163,
+    "settimeofday": 164, "mount": 165, "umount2": 166, "swapon": 167, "swapoff": 168,
+    "reboot": 169, "iopl": 172, "ioperm": 173, "init_module": 175, "delete_module": 176,
+    "quotactl": 179, "sched_setaffinity": 203, "lookup_dcookie": 212, "clock_settime": 227,
+    "mq_open": 240, "kexec_load": 246, "add_key": 248, "request_key": 249, "keyctl": 250,
+    "unshare": 272, "perf_event_open": 298, "name_to_handle_at": 303,
+    "open_by_handle_at": 304, "clock_adjtime": 305, "setns": 308, "process_vm_readv": 310,
+    "process_vm_writev": 311, "kcmp": 312, "finit_module": 313, "memfd_create": 319,
+    "kexec_file_load": 320, "bpf": 321, "execveat": 322, "userfaultfd": 323,
+    "pkey_mprotect": 329, "io_uring_setup": 425, "io_uring_enter": 426,
+    "io_uring_register": 427, "open_tree": 428, "move_mount": 429, "fsopen": 430,
+    "fsconfig": 431, "fsmount": 432, "fspick": 433, "clone3": 435, "mount_setattr": 442,
+}
 AF_UNIX, AF_INET, AF_INET6 = 1, 2, 10
 CLONE_NEW_FLAGS = (0x00020000, 0x02000000, 0x04000000, 0x08000000, 0x10000000, 0x20000000,
                    0x40000000, 0x00000080)  # NS, CGROUP, UTS, IPC, USER, PID, NET, TIME
+# io_uring: its requests are no system calls, so no filter would see them.
 REFUSED = ("ptrace", "process_vm_readv", "process_vm_writev", "kcmp", "add_key",
            "request_key", "keyctl", "unshare", "setns", "mount", "umount2", "pivot_root",
            "chroot", "open_tree", "move_mount", "fsopen", "fsconfig", "fsmount", "fspick",
@@ -63,42 +81,92 @@ REFUSED = ("ptrace", "process_vm_readv", "process_vm_writev", "kcmp", "add_key",
            "finit_module", "delete_module", "kexec_load", "kexec_file_load", "reboot",
            "swapon", "swapoff", "settimeofday", "clock_settime", "clock_adjtime", "adjtimex",
            "acct", "quotactl", "lookup_dcookie", "personality", "name_to_handle_at",
-           "open_by_handle_at", "iopl", "ioperm", "mq_open")
-
-
+           "open_by_handle_at", "iopl", "ioperm", "mq_open", "io_uring_setup",
+           "io_uring_enter", "io_uring_register")
 PROT_EXEC, MAP_ANONYMOUS, MFD_NOEXEC_SEAL, SHM_EXEC = 0x4, 0x20, 0x8, 0o100000
 
+# Classic BPF (linux/filter.h, linux/seccomp.h).
+LD_W_ABS, AND_K = 0x20, 0x54
+JEQ_K, JGT_K, JGE_K, RET_K = 0x15, 0x25, 0x35, 0x06
+RET_ALLOW, RET_KILL_PROCESS, RET_ERRNO = 0x7FFF0000, 0x80000000, 0x00050000
+AUDIT_ARCH_X86_64, X32_SYSCALL_BIT = 0xC000003E, 0x40000000
+NR, ARCH = 0, 4
 
-def build_filter(fixed_affinity: bool = False, ip_sockets: bool = False) -> "seccomp.SyscallFilter":
-    f = seccomp.SyscallFilter(defaction=seccomp.ALLOW)
-    deny = seccomp.ERRNO(errno.EPERM)
+
+def _arg(index: int) -> int:
+    """Offset of a system call argument's low 32 bits in struct seccomp_data: what the calls
+    filtered here read (ints, flags), whatever the upper half holds."""
+    return 16 + 8 * index
+
+
+def rules(fixed_affinity: bool = False, ip_sockets: bool = False) -> list[tuple]:
+    """(system call, [(argument, mask, test, value)...], errno): the call is refused with
+    errno when every test holds for (argument & mask); test is "eq" or "gt"."""
+    found = []
+
+    def deny(name, *tests, err=errno.EPERM):
+        found.append((name, list(tests), err))
     if fixed_affinity:
-        f.add_rule(deny, "sched_setaffinity")
+        deny("sched_setaffinity")
     # Code that is no file: an executable memory file, fexecve, anonymous executable memory.
-    f.add_rule(deny, "memfd_create", seccomp.Arg(1, seccomp.MASKED_EQ, MFD_NOEXEC_SEAL, 0))
-    f.add_rule(deny, "execveat")
-    f.add_rule(deny, "mmap", seccomp.Arg(2, seccomp.MASKED_EQ, PROT_EXEC, PROT_EXEC),
-               seccomp.Arg(3, seccomp.MASKED_EQ, MAP_ANONYMOUS, MAP_ANONYMOUS))
-    for name in ("mprotect", "pkey_mprotect"):
-        f.add_rule(deny, name, seccomp.Arg(2, seccomp.MASKED_EQ, PROT_EXEC, PROT_EXEC))
-    f.add_rule(deny, "shmat", seccomp.Arg(2, seccomp.MASKED_EQ, SHM_EXEC, SHM_EXEC))
+    deny("memfd_create", (1, MFD_NOEXEC_SEAL, "eq", 0))
+    deny("execveat")
+    deny("mmap", (2, PROT_EXEC, "eq", PROT_EXEC), (3, MAP_ANONYMOUS, "eq", MAP_ANONYMOUS))
+    deny("mprotect", (2, PROT_EXEC, "eq", PROT_EXEC))
+    deny("pkey_mprotect", (2, PROT_EXEC, "eq", PROT_EXEC))
+    deny("shmat", (2, SHM_EXEC, "eq", SHM_EXEC))
     for name in REFUSED:
-        try:
-            f.add_rule(deny, name)
-        except (RuntimeError, ValueError, OSError):
-            pass  # not a system call on this architecture
+        deny(name)
     allowed = (AF_UNIX, AF_INET, AF_INET6) if ip_sockets else (AF_UNIX,)
-    for family in range(max(allowed) + 1):  # one rule a family: a rule compares once
+    for family in range(max(allowed) + 1):
         if family not in allowed:
-            f.add_rule(deny, "socket", seccomp.Arg(0, seccomp.EQ, family))
-    f.add_rule(deny, "socket", seccomp.Arg(0, seccomp.GT, max(allowed)))
+            deny("socket", (0, 0xFFFFFFFF, "eq", family))
+    deny("socket", (0, 0xFFFFFFFF, "gt", max(allowed)))
     for flag in CLONE_NEW_FLAGS:
-        f.add_rule(deny, "clone", seccomp.Arg(0, seccomp.MASKED_EQ, flag, flag))
-    try:
-        f.add_rule(seccomp.ERRNO(errno.ENOSYS), "clone3")
-    except (RuntimeError, ValueError, OSError):
-        pass
-    return f
+        deny("clone", (0, flag, "eq", flag))
+    # clone3's flags sit in memory a filter cannot read: ENOSYS makes the C library use clone.
+    deny("clone3", err=errno.ENOSYS)
+    return found
+
+
+def build_filter(fixed_affinity: bool = False, ip_sockets: bool = False) -> bytes:
+    """The filter as a classic BPF program (struct sock_filter[]): another architecture's
+    calls (int 0x80) and the x32 ABI's end the process; each refused call answers its errno;
+    everything else is allowed."""
+    program = [(LD_W_ABS, 0, 0, ARCH), (JEQ_K, 1, 0, AUDIT_ARCH_X86_64),
+               (RET_K, 0, 0, RET_KILL_PROCESS), (LD_W_ABS, 0, 0, NR),
+               (JGE_K, 0, 1, X32_SYSCALL_BIT), (RET_K, 0, 0, RET_KILL_PROCESS)]
+    for name, tests, err in rules(fixed_affinity, ip_sockets):
+        # Each rule: is it this call? then each test on its argument; all hold: refuse.
+        # Whatever fails jumps past the rule's end, where the call's number is loaded again.
+        body = []
+        for index, mask, test, value in tests:
+            body.append((LD_W_ABS, 0, 0, _arg(index)))
+            if mask != 0xFFFFFFFF:
+                body.append((AND_K, 0, 0, mask))
+            body.append((JEQ_K if test == "eq" else JGT_K, 0, None, value))
+        body.append((RET_K, 0, 0, RET_ERRNO | err))
+        block = [(JEQ_K, 0, None, SYSCALLS[name])] + body
+        end = len(block)  # the reload of the call's number that follows the block
+        program += [(code, jt, end - k - 1 if jf is None else jf, k_)
+                    for k, (code, jt, jf, k_) in enumerate(block)]
+        program.append((LD_W_ABS, 0, 0, NR))
+    program.append((RET_K, 0, 0, RET_ALLOW))
+    return b"".join(struct.pack("<HBBI", *insn) for insn in program)
+
+
+def load_filter(program: bytes) -> None:
+    """Install `program` for this process and every one it starts (no new privileges)."""
+    class SockFprog(ctypes.Structure):
+        _fields_ = [("len", ctypes.c_ushort), ("filter", ctypes.c_char_p)]
+    libc = ctypes.CDLL(None, use_errno=True)
+    fprog = SockFprog(len(program) // 8, program)
+    if libc.prctl(PR_SET_NO_NEW_PRIVS, 1, 0, 0, 0) != 0 or \
+            libc.prctl(PR_SET_SECCOMP, SECCOMP_MODE_FILTER, ctypes.byref(fprog), 0, 0) != 0:
+        raise OSError(ctypes.get_errno(), "the seccomp filter could not be loaded")
+
+
+PR_SET_NO_NEW_PRIVS, PR_SET_SECCOMP, SECCOMP_MODE_FILTER = 38, 22, 2
 
 
 # Landlock (linux/landlock.h), through the system calls: no Python binding ships with Debian.
@@ -116,7 +184,6 @@ DEVICES = ("/dev/null", "/dev/zero", "/dev/full", "/dev/tty", "/dev/urandom", "/
 def landlock(read_only, runnable, writable, devices=()) -> bool:
     """Confines the file system (see the module's docstring); False where Landlock is not
     available, so nothing was confined."""
-    import ctypes
     import platform
     if platform.machine() != "x86_64":
         return False
@@ -162,9 +229,6 @@ def landlock(read_only, runnable, writable, devices=()) -> bool:
     return ok
 
 
-PR_SET_NO_NEW_PRIVS = 38
-
-
 def main(argv) -> int:
     if "--" not in argv:
         print("usage: confine.py [--ro PATH]... [--exec PATH]... [--rw PATH]... "
@@ -175,12 +239,15 @@ def main(argv) -> int:
 
     def paths(flag):
         return [options[i + 1] for i, o in enumerate(options) if o == flag]
-    import ctypes
     # Landlock and an unprivileged filter need it; setpriv and bubblewrap set it already.
     ctypes.CDLL(None).prctl(PR_SET_NO_NEW_PRIVS, 1, 0, 0, 0)
     landlock(paths("--ro"), paths("--exec"), paths("--rw"), paths("--device"))
-    build_filter(fixed_affinity="--fixed-affinity" in options,
-                 ip_sockets="--ip-sockets" in options).load()
+    try:
+        load_filter(build_filter(fixed_affinity="--fixed-affinity" in options,
+                                 ip_sockets="--ip-sockets" in options))
+    except OSError as e:
+        print(f"confine.py: {e.strerror}: {os.strerror(e.errno)}", file=sys.stderr)
+        return 126
     # Python ignores SIGXFSZ and SIGPIPE, and an ignored signal stays ignored across exec: the
     # command gets the defaults, so a file over the size limit stops it as it would elsewhere.
     for sig in (signal.SIGXFSZ, signal.SIGPIPE):

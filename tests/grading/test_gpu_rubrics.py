@@ -138,9 +138,9 @@ def test_lab07_sources_build_in_the_sandbox(nvcc_and_sandbox, tmp_path):
     assert binary is not None and binary.is_file(), errors
 
 
-def test_a_gpu_submission_including_the_solution_does_not_compile(nvcc_and_sandbox, tmp_path):
-    """As for the CPU labs: the solution is out of the sandboxed compiler's view (a lab 05
-    render.cu that #includes it), and in view when trusted, so the test can fail."""
+def test_a_gpu_submission_including_the_solution_is_refused(nvcc_and_sandbox, tmp_path):
+    """As for the CPU labs: a lab 05 render.cu that #includes the solution by its path is
+    refused in one line naming the file, before nvcc runs; the pristine hand-in builds."""
     from grading.grade import build_lab
     from labkit.variants import pristine_skeleton_sources
     solution = ROOT / "labs" / GPU_LABS["05"] / "solution"
@@ -150,8 +150,10 @@ def test_a_gpu_submission_including_the_solution_does_not_compile(nvcc_and_sandb
         pristine_skeleton_sources(GPU_LABS["05"])["megakernel.cuh"]
     )
     binary, errors = build_lab("05", tmp_path, trusted=False)
-    assert binary is None and "No such file or directory" in errors, errors
-    binary, errors = build_lab("05", tmp_path, trusted=True)
+    assert binary is None and errors.startswith("refused: render.cu: #include"), errors
+    assert "\n" not in errors, errors
+    (tmp_path / "render.cu").write_text(pristine_skeleton_sources(GPU_LABS["05"])["render.cu"])
+    binary, errors = build_lab("05", tmp_path, trusted=False)
     assert binary is not None, errors
 
 

@@ -210,16 +210,17 @@ def test_a_compile_error_still_writes_results(tmp_path):
     assert all("does not compile" in o for o in outputs(results))
 
 
-def test_including_the_solution_does_not_compile(tmp_path):
-    """The compiler runs in the sandbox too: a render.cpp that #includes the solution (its
-    path is compiled into every build) finds nothing there. Trusted, it would compile."""
+def test_including_the_solution_is_refused_in_one_line(tmp_path):
+    """A render.cpp that #includes the solution by its path (compiled into every build) is
+    refused before anything is built, in one line naming the file (grading/source_rules.py);
+    the sandboxed compiler, which sees no solution, is the wall behind it
+    (test_the_reference_objects_are_out_of_the_compilers_reach)."""
     from grading.grade import build_lab
     solution = ROOT / "labs" / "01-serial" / "solution" / "render.cpp"
     (tmp_path / "render.cpp").write_text(f'#include "{solution}"\n')
     binary, errors = build_lab("01", tmp_path, trusted=False)
-    assert binary is None and "No such file or directory" in errors, errors
-    binary, errors = build_lab("01", tmp_path, trusted=True)
-    assert binary is not None, errors
+    assert binary is None and errors.startswith("refused: render.cpp: #include"), errors
+    assert "\n" not in errors, errors
 
 
 def test_an_interrupted_grader_leaves_complete_results_and_no_processes(tmp_path):
@@ -588,15 +589,22 @@ def test_the_secret_draws_the_timed_and_tested_renders():
 
 def test_the_reference_objects_are_out_of_the_compilers_reach(tmp_path):
     """A render.cpp embedding the reference's binary or objects (.incbin) to run them: the
-    students' tree has no references, the repository is out of the sandbox's view."""
+    directive is refused by name; spelt so that no rule reads it (".inc" "bin", joined by the
+    compiler), the assembler finds nothing: the students' tree has no references and the
+    repository is out of the sandbox's view."""
     from grading.grade import build_lab
     for target in (ROOT / "lab01-ref", ROOT / "build" / "common" / "host" / "lab_main.o"):
-        folder = handin(tmp_path / target.name, {
-            "render.cpp": f'__asm__(".section .rodata\\n.incbin \\"{target}\\"\\n.text");\n'
-                          + solution_text("01-serial", "render.cpp"),
-            "path_tracer.h": solution_text("01-serial", "path_tracer.h")})
-        binary, errors = build_lab("01", folder, trusted=False)
-        assert binary is None and "file not found" in errors, errors
+        for spelling in (".incbin", '.inc" "bin'):
+            folder = handin(tmp_path / f"{target.name}-{len(spelling)}", {
+                "render.cpp": f'__asm__(".section .rodata\\n{spelling} \\"{target}\\"\\n.text");\n'
+                              + solution_text("01-serial", "render.cpp"),
+                "path_tracer.h": solution_text("01-serial", "path_tracer.h")})
+            binary, errors = build_lab("01", folder, trusted=False)
+            assert binary is None, errors
+            if spelling == ".incbin":
+                assert errors.startswith("refused: render.cpp uses the assembler's .incbin")
+            else:
+                assert "file not found" in errors, errors
 
 
 # ---- intake: a hand-in is sources, its names are data, its archive is bounded ------------
