@@ -5,20 +5,21 @@ filter (a classic BPF program written here, so any Python 3 runs it, without a b
 libseccomp) and execs the command, which inherits both and can remove neither.
 
     /usr/bin/python3 -I confine.py [--ro PATH]... [--exec PATH]... [--rw PATH]...
-                                   [--device PATH]... [--fixed-affinity] [--ip-sockets]
-                                   -- COMMAND...
+                                   [--device PATH]... [--thread-names] [--fixed-affinity]
+                                   [--ip-sockets] -- COMMAND...
 
 Only what the run was given may run. Where the kernel offers Landlock (and a container's
 seccomp profile lets it through), files may be executed only from the system's folders (/usr,
 /bin, /sbin, /lib*) and each --exec PATH (the staged binary's read-only folder); read only
 there, under /etc, /proc, /sys, /dev and /run, and under each --ro PATH; written (never
 executed) only under each --rw PATH (its scratch folder; inside bubblewrap its private /tmp
-and /dev/shm), each --device PATH (a GPU's nodes) and device files such as /dev/null. So
-nothing a run writes can be executed, and in the user sandbox nothing is written where a
-later run could read it (/dev/shm and /tmp are shared there: the run's TMPDIR is its scratch).
-Without Landlock the permissions alone keep the grader's files from the sandbox user, and the
-grader's check of every executable mapping (labkit/sandbox.py, ExecCheck) finds a program
-run from a written file.
+and /dev/shm), each --device PATH (a GPU's nodes) and device files such as /dev/null; with
+--thread-names also the files of its own threads under /proc/self/task (the CUDA driver names
+its threads, and does not start where it cannot). So nothing a run writes can be executed,
+and in the user sandbox nothing is written where a later run could read it (/dev/shm and
+/tmp are shared there: the run's TMPDIR is its scratch). Without Landlock the permissions
+alone keep the grader's files from the sandbox user, and the grader's check of every
+executable mapping (labkit/sandbox.py, ExecCheck) finds a program run from a written file.
 
 The filter refuses, with EPERM, what would run code that is no file of the system's or the
 staged binary: memfd_create without MFD_NOEXEC_SEAL (an executable memory file), execveat
@@ -181,7 +182,7 @@ SYSTEM_READ = ("/etc", "/proc", "/sys", "/dev", "/run")
 DEVICES = ("/dev/null", "/dev/zero", "/dev/full", "/dev/tty", "/dev/urandom", "/dev/random")
 
 
-def landlock(read_only, runnable, writable, devices=()) -> bool:
+def landlock(read_only, runnable, writable, devices=(), thread_names=False) -> bool:
     """Confines the file system (see the module's docstring); False where Landlock is not
     available, so nothing was confined."""
     import platform
@@ -218,6 +219,8 @@ def landlock(read_only, runnable, writable, devices=()) -> bool:
         allow(path, READ)
     for path in (*DEVICES, *devices):
         allow(path, READ_FILE | WRITE_FILE)
+    if thread_names:  # this process's own threads, named by writing task/TID/comm
+        allow("/proc/self/task", READ_FILE | WRITE_FILE)
     for path in read_only:
         allow(path, READ)
     for path in runnable:
@@ -232,7 +235,8 @@ def landlock(read_only, runnable, writable, devices=()) -> bool:
 def main(argv) -> int:
     if "--" not in argv:
         print("usage: confine.py [--ro PATH]... [--exec PATH]... [--rw PATH]... "
-              "[--device PATH]... [--fixed-affinity] [--ip-sockets] -- COMMAND...",
+              "[--device PATH]... [--thread-names] [--fixed-affinity] [--ip-sockets] -- "
+              "COMMAND...",
               file=sys.stderr)
         return 2
     options, command = argv[:argv.index("--")], argv[argv.index("--") + 1:]
@@ -241,7 +245,8 @@ def main(argv) -> int:
         return [options[i + 1] for i, o in enumerate(options) if o == flag]
     # Landlock and an unprivileged filter need it; setpriv and bubblewrap set it already.
     ctypes.CDLL(None).prctl(PR_SET_NO_NEW_PRIVS, 1, 0, 0, 0)
-    landlock(paths("--ro"), paths("--exec"), paths("--rw"), paths("--device"))
+    landlock(paths("--ro"), paths("--exec"), paths("--rw"), paths("--device"),
+             thread_names="--thread-names" in options)
     try:
         load_filter(build_filter(fixed_affinity="--fixed-affinity" in options,
                                  ip_sockets="--ip-sockets" in options))

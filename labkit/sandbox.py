@@ -504,6 +504,7 @@ class Runner:
             from labkit import gpu
             options += [x for node in gpu.node_paths() for x in ("--device", node)]
             options += [x for folder in gpu.lib_dirs() for x in ("--ro", folder)]
+            options.append("--thread-names")
         if limits.cpu is not None:
             options.append("--fixed-affinity")
         return options
@@ -514,6 +515,8 @@ class Runner:
             return None
         programs = {inside for inside, outside in self.inputs.items()
                     if os.access(outside, os.X_OK)}
+        if not self.user_mode and bwrap_path():  # the grader's own launcher, wherever it lies
+            programs.add(os.path.realpath(bwrap_path()))
         folders = list(SYSTEM_FOLDERS)
         if self.gpu:
             from labkit import gpu

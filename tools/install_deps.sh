@@ -2,8 +2,9 @@
 # Installs what the labs need and is missing; says what it installs; safe to run again.
 # Compilers (g++, nvcc where present) come with the machine; this adds the JSON library,
 # GoogleTest, Google Benchmark, OpenMPI, bubblewrap (the grader's sandbox), util-linux's setpriv,
-# prlimit and taskset and python3-seccomp (the grader's sandbox where namespaces cannot be had:
-# grading/README.md), Slurm (`make grade-slurm`, tested on a one-node Slurm the test starts),
+# prlimit and taskset (the grader's sandbox where namespaces cannot be had:
+# grading/README.md), python3-seccomp (the grader's tests stand in for Docker's seccomp
+# profile with it: tests/grading/no_namespaces.py), Slurm (`make grade-slurm`, tested on a one-node Slurm the test starts),
 # debootstrap (`make test-gradescope`'s base image) and the Python packages of
 # tools/requirements.txt at their pinned versions (matplotlib: the plots of `make tradeoff`;
 # ruff and clang-format: `make lint`).

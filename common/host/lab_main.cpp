@@ -1,3 +1,5 @@
+#include <sys/stat.h>
+
 #include <cmath>
 #include <cstdio>
 #include <fstream>
@@ -35,12 +37,19 @@ static std::string json_escape(const std::string& s) {
 
 // The scene, centred on its geometry: where a scene sits in the world does not change its
 // image. One that float cannot place goes to the double build where this binary carries one
-// (a reference): this process becomes it, with the same command line.
+// (a reference): this process becomes it, with the same command line. The double build reads
+// the scene again, so a scene this process drained (a pipe, /dev/stdin) is refused instead.
 static Scene load_centred(const Options& options, char** argv) {
     try {
         return centre_scene(load_scene(options.scene_path));
     } catch (const PrecisionError&) {
         if (!has_double_twin()) throw;
+        struct stat st {};
+        if (stat(options.scene_path.c_str(), &st) != 0 || !S_ISREG(st.st_mode)) {
+            throw InputError(options.scene_path + " is no regular file, and only this " +
+                             "reference's double build places its scene, which it would read " +
+                             "again: save the scene to a file and pass that");
+        }
         const char* why = run_double_twin(argv);
         throw InputError(std::string("cannot start this reference's double build: ") + why);
     }

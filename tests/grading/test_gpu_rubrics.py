@@ -293,6 +293,9 @@ def test_sandboxed_cuda_builds_target_the_gpu_here(monkeypatch, tmp_path):
         def bind(self, *_args, **_kwargs):
             pass
 
+        def close_to_others(self, *_args):
+            pass
+
         def run(self, command, _limits):
             seen.append(command)
             return sandbox.Outcome(returncode=2, stdout="", stderr="stand-in", wall_seconds=0,

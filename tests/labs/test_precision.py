@@ -83,6 +83,25 @@ def test_the_reference_renders_wider_scales_in_double(lab01_ref, lab01_ref_doubl
     assert "1e9" in run_lab(lab01_ref, big, **settings).json["precision_reason"]
 
 
+def test_a_piped_scene_only_double_places_is_refused_in_one_line(lab01_ref, tmp_path):
+    """The double build reads the scene again, which a pipe drained by the float process
+    cannot give: the reference says so in one line (a file renders: the test above); a scene
+    float places renders from a pipe as from a file."""
+    big = scenes.write_scene(tmp_path / "big.json", scenes.scaled(
+        scenes.sphere_interior(**checks.INTERIOR), 1e12))
+    small = scenes.write_scene(tmp_path / "small.json", scenes.sphere_interior(**checks.INTERIOR))
+    args = ["--scene", "/dev/stdin", "--width", "4", "--height", "4", "--spp", "1", "--quiet",
+            "--out", str(tmp_path / "out.ppm")]
+    p = subprocess.run([str(lab01_ref), *args], input=big.read_text(), capture_output=True,
+                       text=True)
+    lines = p.stderr.strip().splitlines()
+    assert p.returncode == 2 and len(lines) == 1 and "no regular file" in lines[0], p.stderr
+    assert not (tmp_path / "out.ppm").exists()
+    p = subprocess.run([str(lab01_ref), *args], input=small.read_text(), capture_output=True,
+                       text=True)
+    assert p.returncode == 0 and (tmp_path / "out.ppm").is_file(), p.stderr
+
+
 def test_a_mixed_scale_scene_is_rendered_right_by_the_reference(lab01_ref, tmp_path):
     """A sphere of radius 1e-4 on a floor of half-size 1e4, lit from the side: float cannot
     place the sphere, so lab01-ref renders it in double, and its image is the float image of
