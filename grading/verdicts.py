@@ -7,6 +7,7 @@ import re
 
 # The cause of a failure, from what the failing check or the grader said: first match wins.
 CAUSES = [
+    ("foreign program", re.compile(r"ran a program it did not build")),
     ("timeout", re.compile(r"the grader did not finish in")),  # stopped by the batch
     ("no results", re.compile(r"left no results\.json")),
     ("compile error", re.compile(r"does not compile")),
@@ -23,8 +24,9 @@ CAUSES = [
 
 
 def provisional_points(results: dict) -> int:
-    """Points given without a measurement (a machine too busy): the regrade decides them."""
-    return sum(t.get("score", 0) for t in results.get("tests", [])
+    """Points waiting for a regrade (a machine too busy to measure them), which results.json
+    keeps apart from the score ("+N if the regrade confirms"): the regrade decides them."""
+    return sum(t.get("extra_data", {}).get("provisional", 0) for t in results.get("tests", [])
                if t.get("extra_data", {}).get("regrade"))
 
 

@@ -84,7 +84,7 @@ class Outcome:
     busiest_thread_share: float = float("nan")  # of the tree's CPU time, its busiest thread's
                                                 # (sampled by the grader: TreeClock)
     foreign: str | None = None  # what it ran that it was not given (ExecCheck), e.g.
-                                # "/tmp/x mapped executable by pid 12"
+                                # "/tmp/x (mapped executable by process 12)"
 
     @property
     def failure(self) -> str | None:
