@@ -398,9 +398,17 @@ def sandbox_problem(results: Results | None = None) -> str | None:
     return None
 
 
-def no_gpu_line(lab: str, reason: str) -> str:
-    return (f"lab {lab} renders on an NVIDIA GPU and {reason}: not graded, marked for regrade "
-            f"on a machine with one (yours: make grade-gpu, through the course's Slurm)")
+def no_gpu_line(lab: str, reason: str, environment=None) -> str:
+    """One line for a grade with no working GPU. Inside a Slurm job (make grade-gpu, the
+    course's batch), the node was given as a GPU node: its name is what staff need, and
+    running make grade-gpu again could land on it again."""
+    environment = os.environ if environment is None else environment
+    start = f"lab {lab} renders on an NVIDIA GPU and {reason}: not graded, marked for regrade"
+    if environment.get("SLURM_JOB_ID"):
+        node = environment.get("SLURMD_NODENAME") or environment.get("SLURM_NODELIST") or "?"
+        return (f"{start}; this Slurm job's node {node} (job {environment['SLURM_JOB_ID']}) "
+                f"was given as a GPU node: tell course staff, naming the node")
+    return f"{start} on a machine with one (yours: make grade-gpu, through the course's Slurm)"
 
 
 def next_step(results: dict) -> str | None:

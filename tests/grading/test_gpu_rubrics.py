@@ -532,3 +532,14 @@ def test_lab06_handed_in_for_lab07_loses_the_layout_points(on_gpu, tmp_path):
     layout = next(t["output"] for t in results["tests"]
                   if t["extra_data"]["check"] == "structure-of-arrays")
     assert "48 bytes apart" in layout, layout
+
+
+def test_no_gpu_inside_a_slurm_job_names_the_node_for_staff():
+    """make grade-gpu landed on a node whose GPU does not work: running it again is no advice;
+    the node's name for course staff is."""
+    from grading.grade import no_gpu_line
+    inside = no_gpu_line("05", "no NVIDIA GPU was found", {"SLURM_JOB_ID": "4242",
+                                                          "SLURMD_NODENAME": "gpu-node-7"})
+    assert "gpu-node-7" in inside and "4242" in inside and "course staff" in inside
+    assert "make grade-gpu" not in inside and "\n" not in inside
+    assert "make grade-gpu" in no_gpu_line("05", "no NVIDIA GPU was found", {})
