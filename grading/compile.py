@@ -91,6 +91,8 @@ def build_in_sandbox(variant_lab: str, handin: pathlib.Path, target: str = "vari
         binary = src / "lab"
         if out.failure is None and binary.is_file() and not binary.is_symlink():
             return keep_binary(binary), "", note
-        return None, f"{out.failure}\n{out.stdout}{out.stderr}", note
+        # The compiler names files by the grader's temporary folders: the student's by name.
+        said = (out.stdout + out.stderr).replace(f"{src}/", "").replace(f"{tree}/", "")
+        return None, f"{out.failure}\n{said}", note
     finally:
         shutil.rmtree(work, ignore_errors=True)

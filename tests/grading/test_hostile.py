@@ -208,6 +208,8 @@ def test_a_compile_error_still_writes_results(tmp_path):
     assert results["score"] == 0
     assert "does not compile" in results["output"] and "error:" in results["output"], results
     assert all("does not compile" in o for o in outputs(results))
+    # the file by its own name, not by the grader's temporary folder
+    assert "render.cpp:1:" in results["output"] and "students-tree-" not in results["output"]
 
 
 def test_including_the_solution_is_refused_in_one_line(tmp_path):
