@@ -18,15 +18,17 @@ from grading.verdicts import failure_cause, flagged, provisional_points, waiting
 MOST_NOTE_LINES = 3  # of a row's own notes (a compile error's lines are in its cause and page)
 
 SORT_SCRIPT = """<script>
-// Sorts the rows by the clicked column: numbers (data-v) as numbers, text as text; a second
-// click reverses.
+// Sorts the rows by the clicked column: numbers (data-v) as numbers, highest first; text as
+// text, A to Z; a second click reverses.
 function sortBy(th) {
   const table = th.closest("table"), body = table.tBodies[0];
   const k = Array.from(th.parentNode.children).indexOf(th);
-  const down = th.dataset.dir !== "down";
-  th.dataset.dir = down ? "down" : "up";
   const key = tr => { const c = tr.children[k]; const v = c.dataset.v;
     return v !== undefined && v !== "" ? parseFloat(v) : c.textContent.trim().toLowerCase(); };
+  const numbers = Array.from(body.rows).some(r => typeof key(r) === "number");
+  const first = numbers ? "down" : "up";
+  const down = (th.dataset.dir ? (th.dataset.dir === "down" ? "up" : "down") : first) === "down";
+  th.dataset.dir = down ? "down" : "up";
   const rows = Array.from(body.rows).sort((a, b) => {
     const x = key(a), y = key(b);
     const order = typeof x === "number" && typeof y === "number" ? x - y
@@ -133,7 +135,8 @@ def write_html(path: pathlib.Path, lab: str, rows: dict[str, dict], labels: list
             cells.append(f'<td class="{e(cls)}" data-v="{t["score"]}" '
                          f'title="{e(t.get("output", ""))}">{t["score"]}/{t["max_score"]}</td>')
         own = [line for line in note_lines(r) if line not in shared][:MOST_NOTE_LINES]
-        cells.append(f"<td>{e(failure_cause(r))}</td><td>{'<br>'.join(map(e, own))}</td>")
+        cells.append(f'<td class="words">{e(failure_cause(r))}</td>'
+                     f'<td class="words">{"<br>".join(map(e, own))}</td>')
         body.append(f"<tr>{''.join(cells)}</tr>")
     said = "".join(f"<li>{e(line)} <i>({shared_count[line]} submissions)</i></li>"
                    for line in shared)
@@ -146,6 +149,7 @@ def write_html(path: pathlib.Path, lab: str, rows: dict[str, dict], labels: list
 <style>body{{font-family:sans-serif}} td,th{{padding:2px 8px;border:1px solid #ccc}}
 .passed{{background:#cfc}} .failed{{background:#fcc}} .regrade{{background:#ffc}}
 .waiting{{background:#eee}} table{{border-collapse:collapse}} thead th{{cursor:pointer}}
+td.words{{min-width:16em;max-width:28em;overflow-wrap:anywhere}}
 .plots svg{{margin-right:2em}}</style>
 {SORT_SCRIPT}
 <h1>Lab {e(lab)}: {len(rows)} submissions, {flagged_count} flagged</h1>

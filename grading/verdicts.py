@@ -23,6 +23,18 @@ CAUSES = [
 ]
 
 
+CAUSE_CHARS = 200  # of a cause's words: the row's whole story is on the submission's page
+
+
+def clipped(text: str, most: int = CAUSE_CHARS) -> str:
+    """`text` cut at most `most` characters, at a space where there is one, marked with an
+    ellipsis: never a word cut in half."""
+    if len(text) <= most:
+        return text
+    cut = text[:most - 1]
+    return (cut[:cut.rfind(" ")] if " " in cut else cut).rstrip(" ,;:") + "…"
+
+
 def provisional_points(results: dict) -> int:
     """Points waiting for a regrade (a machine too busy to measure them), which results.json
     keeps apart from the score ("+N if the regrade confirms"): the regrade decides them."""
@@ -59,17 +71,17 @@ def failure_cause(results: dict) -> str:
             if pattern.search(text):
                 if cause == "refused":  # the grader's one line, once
                     why = text.split("the hand-in was refused: ", 1)[1].splitlines()
-                    return f"refused: {why[0][:200] if why else ''}"
+                    return f"refused: {clipped(why[0]) if why else ''}"
                 if cause == "compile error":  # the compiler's first line after the note
                     lines = top.splitlines()
                     at = next((i for i, line in enumerate(lines) if "does not compile" in line), 0)
                     after = [line for line in lines[at + 1:] if line.strip()]
-                    return f"compile error: {after[0][:200] if after else ''}".rstrip(": ")
-                return f"{cause}: {text.splitlines()[0][:200]}"
+                    return f"compile error: {clipped(after[0]) if after else ''}".rstrip(": ")
+                return f"{cause}: {clipped(text.splitlines()[0])}"
     if failing:
         t = failing[0]
         kind = "image check" if t.get("extra_data", {}).get("check", "").startswith(
             ("golden", "hidden", "sphere", "lit", "glass", "scale")) else "check"
-        first = t.get("output", "").splitlines()[0][:200] if t.get("output") else ""
+        first = clipped(t.get("output", "").splitlines()[0]) if t.get("output") else ""
         return f"{kind} {t['name']}: {first}"
     return ""

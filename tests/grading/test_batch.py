@@ -305,6 +305,17 @@ def test_the_class_page_names_links_sorts_plots_and_says_a_shared_note_once(tmp_
     assert page.count(HIDDEN_NOTE.split(" (")[0]) == 1, page  # said once, not per row
     assert page.count("<svg") >= 2 and "sort" in page and "<th onclick" in page
     assert "serial: in every timed run" in page and "1.91" in page and "1.97" in page
+    # causes and notes wrap in columns of their own width, so every column fits a screen
+    assert 'td.words{' in page and page.count('<td class="words">') == 2 * len(rows)
+
+
+def test_a_cause_is_cut_between_words():
+    from grading.verdicts import clipped
+    text = "the timed render differs from the serial reference " * 10
+    cut = clipped(text, 60)
+    assert len(cut) <= 60 and cut.endswith("…") and text.startswith(cut[:-1])
+    assert text[len(cut) - 1] == " ", cut  # where a word ended
+    assert clipped("short", 60) == "short"
 
 
 def test_a_grader_that_never_ends_is_stopped_and_the_class_goes_on(tmp_path, monkeypatch):
