@@ -194,6 +194,17 @@ def end_processes(uid: int, gid: int, seconds: float = 5.0) -> list[int]:
         time.sleep(0.01)
 
 
+def _remove_entry(remove, name: str, folder_fd: int, problems: list[str]) -> None:
+    """`remove(name, dir_fd=folder_fd)` (os.unlink or os.rmdir): one already gone is fine,
+    any other failure is said in `problems`."""
+    try:
+        remove(name, dir_fd=folder_fd)
+    except FileNotFoundError:
+        pass
+    except OSError as e:
+        problems.append(f"{name}: {e.strerror}")
+
+
 def _remove_tree(parent_fd: int, name: str) -> list[str]:
     """Remove the folder `name` of the folder open as `parent_fd`, however deep, without
     recursion and without walking paths: each folder is opened from its parent's descriptor
@@ -235,22 +246,11 @@ def _remove_tree(parent_fd: int, name: str) -> list[str]:
                 if is_dir:
                     enter(fd, entry.name)
                 else:
-                    try:
-                        os.unlink(entry.name, dir_fd=fd)
-                    except FileNotFoundError:
-                        pass
-                    except OSError as e:
-                        problems.append(f"{entry.name}: {e.strerror}")
+                    _remove_entry(os.unlink, entry.name, fd, problems)
                 continue
             stack.pop()
             os.close(fd)
-            above = stack[-1][0] if stack else parent_fd
-            try:
-                os.rmdir(own_name, dir_fd=above)
-            except FileNotFoundError:
-                pass
-            except OSError as e:
-                problems.append(f"{own_name}: {e.strerror}")
+            _remove_entry(os.rmdir, own_name, stack[-1][0] if stack else parent_fd, problems)
     finally:
         for fd, _, _ in stack:
             os.close(fd)
@@ -290,12 +290,7 @@ def remove_files(uid: int, places=SHARED_PLACES) -> list[str]:
                     if stat.S_ISDIR(est.st_mode):
                         problems += _remove_tree(fd, entry.name)
                     else:
-                        try:
-                            os.unlink(entry.name, dir_fd=fd)
-                        except FileNotFoundError:
-                            pass
-                        except OSError as e:
-                            problems.append(f"{entry.name}: {e.strerror}")
+                        _remove_entry(os.unlink, entry.name, fd, problems)
                 elif stat.S_ISDIR(est.st_mode) and est.st_mode & stat.S_IWOTH:
                     with contextlib.suppress(OSError):
                         folders.append(os.open(entry.name, os.O_RDONLY | os.O_DIRECTORY |
