@@ -83,21 +83,28 @@ def test_the_missing_gather_is_rows_never_gathered_not_a_work_split(tmp_path):
     assert "never gathered" in cause and "work split" not in cause, result.detail
 
 
-def test_a_wrong_lane_mask_in_lab02_is_named_before_the_statistics(tmp_path):
-    """Lab 02's rectangle test keeping hits behind the ray (its `crosses` mask dropped): the
-    golden check names the lanes, which lab 01's bits show, before "too noisy", which would
-    point at a loop over paths lab 02 students never write."""
+def test_a_wrong_lane_mask_in_lab02_is_named_by_its_kind_before_the_statistics(tmp_path):
+    """Lab 02's rectangle test keeping hits behind the ray (its `crosses` mask dropped) and its
+    triangle test accepting one winding only: the golden check names the lanes, which lab
+    01's bits show, and the two kinds whose scenes alone differ, not the sphere or the convex
+    quad, before "too noisy", which would point at a loop over paths lab 02 students never
+    write."""
     if not cpu_has_avx2():
         pytest.skip("this CPU has no AVX2/FMA: lab 02's Part B cannot run")
     source = (ROOT / "common/simd/packet_tracer.h").read_text()
-    old = "return select(crosses & inside, t, t_max);"
-    assert old in source
-    mutant = build_variant("02-simd", tmp_path,
-                           {"packet_tracer.h": source.replace(old, "return select(inside, t, "
-                                                                   "t_max);")})
+    mutations = {"return select(crosses & inside, t, t_max);": "return select(inside, t, t_max);",
+                 "inside = and_not(candidates, any_negative & any_positive);":
+                     "inside = and_not(candidates, any_negative);"}
+    for old, new in mutations.items():
+        assert source.count(old) == 1, old
+        source = source.replace(old, new)
+    mutant = build_variant("02-simd", tmp_path, {"packet_tracer.h": source})
     with draws.secret("lanes"), symptoms.grading("02"), policy(UNTRUSTED), rerun_as("./lab02"):
-        result = checks.check_golden(mutant, "cornell")
+        result = checks.check_golden(mutant, "showcase")
     assert not result.passed
-    assert result.detail.startswith("lanes: ") and "lane mask" in result.detail, result.detail
+    cause = result.detail.split("; ", 1)[0]
+    assert cause.startswith("lanes: ") and "lane mask" in cause, result.detail
+    assert "axis-aligned rectangles" in cause and "triangles" in cause, cause
+    assert "spheres" not in cause and "convex quads" not in cause, cause
     # and the command to see it again at home, on the scene the check rendered
-    assert "rerun: ./lab02 --scene common/scenes/cornell.json " in result.detail, result.detail
+    assert "rerun: ./lab02 --scene common/scenes/showcase.json " in result.detail, result.detail
