@@ -223,6 +223,14 @@ ONE_THREAD = 0.9
 # noise and a faster serial path. One that does read something it had kept (its own first
 # render, another run's image) or slowed the reference: refused, never scored.
 IMPOSSIBLE = 1.5
+# Threads that take turns (an `ordered` loop body, one `critical` around the work, a lock held
+# while tracing): the work is shared among the threads, so no thread did ONE_THREAD of it, and
+# while they wait they may spin, so the CPU time says "parallel"; only the speed tells. Where
+# the same rounds measured at least TURNS_CAPACITY cores' worth for n copies of the serial
+# reference (room for a parallel program) and the program's best speedup stays at most
+# TURNS_SPEEDUP, the verdict is final: a machine that busy still gives the reference ~1.4x.
+TURNS_CAPACITY = 1.5
+TURNS_SPEEDUP = 1.15
 
 
 def busiest_thread_share(run) -> float:
@@ -385,12 +393,27 @@ def _parallel_speedup(binary, baseline, settings: dict, *, threads, launcher, fr
     credit, timing = best
     bar = timing.required(fraction)
     detail = timing.describe("yours") + note + credit_note(credit, bar)
+    if took_turns(timing.speedup("yours"), timing.capacity, shares):
+        return CheckResult("parallel speedup", False,
+                           f"the threads ran one at a time: the work was shared among them "
+                           f"(the busiest thread did {max(shares):.0%} of the CPU time) but "
+                           f"the best speedup was {timing.speedup('yours'):.2f}x where the "
+                           f"machine gave {timing.capacity:.2f} cores' worth in the same rounds; "
+                           f"an ordered loop body, a critical section or a lock around the work "
+                           f"makes them wait for each other ({detail})", credit=0.0)
     if credit < 1 and timing.capacity < BUSY:
         return CheckResult("parallel speedup", credit > 0 or threaded(),
                            f"short of the bar on a machine too busy to judge ({detail}); "
                            f"marked for regrade", regrade=True, credit=credit,
                            provisional=1.0 - credit)
     return CheckResult("parallel speedup", credit > 0, detail, credit=credit)
+
+
+def took_turns(speedup: float, capacity: float, shares: list[float]) -> bool:
+    """Threads that shared the work but ran one at a time (see TURNS_CAPACITY): a final
+    verdict, not the machine's fault."""
+    return (capacity >= TURNS_CAPACITY and speedup <= TURNS_SPEEDUP and bool(shares)
+            and max(shares) < ONE_THREAD)
 
 
 def together_launcher(n: int) -> list[str]:

@@ -14,6 +14,8 @@ CAUSES = [
     ("no hand-in", re.compile(r"the hand-in holds (none|lab)")),
     ("refused", re.compile(r"the hand-in was refused")),
     ("timeout", re.compile(r"timed out")),
+    ("rows missing", re.compile(r"never (rendered|gathered)")),
+    ("threads took turns", re.compile(r"the threads ran one at a time")),
     ("work split", re.compile(r"deterministic but different")),
     ("race", re.compile(r"nondeterministic|data race|differs? for|differs from the serial")),
     ("signal", re.compile(r"killed by|signal|SIG[A-Z]+")),
@@ -33,6 +35,16 @@ def clipped(text: str, most: int = CAUSE_CHARS) -> str:
         return text
     cut = text[:most - 1]
     return (cut[:cut.rfind(" ")] if " " in cut else cut).rstrip(" ,;:") + "…"
+
+
+def around(line: str, pattern: re.Pattern, most: int = CAUSE_CHARS) -> str:
+    """`line`, or where the words that name the cause would be cut off, the clause holding
+    them onward: the label's evidence is always shown."""
+    found = pattern.search(line)
+    if not found or found.end() <= most - 20:
+        return line
+    start = max(line.rfind("; ", 0, found.start()), line.rfind(": ", 0, found.start()))
+    return "…" + line[start + 2:] if start >= 0 else line
 
 
 def provisional_points(results: dict) -> int:
@@ -77,7 +89,7 @@ def failure_cause(results: dict) -> str:
                     at = next((i for i, line in enumerate(lines) if "does not compile" in line), 0)
                     after = [line for line in lines[at + 1:] if line.strip()]
                     return f"compile error: {clipped(after[0]) if after else ''}".rstrip(": ")
-                return f"{cause}: {clipped(text.splitlines()[0])}"
+                return f"{cause}: {clipped(around(text.splitlines()[0], pattern))}"
     if failing:
         t = failing[0]
         kind = "image check" if t.get("extra_data", {}).get("check", "").startswith(

@@ -234,6 +234,23 @@ def test_a_race_and_a_work_split_are_told_apart():
     assert batch.failure_cause(split).startswith("work split: ")
 
 
+def test_a_cause_is_labelled_by_its_verdict_and_shows_its_words():
+    """Rows never gathered (lab 04's skeleton) are no race though the check says the image
+    "differs for" a count; the words that name the cause survive the cut; threads that took
+    turns are their own cause."""
+    def failed(output):
+        return {"score": 0, "tests": [{"name": "bit for bit", "score": 0, "max_score": 30,
+                                       "output": output}]}
+    counts = ", ".join(f"{n} ranks x {t} threads" for n in (1, 2, 3) for t in (1, 2, 4))
+    gather = failed(f"FAIL: differs for {counts} from lab 01's image: at 2 ranks x 1 threads, "
+                    f"150 of 300 rows are exactly black (rows 150-299): rows never rendered or "
+                    f"never gathered (how the rows are divided among ranks)")
+    cause = batch.failure_cause(gather)
+    assert cause.startswith("rows missing: ") and "never gathered" in cause, cause
+    turns = failed("FAIL: the threads ran one at a time: the work was shared among them")
+    assert batch.failure_cause(turns).startswith("threads took turns: ")
+
+
 def test_leaderboard_only_for_a_measured_correct_speed():
     """Gradescope's leaderboard (results.json) ranks the speed the grader measured on a
     correct image; a failed, unmeasured or provisional speed check gives no entry."""

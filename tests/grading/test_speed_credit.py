@@ -209,3 +209,22 @@ def test_a_spinning_thread_opens_no_gate_on_cpu_share_alone(monkeypatch, tmp_pat
     assert bitwise["score"] == 0 and bitwise["extra_data"]["provisional"] == 30, (
         bitwise["output"], data["tests"][0]["output"])
     assert "counted when the regrade confirms the parallel speedup" in bitwise["output"], bitwise
+
+
+def test_threads_that_take_turns_are_named_not_left_to_a_regrade(monkeypatch):
+    """An `ordered` row loop: the work shared among the threads (the busiest did half), the
+    waiting threads spinning (1.9 cores' worth of CPU time), and 0.95x where the same rounds
+    measured 1.78 cores' worth: a final verdict that names the cause, not the machine."""
+    result = parallel_timed(monkeypatch, capacity=1.78, base=0.600, yours=0.600 / 0.95,
+                            cores_used=1.9, busiest=0.5)
+    assert not result.passed and not result.regrade and result.credit == 0, result
+    assert result.detail.startswith("the threads ran one at a time"), result.detail
+    assert "0.95x" in result.detail and "1.78 cores' worth" in result.detail, result.detail
+
+
+def test_a_slow_speedup_on_a_machine_without_room_still_waits_for_a_regrade(monkeypatch):
+    """The same 0.95x where the machine gave only 1.4 cores' worth: not told apart from the
+    load, so marked for regrade as before."""
+    result = parallel_timed(monkeypatch, capacity=1.4, base=0.600, yours=0.600 / 0.95,
+                            cores_used=1.3, busiest=0.5)
+    assert result.regrade and result.credit == 0, result

@@ -15,7 +15,7 @@ from labkit.harness import (
     render_seconds,
     run_lab,
 )
-from labkit.variants import build_pristine_skeleton
+from labkit.variants import build_pristine_skeleton, build_variant, lab_sources
 
 # Small renders for the bitwise comparisons: every pixel, sample and bounce is exercised.
 SMALL = dict(width=48, height=40, spp=8, seed=3)
@@ -97,14 +97,29 @@ def test_skeleton_is_correct(lab03_skeleton, lab01_bits, threads):
 # --- speed ----------------------------------------------------------------------------------
 
 @pytest.fixture(scope="module")
-def speedups(lab01_ref, lab03_ref, lab03_skeleton):
-    """Speedups over lab01-ref of lab03-ref and of the skeleton with every core, measured with
-    the machine's capacity alongside (labkit.harness.measure_parallel)."""
+def lab03_ordered(tmp_path_factory):
+    """The reference with its row loop `ordered`: every row body waits for the one before,
+    so the threads share the work but run one at a time."""
+    source = lab_sources("03-openmp")["render.cpp"]
+    loop = "#pragma omp parallel for schedule(dynamic, 1) num_threads(threads)"
+    body = "        for (int x = 0; x < width; ++x) image.at(x, y) = pixel(x, y);"
+    assert source.count(loop) == 1 and source.count(body) == 1
+    source = source.replace(loop, loop.replace("parallel for", "parallel for ordered")).replace(
+        body, "#pragma omp ordered\n" + body)
+    return build_variant("03-openmp", tmp_path_factory.mktemp("lab03-ordered"),
+                         {"render.cpp": source})
+
+
+@pytest.fixture(scope="module")
+def speedups(lab01_ref, lab03_ref, lab03_skeleton, lab03_ordered):
+    """Speedups over lab01-ref of lab03-ref, of the skeleton and of the ordered loop with every
+    core, measured with the machine's capacity alongside (labkit.harness.measure_parallel)."""
     if available_cores() < 2:
         pytest.skip("only one core available to this process: no parallel speedup to measure")
     timing = measure_parallel(lambda: render_seconds(lab01_ref, **TIMED),
                               {"lab03-ref": lambda: render_seconds(lab03_ref, **TIMED),
-                               "skeleton": lambda: render_seconds(lab03_skeleton, **TIMED)},
+                               "skeleton": lambda: render_seconds(lab03_skeleton, **TIMED),
+                               "ordered": lambda: render_seconds(lab03_ordered, **TIMED)},
                               rounds=ROUNDS)
     if timing.capacity < 1.5:
         pytest.skip(f"the machine is too busy to measure a parallel speedup: "
@@ -124,6 +139,15 @@ def test_skeleton_is_serial(speedups):
     speedup = speedups.speedup("skeleton")
     assert speedup < 1.3, speedups.describe("skeleton") + ": expected ~1x"
     assert speedup < speedups.required(), speedups.describe("skeleton")
+
+
+def test_threads_taking_turns_stay_below_the_grader_s_turns_bar(speedups):
+    """An ordered row loop, where the machine has room for a parallel program: no faster than
+    the grader's bar for threads that ran one at a time (grading/speed_checks.py), while the
+    reference, in the same rounds, is well above it."""
+    from grading.speed_checks import TURNS_SPEEDUP
+    assert speedups.speedup("ordered") <= TURNS_SPEEDUP, speedups.describe("ordered")
+    assert speedups.speedup("lab03-ref") > TURNS_SPEEDUP + 0.2, speedups.describe("lab03-ref")
 
 
 # --- variants -------------------------------------------------------------------------------
