@@ -37,7 +37,14 @@ from grading.invariance_checks import (
 )
 from grading.lanes import lanes_not_lab01
 from grading.layout_check import check_structure_of_arrays
-from grading.mpi_checks import DISTRIBUTIONS, check_distributions, mpirun, report_rows
+from grading.mpi_checks import (
+    DISTRIBUTIONS,
+    HYBRID_SHARED,
+    check_distributions,
+    check_hybrid_threads,
+    mpirun,
+    report_rows,
+)
 from grading.speed_checks import (
     BUSY,
     IMPOSSIBLE,
@@ -125,4 +132,6 @@ __all__ = [
     "DISTRIBUTIONS",
     "report_rows",
     "check_distributions",
+    "check_hybrid_threads",
+    "HYBRID_SHARED",
 ]

@@ -93,6 +93,11 @@ def passes_when(lab: str, item: grade.Item) -> str:
         return (f"with `RT_MPI_DISTRIBUTION=interleaved` rank r of {ranks} renders "
                 f"rows r, r + {ranks}, r + {2 * ranks}, ..., with `dynamic` the rows are not "
                 f"block's fixed bands (as `RT_MPI_REPORT=1` lists them); half the points each")
+    if item.id == "hybrid":
+        threads = parameter(checks.check_hybrid_threads, "threads")
+        return (f"one rank with `--threads {threads}` under `mpirun`: no thread did "
+                f"{checks.HYBRID_SHARED:.0%} of the CPU time (each thread's measured by the "
+                f"grader): the rank's rows are shared among its threads")
     if item.id == "parallel-speedup":
         fraction = parameter(checks.check_parallel_speedup, "fraction")
         who = ("`mpirun -np N` (N = the cores), 1 thread a rank" if launcher

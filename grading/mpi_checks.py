@@ -1,6 +1,7 @@
 """Lab 04's ranks: mpirun as the grader starts it, and every distribution of rows."""
 from __future__ import annotations
 
+import math
 import re
 
 from grading.check_result import CheckResult
@@ -63,3 +64,32 @@ def check_distributions(binary, ranks: int = 3, width: int = 16, height: int = 1
     detail = f"{ranks} ranks, {width}x{height}: " + "; ".join(text for _, text in verdicts)
     return CheckResult("rows per distribution", passed == len(verdicts), detail,
                        credit=passed / len(verdicts))
+
+
+# A rank's --threads share its rows (handout 04, task 4) when its busiest thread did less than
+# this part of the run's CPU time: two threads sharing the work do about half each; one rank
+# whose loop is not threaded does nearly all of it, less only mpirun's own start-up, which a
+# render of HYBRID_SETTINGS (about 2 s of CPU time on the course's two-core VM) keeps small.
+HYBRID_SHARED = 0.7
+HYBRID_SETTINGS = dict(width=256, height=256, spp=128)
+
+
+def check_hybrid_threads(binary, threads: int = 2) -> CheckResult:
+    """Lab 04's task 4, which the image cannot show (an unthreaded rank renders the same
+    bits): one rank run with `threads` OpenMP threads, and the CPU time of each of its threads
+    measured by the grader (as lab 03's serial check does). Passes where no thread did
+    HYBRID_SHARED of the work, at any load: a thread's share does not depend on the cores
+    the machine gave."""
+    run = run_lab(binary, **HYBRID_SETTINGS, threads=threads, launcher=mpirun(1))
+    share = run.thread_share
+    if math.isnan(share):
+        return CheckResult("hybrid threads", True, "the threads' CPU time could not be measured "
+                           "here; marked for regrade", regrade=True, credit=0.0, provisional=1.0)
+    shared = share < HYBRID_SHARED
+    detail = (f"1 rank x {threads} threads, {HYBRID_SETTINGS['width']}x"
+              f"{HYBRID_SETTINGS['height']} at {HYBRID_SETTINGS['spp']} spp: its busiest thread "
+              f"did {share:.0%} of the CPU time (measured by the grader, thread by thread)")
+    if not shared:
+        detail += ("; one thread did the rank's work: the rows a rank renders are shared among "
+                   "its --threads with an OpenMP loop (task 4, hybrid, undone?)")
+    return CheckResult("hybrid threads", shared, detail, credit=1.0 if shared else 0.0)

@@ -462,3 +462,19 @@ def test_grader_takes_the_points_of_an_undone_distribution(lab04_ref, task, tmp_
     assert not undone.passed and undone.credit == 0.5, str(undone)
     assert round(item.points * undone.credit) < item.points
     assert f"task {2 if task == 'interleaved' else 3}" in undone.detail, str(undone)
+
+
+def test_grader_takes_the_points_of_an_undone_hybrid_task(lab04_ref, tmp_path):
+    """A rank that ignores --threads renders lab 01's bits: the threads' CPU time shows the
+    hybrid task left undone, and its points are lost; the reference's threads share the work."""
+    from grading.grade import RUBRICS
+    from labkit.variants import build_variant, lab_sources
+    pragma = "#pragma omp parallel for schedule(dynamic, 16) num_threads(team.threads)\n"
+    source = lab_sources("04-mpi")["render.cpp"]
+    assert source.count(pragma) == 1
+    mutant = build_variant("04-mpi", tmp_path, {"render.cpp": source.replace(pragma, "")})
+    assert any(i.id == "hybrid" and i.points > 0 for i in RUBRICS["04"])
+    done, undone = checks.check_hybrid_threads(lab04_ref), checks.check_hybrid_threads(mutant)
+    assert done.passed and done.credit == 1, str(done)
+    assert not undone.passed and undone.credit == 0 and not undone.regrade, str(undone)
+    assert "task 4" in undone.detail, str(undone)
