@@ -20,13 +20,25 @@ import sys
 import time
 from typing import Callable
 
-from grading import checks, draws, golden_sums, hidden, part_a, references, report_html, symptoms
+from grading import (
+    checks,
+    draws,
+    golden_sums,
+    hidden,
+    part_a,
+    race_checks,
+    references,
+    report_html,
+    symptoms,
+)
 from grading.results import Results, Test
 from labkit import gpu, registry, sandbox
 from labkit.harness import ROOT, RunPolicy, available_cores, policy, rerun_as
 
 LAB01_REFERENCE = ROOT / "lab01-ref"
 LAB04_REFERENCE = ROOT / "lab04-ref"
+# The binaries a rubric's parts run on, besides the lab's own (Item.part).
+PART_NAMES = {"a": "Part A binary (./lab02a)", "race": "ThreadSanitizer build (make lab03-race)"}
 
 
 @dataclasses.dataclass(frozen=True)
@@ -189,7 +201,10 @@ RUBRIC_KINDS: dict[str, Callable[[str], list[Item]]] = {
         needs(checked_golden("showcase", 10), "parallel-speedup"),
         # 75% of the cores' worth of throughput the machine gives during the run; the
         # handout's bar, 0.9 x cores, is measured by tools/bench/openmp.py on a quiet machine.
-        parallel_speedup(40),
+        parallel_speedup(30),
+        # The races no image shows: the hand-in built for ThreadSanitizer (its own binary).
+        Item("races", "no data race", 10, race_checks.check_races, requires="parallel-speedup",
+             part="race"),
     ],
     # Every task of the handout: the gather (the bits at 2, 3, 5 ranks), the interleaved and
     # dynamic distributions (their bits, and the rows each rank rendered, which no image
@@ -325,8 +340,8 @@ def grade_items(rubric, binary, heatmap_dir, secret, results, run_policy, limits
         unconfirmed = [i.label for i in rubric if i.id in item.requires
                        and gate_unconfirmed(results.test(i.id))]
         # A part's binary, or why it has none (a string); the lab's own binary otherwise.
-        target = (parts or {}).get(item.part, f"no Part {item.part.upper()} binary was "
-                                              f"given") if item.part else binary
+        target = (parts or {}).get(item.part, f"no {PART_NAMES[item.part]} was given") \
+            if item.part else binary
         if item.part and isinstance(target, str):
             test.finish(0, f"not graded: {target}")
         elif time.perf_counter() - start > budget_seconds:
@@ -596,6 +611,21 @@ def part_a_binary(a, results: Results) -> pathlib.Path | str:
     return binary.resolve()
 
 
+def race_binary(a, results: Results) -> pathlib.Path | str:
+    """Lab 03's ThreadSanitizer build for this grade (grading/race_checks.py), or why there is
+    none."""
+    if a.binary:
+        if a.race_binary and pathlib.Path(a.race_binary).is_file():
+            return pathlib.Path(a.race_binary).resolve()
+        return "no ThreadSanitizer build was given (--race-binary BINARY)"
+    binary, errors = race_checks.build(registry.lab(a.lab).folder,
+                                       pathlib.Path(a.sources) if a.sources else None, a.trusted)
+    if binary is None:
+        return errors.removeprefix("refused: ") if errors.startswith("refused: ") else \
+            f"the ThreadSanitizer build (clang++) does not compile: {first_errors(errors, 5)}"
+    return binary.resolve()
+
+
 def main(argv=None) -> int:
     p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     p.add_argument("lab", choices=sorted(RUBRICS))
@@ -612,6 +642,8 @@ def main(argv=None) -> int:
     p.add_argument("--budget-seconds", type=float, default=BUDGET_SECONDS,
                    help=f"wall-clock budget of the whole grade (default {BUDGET_SECONDS})")
     p.add_argument("--part-a", help="with --binary: lab 02's Part A binary (./lab02a)")
+    p.add_argument("--race-binary", help="with --binary: lab 03's ThreadSanitizer build "
+                                         "(make lab03-race)")
     p.add_argument("--no-build", action="store_true",
                    help="run make for nothing: the references are built already (a batch "
                         "builds them once before its graders start side by side)")
@@ -669,6 +701,8 @@ def main(argv=None) -> int:
         parts = {}
         if part_a.has_part_a(a.lab):
             parts["a"] = part_a_binary(a, results)
+        if registry.lab(a.lab).rubric in race_checks.RUBRICS:
+            parts["race"] = race_binary(a, results)
         heatmaps = pathlib.Path(a.heatmaps)
         clear_report(heatmaps)
         heatmaps.mkdir(parents=True, exist_ok=True)

@@ -33,6 +33,31 @@ release:
 variant-driver: $(VARIANT_DRIVER_$(VARIANT_LAB))
 cuda-variant-driver: $(COMMON_OBJ)
 
+# ThreadSanitizer builds, for lab 03's race check (grading/race_checks.py): LLVM's clang and
+# OpenMP runtime, whose Archer tool tells ThreadSanitizer what OpenMP's barriers and loops
+# order (GCC's libgomp tells it nothing, and every barrier would read as a race). The lab's
+# own files at -O0, so that a variable its threads share is read and written in memory as the
+# source says, not kept in a register where no tool sees it (and no image shows it); the
+# driver, which has no threads, at -O1. `make lab03-race` builds your labs/03-openmp/skeleton
+# so (make grade LAB=03 does); race-variant builds a hand-in folder, in the grader's sandbox.
+.PHONY: race-variant race-variant-driver
+RACE_CXX    ?= clang++
+RACE_BUILD  := $(BUILD)/race
+RACE_FLAGS  := -std=c++17 -g -fsanitize=thread -fopenmp -ffp-contract=off -w \
+               -DRT_SOURCE_DIR='"$(CURDIR)"'
+RACE_DRIVER := $(COMMON_OBJ:$(BUILD)/%=$(RACE_BUILD)/%)
+$(RACE_BUILD)/%.o: %.cpp
+	@mkdir -p $(dir $@)
+	$(RACE_CXX) $(RACE_FLAGS) -O1 $(INCLUDES) -c $< -o $@
+race-variant-driver: $(RACE_DRIVER)
+race-variant: $(RACE_DRIVER)
+	@test -n "$(VARIANT)" || { echo "race-variant: needs VARIANT=DIR" >&2; exit 2; }
+	$(RACE_CXX) $(RACE_FLAGS) -O0 -I'$(VARIANT)' $(INCLUDES) \
+	    $(call quoted,$(sort $(wildcard $(VARIANT)/*.cpp))) $(RACE_DRIVER) -o '$(VARIANT)/lab'
+lab03-race: $(RACE_DRIVER) $(wildcard $(LAB03)/skeleton/*.cpp $(LAB03)/skeleton/*.h)
+	$(RACE_CXX) $(RACE_FLAGS) -O0 -I$(LAB03)/skeleton $(INCLUDES) $(wildcard $(LAB03)/skeleton/*.cpp) \
+	    $(RACE_DRIVER) $(INTO_TARGET)
+
 # make test-gradescope: the lab-01 Gradescope bundle built into a Docker image on a debootstrap
 # Debian base and graded in containers with Docker's default seccomp at 0.5 CPU and 768 MB
 # (grading/gradescope/test_gradescope.py). Needs Docker and debootstrap; not part of make test.

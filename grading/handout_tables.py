@@ -17,7 +17,7 @@ import pathlib
 import re
 import sys
 
-from grading import checks, grade
+from grading import checks, grade, race_checks
 from labkit import harness
 from labkit.harness import ROOT
 
@@ -93,6 +93,12 @@ def passes_when(lab: str, item: grade.Item) -> str:
         return (f"with `RT_MPI_DISTRIBUTION=interleaved` rank r of {ranks} renders "
                 f"rows r, r + {ranks}, r + {2 * ranks}, ..., with `dynamic` the rows are not "
                 f"block's fixed bands (as `RT_MPI_REPORT=1` lists them); half the points each")
+    if item.id == "races":
+        counts = " and ".join(str(t) for t in race_checks.RACE_THREADS)
+        return (f"your sources built for ThreadSanitizer (`make lab03-race`: clang, LLVM's "
+                f"OpenMP and its Archer tool, your files at -O0) report no data race at "
+                f"{counts} threads on a small render: a variable the threads share where each "
+                f"needs its own is found even where every image is right")
     if item.id == "hybrid":
         threads = parameter(checks.check_hybrid_threads, "threads")
         return (f"one rank with `--threads {threads}` under `mpirun`: no thread did "

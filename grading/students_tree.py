@@ -246,7 +246,8 @@ def _tree_files(lab_folder: str) -> dict[str, bytes]:
 
 
 def _driver_target(variant_target: str) -> str:
-    return "cuda-variant-driver" if variant_target == "cuda-variant" else "variant-driver"
+    return {"cuda-variant": "cuda-variant-driver",
+            "race-variant": "race-variant-driver"}.get(variant_target, "variant-driver")
 
 
 def cached_tree(lab_folder: str, target: str = "variant",
