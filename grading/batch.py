@@ -478,7 +478,9 @@ def grade_all(lab: str, todo: list[str], found: dict[str, pathlib.Path | str], o
 
 
 def write_report(out: pathlib.Path, lab: str, rows: dict[str, dict | None],
-                 submitters: dict[str, str] | None) -> None:
+                 submitters: dict[str, str] | None, regrade: str = "make grade-batch") -> None:
+    """grades.csv and report.html; `regrade`: the command that graded the class, which regrades
+    its flagged students with ONLY=flagged (a Slurm class's through Slurm again)."""
     rows = {s: r if r is not None else {"score": 0, "output": "not graded", "tests": []}
             for s, r in rows.items()}
     write_csv(out / "grades.csv", lab, rows, submitters)
@@ -486,7 +488,7 @@ def write_report(out: pathlib.Path, lab: str, rows: dict[str, dict | None],
                           submitters)
     count = sum(flagged(r) for r in rows.values())
     print(f"wrote {out / 'grades.csv'} and {out / 'report.html'}: {len(rows)} students, "
-          f"{count} flagged{' (regrade them: make grade-batch ... ONLY=flagged)' if count else ''}")
+          f"{count} flagged{f' (regrade them: {regrade} ... ONLY=flagged)' if count else ''}")
 
 
 def exposure_problem(folders: list[pathlib.Path]) -> str | None:
@@ -550,8 +552,8 @@ def main(argv=None) -> int:
         found = submissions(a.submissions, unpacked)
         found = by_export(found, submitters)
         rows = {student: previous(a.out, student) for student in found}
-        if a.merge:
-            write_report(a.out, a.lab, rows, submitters)
+        if a.merge:  # the last job of a class graded through Slurm (grading/slurm.py)
+            write_report(a.out, a.lab, rows, submitters, regrade="make grade-slurm")
             return 0
         if a.task is not None:
             if not 0 <= a.task < len(found):

@@ -66,11 +66,12 @@ lab03-race: $(RACE_DRIVER) $(wildcard $(LAB03)/skeleton/*.cpp $(LAB03)/skeleton/
 .PHONY: test-gradescope
 test-gradescope:
 	PYTHONPATH=$(CURDIR) $(PYTHON) grading/gradescope/test_gradescope.py
-# make grade-slurm LAB=NN SUBMISSIONS=DIR [REPORT=DIR] [PARTITION=P] [TIME=H:MM:SS] [MEM=4G]:
-# the same as a Slurm job array, one task per submission, and a merge job for grades.csv and
-# report.html (grading/slurm.py, which says its defaults); the tasks run $(PYTHON) by name.
+# make grade-slurm LAB=NN SUBMISSIONS=DIR [REPORT=DIR] [PARTITION=P] [TIME=H:MM:SS] [MEM=4G]
+# [ONLY=flagged]: the same as a Slurm job array, one task per submission, and a merge job for
+# grades.csv and report.html (grading/slurm.py, which says its defaults); the tasks run
+# $(PYTHON) by name. ONLY=flagged submits the tasks of the students REPORT flagged.
 grade-slurm:
 	@test -n "$(SUBMISSIONS)" || { echo "grade-slurm: needs SUBMISSIONS=DIR" >&2; exit 2; }
 	@$(PYTHON) -m grading.slurm $(LAB) $(SUBMISSIONS) --out $(or $(REPORT),grades) \
 	    --python $(PYTHON) $(if $(PARTITION),--partition $(PARTITION)) \
-	    $(if $(TIME),--time $(TIME)) $(if $(MEM),--mem $(MEM))
+	    $(if $(TIME),--time $(TIME)) $(if $(MEM),--mem $(MEM)) $(if $(ONLY),--only $(ONLY))

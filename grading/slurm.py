@@ -1,9 +1,9 @@
 """A class graded as a Slurm job array, where it outgrows one machine.
 
     make grade-slurm LAB=NN SUBMISSIONS=DIR [REPORT=DIR] [PARTITION=P] [TIME=H:MM:SS]
-                     [MEM=SIZE] [PYTHON=python3]
+                     [MEM=SIZE] [PYTHON=python3] [ONLY=flagged]
     python3 -m grading.slurm NN SUBMISSIONS --out REPORT [--partition P] [--time T] [--mem M]
-                             [--python NAME] [--no-submit]
+                             [--python NAME] [--only flagged] [--no-submit]
 
 One array task per submission (`python3 -m grading.batch ... --task K`: the K-th in name
 order, in its own grader process, in the sandbox, with the batch's hidden-scene secret that
@@ -19,7 +19,9 @@ top of each script. The references are built here once, before anything is submi
 tasks grade with --no-build (grading/references.py). The scripts are written to REPORT
 (grade-array.sbatch, merge.sbatch) and submitted with sbatch, whose job ids are printed;
 --no-submit only writes them. The repository must be on a file system every node sees (it
-is each task's working directory).
+is each task's working directory). `--only flagged` (ONLY=flagged, as the merge's log
+advises) submits only the tasks of the students REPORT flagged (or never graded), with the
+saved secret, and the merge again.
 """
 from __future__ import annotations
 
@@ -55,10 +57,19 @@ def asked(partition: str | None, time_limit: str, mem: str, python: str) -> str:
             f"change them)")
 
 
+def flagged_tasks(submissions: pathlib.Path, out: pathlib.Path) -> list[int]:
+    """The task numbers of the students an earlier run of REPORT flagged or never graded."""
+    found = batch.by_export(batch.submissions(submissions, out / ".unpacked"),
+                            batch.export_submitters(submissions))
+    return [k for k, student in enumerate(found)
+            if (row := batch.previous(out, student)) is None or batch.flagged(row)]
+
+
 def scripts(lab: str, submissions: pathlib.Path, out: pathlib.Path, n: int,
             partition: str | None, run_seconds: float | None, time_limit: str = DEFAULT_TIME,
-            mem: str = DEFAULT_MEM, python: str = DEFAULT_PYTHON) -> tuple[str, str]:
-    """(the array job's script, the merge job's script)."""
+            mem: str = DEFAULT_MEM, python: str = DEFAULT_PYTHON,
+            tasks: list[int] | None = None) -> tuple[str, str]:
+    """(the array job's script, the merge job's script); `tasks`: only these task numbers."""
     # Paths on a directive line stay on it (a newline would add a directive of its own):
     # one cleaner for everything shown or run (grading/shown.py).
     def q(text: object) -> str:
@@ -73,7 +84,7 @@ def scripts(lab: str, submissions: pathlib.Path, out: pathlib.Path, n: int,
               f"--out {q(str(out))}{extra}")
     array = f"""#!/bin/bash
 #SBATCH --job-name=grade-lab{lab}
-#SBATCH --array=0-{n - 1}
+#SBATCH --array={",".join(map(str, tasks)) if tasks is not None else f"0-{n - 1}"}
 #SBATCH --exclusive
 #SBATCH --nodes=1
 #SBATCH --output={out_line}/slurm-%A_%a.log
@@ -108,6 +119,8 @@ def main(argv=None) -> int:
     p.add_argument("--mem", default=DEFAULT_MEM, help=f"each task's --mem ({DEFAULT_MEM})")
     p.add_argument("--python", default=DEFAULT_PYTHON,
                    help=f"the Python the tasks run, by name ({DEFAULT_PYTHON})")
+    p.add_argument("--only", choices=["flagged"],
+                   help="regrade only the students an earlier run of REPORT flagged")
     p.add_argument("--no-submit", action="store_true", help="write the scripts only")
     a = p.parse_args(argv)
     submissions, out = a.submissions.absolute(), a.out.absolute()
@@ -127,8 +140,19 @@ def main(argv=None) -> int:
     if n == 0:
         print(f"error: grade-slurm: no submissions in {submissions}", file=sys.stderr)
         return 2
+    tasks = None
+    if a.only:
+        if not any(out.glob("*/results.json")):
+            print(f"error: grade-slurm: ONLY=flagged needs an earlier run's report in {out}",
+                  file=sys.stderr)
+            return 2
+        tasks = flagged_tasks(submissions, out)
+        if not tasks:
+            print(f"no student of {out} is flagged: nothing to regrade")
+            return 0
+        n = len(tasks)
     array, merge = scripts(a.lab, submissions, out, n, a.partition, a.run_seconds,
-                           a.time, a.mem, a.python)
+                           a.time, a.mem, a.python, tasks)
     print(asked(a.partition, a.time, a.mem, a.python))
     paths = []
     for name, text in (("grade-array.sbatch", array), ("merge.sbatch", merge)):

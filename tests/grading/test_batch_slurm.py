@@ -167,3 +167,30 @@ def test_run_gpu_runs_a_command_as_a_slurm_job_and_prints_its_log(slurm):
         log.unlink()
     assert p.returncode == 0, p.stdout + p.stderr
     assert str(ROOT) in p.stdout.splitlines() and "ended with status 0" in p.stdout, p.stdout
+
+
+def test_only_flagged_submits_the_flagged_students_tasks(tmp_path, capsys):
+    """ONLY=flagged, as the merge's log advises for a class graded through Slurm: the array
+    holds the tasks of the students the report flagged or never graded, no others."""
+    import json
+
+    from grading import batch, slurm
+    subs, report = tmp_path / "subs", tmp_path / "report"
+    for student in ("ann", "ben", "cy"):
+        (subs / student).mkdir(parents=True)
+        (subs / student / "render.cpp").write_text("int main;\n")
+    waiting = {"score": 60, "tests": [{"name": "speed", "score": 0, "max_score": 40,
+                                       "output": "marked for regrade",
+                                       "extra_data": {"regrade": True, "provisional": 40}}]}
+    final = {"score": 100, "tests": [{"name": "speed", "score": 40, "max_score": 40,
+                                      "output": "1.9x"}]}
+    for student, results in (("ann", waiting), ("ben", final)):
+        (report / student).mkdir(parents=True)
+        (report / student / "results.json").write_text(json.dumps(results))
+    assert slurm.main(["01", str(subs), "--out", str(report), "--only", "flagged",
+                       "--no-submit"]) == 0
+    array = (report / "grade-array.sbatch").read_text()
+    assert "#SBATCH --array=0,2\n" in array, array  # ann (flagged) and cy (never graded)
+    batch.write_report(report, "01", {"ann": waiting, "ben": final}, None,
+                       regrade="make grade-slurm")
+    assert "regrade them: make grade-slurm ... ONLY=flagged" in capsys.readouterr().out
