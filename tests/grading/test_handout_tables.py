@@ -29,7 +29,7 @@ def test_a_table_edited_away_from_the_rubric_fails(tmp_path, monkeypatch, edit):
     text = path.read_text()
     table = handout_tables.current(text)
     changed = {
-        "points": lambda t: t.replace("| parallel speedup | 40 |", "| parallel speedup | 45 |"),
+        "points": lambda t: t.replace("| parallel speedup | 30 |", "| parallel speedup | 45 |"),
         "threshold": lambda t: t.replace("0.75 x the capacity", "0.5 x the capacity"),
         "gate": lambda t: t.replace("| 30 | parallel speedup passes |", "| 30 | always |"),
     }[edit](table)
