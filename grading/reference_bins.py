@@ -17,8 +17,9 @@ this one:
 - the default scene path compiled in (RT_SOURCE_DIR, the source tree's absolute path) becomes
   ".", so `./labNN-ref` with no --scene finds common/scenes/cornell.json from the release's
   root, as the grader runs it.
-- CUDA code is compiled for cuda.mk's fallback architectures (sm_75 to sm_90 and compute_90
-  PTX), not for the GPUs of this machine, if it has any.
+- CUDA code is compiled for cuda.mk's architectures of a machine without a GPU (sm_75 to sm_90
+  and compute_90 PTX), not for the GPUs of this machine, if it has any; under CI (CI=true:
+  the tests' releases, which no student receives) for CI's two (CUDA_NO_GPU_ARCH).
 They need x86-64 Linux with the libraries `make deps` installs (OpenMPI for lab 04).
 """
 from __future__ import annotations
@@ -114,7 +115,7 @@ def build(targets: list[str], files: list[str], dest: pathlib.Path) -> tuple[lis
     names, the build's output). One release at a time builds and copies there (a lock)."""
     LOCK.parent.mkdir(parents=True, exist_ok=True)
     opt = portable_opt()
-    cuda_arch = make_variable("CUDA_FALLBACK_ARCH")
+    cuda_arch = make_variable("CUDA_NO_GPU_ARCH")
     objects = f"obj-{build_key(opt, cuda_arch)}"
     with open(LOCK, "w") as lock:
         fcntl.flock(lock, fcntl.LOCK_EX)
