@@ -146,8 +146,7 @@ __device__ inline SampleSum trace_samples_together(const SceneView& scene, const
     //> // TODO(lab05, optional, once trace_samples works): the same samples with the warp's
     //> // lanes kept together: a lane whose path has ended stays in the bounce loop, tracing
     //> // idle_ray(), until every lane's has (any_lane). Until then: trace_samples.
-    //> sum = trace_samples<Materials, Primitives>(scene, geometry, args, x, y, pixel, first,
-    //>                                            stride);
+    //> sum = trace_samples<Materials, Primitives>(scene, geometry, args, x, y, pixel, first, stride);
     // END SOLUTION
     return sum;
 }
@@ -193,8 +192,7 @@ __device__ inline SampleSum trace_samples_regenerating(const SceneView& scene,
     //> // per loop iteration (closest_hit<Primitives>(geometry, ...), bounce_step<Materials,
     //> // Primitives>, occluded<Primitives>(geometry, ...), as trace_path's loop does),
     //> // starting the lane's next sample as soon as its path ends. Until then: trace_samples.
-    //> sum = trace_samples<Materials, Primitives>(scene, geometry, args, x, y, pixel, first,
-    //>                                            stride);
+    //> sum = trace_samples<Materials, Primitives>(scene, geometry, args, x, y, pixel, first, stride);
     // END SOLUTION
     return sum;
 }
@@ -205,8 +203,8 @@ __device__ inline SampleSum trace_samples_regenerating(const SceneView& scene,
 // a new sample's pixel jitter.
 struct DrawnNumbers {
     SampleStream stream;  // the path's
-    uint32_t first;       // bounce_dimension(bounce, 0)
-    float u0, u1;         // the numbers of dimensions first and first + 1
+    uint32_t first;  // bounce_dimension(bounce, 0)
+    float u0, u1;  // the numbers of dimensions first and first + 1
 
     __device__ float at(uint32_t dimension) const {
         return dimension == first ? u0 : dimension == first + 1 ? u1 : stream.at(dimension);
@@ -272,8 +270,7 @@ __device__ inline SampleSum trace_samples_claimed(const SceneView& scene, const 
     //> // loop iteration on every lane; a lane whose path ends claims the pixel's next
     //> // unclaimed sample (__ballot_sync of the lanes that claim, __popc of those below it).
     //> // Until then: trace_samples.
-    //> sum = trace_samples<Materials, Primitives>(scene, geometry, args, x, y, pixel, first,
-    //>                                            stride);
+    //> sum = trace_samples<Materials, Primitives>(scene, geometry, args, x, y, pixel, first, stride);
     // END SOLUTION
     return sum;
 }

@@ -55,8 +55,7 @@ struct SlabRay {
     Vec3 origin_scaled;   // o * (1 / d) per axis
 
     __device__ explicit SlabRay(const Ray& ray)
-        : inverse(real(1) / ray.direction.x, real(1) / ray.direction.y,
-                  real(1) / ray.direction.z),
+        : inverse(real(1) / ray.direction.x, real(1) / ray.direction.y, real(1) / ray.direction.z),
           origin_scaled(ray.origin * inverse) {}
 
     // Where the ray crosses {p_k = c}: the same operations for every rectangle that has c.
@@ -80,10 +79,10 @@ __device__ __forceinline__ SlabSpan slab_span(const SlabRay& ray, const RectSlab
     const real x0 = ray.cross_x(s.lo_x), x1 = ray.cross_x(s.hi_x);
     const real y0 = ray.cross_y(s.lo_y), y1 = ray.cross_y(s.hi_y);
     const real z0 = ray.cross_z(s.lo_z), z1 = ray.cross_z(s.hi_z);
-    const real entry = max_number(max_number(min_number(x0, x1), min_number(y0, y1)),
-                                  min_number(z0, z1));
-    const real exit = min_number(min_number(max_number(x0, x1), max_number(y0, y1)),
-                                 max_number(z0, z1));
+    const real entry =
+        max_number(max_number(min_number(x0, x1), min_number(y0, y1)), min_number(z0, z1));
+    const real exit =
+        min_number(min_number(max_number(x0, x1), max_number(y0, y1)), max_number(z0, z1));
     return {entry, exit};
 }
 

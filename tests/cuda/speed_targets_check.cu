@@ -63,16 +63,18 @@ int main() {
     expect(has(json, "\"best_ms\": null, \"met\": null, \"why_not\": \"not run in this call\""),
            "not run", json);
     // A bar set for one card: on that card alone, named; a bar for every card names the one run.
-    constexpr SpeedTarget per_card[] = {{"AoS", 60.0, nullptr, "H100"}, {"AoS", 50.0, nullptr, "H200"},
-                                        {"SoA", 0.0, "AoS"}};
+    constexpr SpeedTarget per_card[] = {
+        {"AoS", 60.0, nullptr, "H100"}, {"AoS", 50.0, nullptr, "H200"}, {"SoA", 0.0, "AoS"}};
     json = targets_json(per_card, times(55.0, 50.0), "", h100.name);
-    expect(has(json, "\"bar\": \"at most 60 ms on an NVIDIA H100, the baseline\", "
-                     "\"best_ms\": 55.000, \"met\": true") &&
+    expect(has(json,
+               "\"bar\": \"at most 60 ms on an NVIDIA H100, the baseline\", "
+               "\"best_ms\": 55.000, \"met\": true") &&
                !has(json, "at most 50 ms") && has(json, "faster than AoS on an NVIDIA H100"),
            "an H100's bars", json);
     json = targets_json(per_card, times(55.0, 50.0), "", h200.name);
-    expect(has(json, "\"bar\": \"at most 50 ms on an NVIDIA H200, the baseline\", "
-                     "\"best_ms\": 55.000, \"met\": false") &&
+    expect(has(json,
+               "\"bar\": \"at most 50 ms on an NVIDIA H200, the baseline\", "
+               "\"best_ms\": 55.000, \"met\": false") &&
                !has(json, "at most 60 ms"),
            "an H200's bars", json);
     if (failures == 0) std::printf("speed targets: every case holds\n");

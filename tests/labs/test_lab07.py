@@ -12,8 +12,8 @@ import pytest
 from test_lab06 import (
     CHECKS,
     no_gpu_is_one_line,
-    recorded_card,
     pristine_skeleton,
+    recorded_card,
     statistically_agrees_with,
     targets_fail_without_nvcc,
     waves_do_not_change_the_image,

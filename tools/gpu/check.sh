@@ -180,7 +180,7 @@ if ! skipped ncu && [ -n "$ncu_bin" ] && [ -x lab05-bench ]; then
         timeout 180 "$ncu_bin" --clock-control none --metrics "$metrics" --csv --page raw \
             ./lab05-bench --repeat 1 "$@" > "/tmp/gpu-check-ncu-$label.csv" 2>> "$log"
     }
-    ncu_run cornell --spp 64 --only "${GPU_CHECK_NCU_VARIANTS:-plain,reference,no-register-cap,triangles,quads,general,regenerate,together,scene-shared}" &&
+    ncu_run cornell --spp 64 --only "${GPU_CHECK_NCU_VARIANTS:-plain,reference,exact-rects,no-register-cap,triangles,quads,general,regenerate,together,claimed,scene-shared}" &&
     ncu_run cornell-1-bounce --spp 64 --bounces 1 --only reference &&
     ncu_run showcase --spp 64 --width 600 --height 600 --scene common/scenes/showcase.json --only reference &&
         step[ncu]=ok || step[ncu]=failed

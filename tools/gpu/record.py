@@ -62,7 +62,8 @@ def best_ms(card: str, bench: str, config: str) -> float | None:
 
 
 # check.sh's output files, by the names the record gives them.
-RECORD_FILES = {"bench.json": "bench-lab05.json", "bench-fast-math.json": "bench-lab05-fast-math.json",
+RECORD_FILES = {"bench.json": "bench-lab05.json",
+                "bench-fast-math.json": "bench-lab05-fast-math.json",
                 "bench-lab06.json": "bench-lab06.json", "bench-lab07.json": "bench-lab07.json",
                 "gpu-check.json": "gpu-check.json", "summary.md": "summary.md",
                 "wavefront.md": "wavefront.md", "machine.txt": "machine.txt"}
@@ -100,6 +101,7 @@ def read(record: pathlib.Path = RECORD) -> dict:
         "lab05": {v["name"]: v for v in lab05["variants"]},
         "lab05_fast": {v["name"]: v for v in fast["variants"]},
         "baseline": {k: lab05[k] for k in ("width", "height", "spp", "bounces", "device")},
+        "targets05": {t["config"]: t for t in lab05.get("targets", [])},
         "host_ms": lab05["host_ms"],
         "accuracy": check["accuracy"],
         "process": check["process_vs_kernel"],
@@ -118,24 +120,25 @@ def read(record: pathlib.Path = RECORD) -> dict:
 # lab05-bench's shapes each kernel is, by the run and the kernel's template arguments
 # (threads a pixel, scene memory, block, path loop, register cap, materials, geometry).
 NCU_SHAPES = {
-    # The kernels since the rectangles' slabs (render_kernel's last argument: slabs or not).
-    ("cornell", "32, 1, 64, 0, 56, Kinds<Diffuse>, Kinds<Sphere, AxisRect>, true"): "reference",
-    ("cornell", "32, 1, 64, 0, 56, Kinds<Diffuse>, Kinds<Sphere, AxisRect>, false"):
+    # The kernels since the rectangles' slabs (render_kernel's last argument, slabs or not, as
+    # the demangler writes it: 1 or 0).
+    ("cornell", "32, 1, 64, 0, 56, Kinds<Diffuse>, Kinds<Sphere, AxisRect>, 1"): "reference",
+    ("cornell", "32, 1, 64, 0, 56, Kinds<Diffuse>, Kinds<Sphere, AxisRect>, 0"):
         "exact-rects",
-    ("cornell", "32, 1, 64, 0, 56, Kinds<Diffuse>, Kinds<Sphere, Triangle, ConvexQuad>, true"):
+    ("cornell", "32, 1, 64, 0, 56, Kinds<Diffuse>, Kinds<Sphere, Triangle, ConvexQuad>, 1"):
         "general",
-    ("cornell", "32, 1, 64, 0, 56, Kinds<Diffuse>, Kinds<Sphere, ConvexQuad>, true"): "quads",
-    ("cornell", "32, 1, 64, 0, 56, Kinds<Diffuse>, Kinds<Sphere, Triangle>, true"): "triangles",
-    ("cornell", "32, 2, 64, 0, 56, Kinds<Diffuse>, Kinds<Sphere, AxisRect>, true"): "scene-shared",
-    ("cornell", "32, 1, 64, 2, 56, Kinds<Diffuse>, Kinds<Sphere, AxisRect>, true"): "regenerate",
-    ("cornell", "32, 1, 64, 1, 56, Kinds<Diffuse>, Kinds<Sphere, AxisRect>, true"): "together",
-    ("cornell", "32, 1, 64, 3, 56, Kinds<Diffuse>, Kinds<Sphere, AxisRect>, true"): "claimed",
-    ("cornell", "32, 1, 64, 0, 255, Kinds<Diffuse>, Kinds<Sphere, AxisRect>, true"):
+    ("cornell", "32, 1, 64, 0, 56, Kinds<Diffuse>, Kinds<Sphere, ConvexQuad>, 1"): "quads",
+    ("cornell", "32, 1, 64, 0, 56, Kinds<Diffuse>, Kinds<Sphere, Triangle>, 1"): "triangles",
+    ("cornell", "32, 2, 64, 0, 56, Kinds<Diffuse>, Kinds<Sphere, AxisRect>, 1"): "scene-shared",
+    ("cornell", "32, 1, 64, 2, 56, Kinds<Diffuse>, Kinds<Sphere, AxisRect>, 1"): "regenerate",
+    ("cornell", "32, 1, 64, 1, 56, Kinds<Diffuse>, Kinds<Sphere, AxisRect>, 1"): "together",
+    ("cornell", "32, 1, 64, 3, 56, Kinds<Diffuse>, Kinds<Sphere, AxisRect>, 1"): "claimed",
+    ("cornell", "32, 1, 64, 0, 255, Kinds<Diffuse>, Kinds<Sphere, AxisRect>, 1"):
         "no-register-cap",
-    ("cornell-1-bounce", "32, 1, 64, 0, 56, Kinds<Diffuse>, Kinds<Sphere, AxisRect>, true"):
+    ("cornell-1-bounce", "32, 1, 64, 0, 56, Kinds<Diffuse>, Kinds<Sphere, AxisRect>, 1"):
         "reference, 1 bounce",
     ("showcase", "32, 1, 64, 0, 56, Kinds<Diffuse, Mirror, Glass>, "
-                 "Kinds<Sphere, Triangle, ConvexQuad, AxisRect>, true"): "showcase",
+                 "Kinds<Sphere, Triangle, ConvexQuad, AxisRect>, 1"): "showcase",
     # The kernels before (the H200's record).
     ("cornell", "32, 1, 64, 0, 56, Kinds<Diffuse>, Kinds<Sphere, AxisRect>"): "reference",
     ("cornell", "32, 1, 64, 0, 56, Kinds<Diffuse>, Kinds<Sphere, Triangle, ConvexQuad>"): "general",
