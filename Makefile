@@ -111,7 +111,7 @@ help-staff:
 	@echo "  make bench-precision  float against double: time and error of lab 01's reference"
 	@echo "  make extremes-report  the extreme scenes in float and double (docs/extremes.md's table)"
 	@echo "  make check-nvcc   compile every header of common/core for the GPU (needs nvcc)"
-	@echo "  make gpu-figures  the handouts' GPU tables from reference/gpu/h200/ (CHECK=1: compare)"
+	@echo "  make gpu-figures  the handouts' GPU tables from the records in reference/gpu/ (CHECK=1: compare)"
 	@echo "  make gpu-check OUT=DIR  on a GPU machine: build, test and benchmark the CUDA labs"
 	@echo "  make tradeoff-gpu OUT=DIR  on a GPU machine: make tradeoff's GPU rows (no plots)"
 	@echo "  make golden       regenerate the golden images in reference/ (minutes)"
@@ -342,9 +342,9 @@ tradeoff: lab01-ref
 	$(PYTHON) -m tools.tradeoff --out $(REPORTS) $(if $(filter 1 true yes,$(QUICK)),--quick) \
 	    $(if $(PLAN),--plan $(PLAN)) $(if $(filter 0 false no,$(PLOTS)),--no-plots)
 
-# The GPU record's figures in the handouts and READMEs (tools/gpu/figures.py): the tables
-# regenerated from reference/gpu/h200/ after a new record; CHECK=1 only compares, naming every
-# figure that differs.
+# The GPU records' figures in the handouts and READMEs (tools/gpu/figures.py): the tables
+# regenerated from the records in reference/gpu/ after a new one; CHECK=1 only compares,
+# naming every figure that differs.
 gpu-figures:
 	$(PYTHON) -m tools.gpu.figures $(if $(filter 1 true yes,$(CHECK)),--check)
 

@@ -402,6 +402,7 @@ int run_wavefront_bench(int argc, char** argv, const SpeedTarget (&targets)[N]) 
     };
     std::printf(
         "\n], \"targets\": %s}\n",
-        targets_json(targets, best_of, why_not_judged(s.prop, options.scene_path, st)).c_str());
+        targets_json(targets, best_of, why_not_judged(s.prop, options.scene_path, st), s.prop.name)
+            .c_str());
     return 0;
 }

@@ -1,7 +1,7 @@
-// The scene as one block of 16-byte words (materials, then each primitive kind's array in the
-// order of AllPrimitives, primitive_kinds.h), so that a single copy puts it in any of the GPU's
-// memories, and the SceneView the shared core reads
-// from it wherever it lies: global memory, the constant bank or a block's shared memory.
+// The scene as one block of 16-byte words (the rectangles' slabs, the materials, then each
+// primitive kind's array in the order of AllPrimitives, primitive_kinds.h), so that a single
+// copy puts it in any of the GPU's memories, and the SceneView the shared core reads from it
+// wherever it lies: global memory, the constant bank or a block's shared memory.
 #pragma once
 
 #include <cuda_runtime.h>
@@ -9,6 +9,7 @@
 #include <cstring>
 #include <vector>
 
+#include <rect_slabs.cuh>
 #include <scene_view.h>
 
 // Where the kernel reads the scene from. Every thread of a warp reads the same primitive at
@@ -27,10 +28,13 @@ struct KindPlace {
     int word = 0;  // its first 16-byte word
 };
 
-// Where each array starts in the pool, in 16-byte words, and the scene's small fields.
+// Where each array starts in the pool, in 16-byte words, and the scene's small fields. The
+// rectangles' slabs (rect_slabs.cuh) come first, at word 0, one RectSlab per AxisRect of the
+// scene in the same order: a kernel that reads the pool from the constant bank then knows
+// each slab's address at compile time.
 struct SceneLayout {
     int num_materials = 0;
-    int material_word = 0;  // first; then each kind of AllPrimitives in the list's order
+    int material_word = 0;  // after the slabs; then each kind of AllPrimitives in the list's order
     PerKind<KindPlace, AllPrimitives> primitives;
     int words = 0;  // the whole pool
     PointLight light{};
@@ -72,7 +76,7 @@ inline int words_for(size_t bytes) { return static_cast<int>((bytes + 15) / 16);
 inline SceneLayout layout_of(const SceneView& scene) {
     SceneLayout l;
     l.num_materials = scene.num_materials;
-    l.material_word = 0;
+    l.material_word = words_for(scene.of<AxisRect>().count * sizeof(RectSlab));
     int word = l.material_word + words_for(scene.num_materials * sizeof(Material));
     for_each_kind(AllPrimitives{}, [&](auto kind) {
         using K = typename decltype(kind)::type;
@@ -92,6 +96,11 @@ inline std::vector<float4> pack(const SceneView& scene, const SceneLayout& l) {
     const auto put = [&](int word, const void* data, size_t bytes) {
         if (bytes) std::memcpy(pool.data() + word, data, bytes);
     };
+    const KindSpan<AxisRect> rects = scene.of<AxisRect>();
+    for (int i = 0; i < rects.count; ++i) {
+        const RectSlab slab = rect_slab(rects[i]);
+        put(i * kWordsPerSlab, &slab, sizeof slab);
+    }
     put(l.material_word, scene.materials, scene.num_materials * sizeof(Material));
     for_each_kind(AllPrimitives{}, [&](auto kind) {
         using K = typename decltype(kind)::type;
@@ -132,5 +141,18 @@ __device__ inline SceneView scene_in(const SceneLayout& layout, const float4* gl
         return layout.view(shared);
     } else {
         return layout.view(global_pool);
+    }
+}
+
+// The rectangles' slabs of the pool of scene_in<kMemory>: at word 0 of the same memory. From
+// the constant bank the compiler knows each slab's address, not only the pool's.
+template <SceneMemory kMemory>
+__device__ inline const RectSlab* slabs_in(const float4* global_pool, const float4* shared) {
+    if constexpr (kMemory == SceneMemory::Constant) {
+        return reinterpret_cast<const RectSlab*>(constant_pool);
+    } else if constexpr (kMemory == SceneMemory::Shared) {
+        return reinterpret_cast<const RectSlab*>(shared);
+    } else {
+        return reinterpret_cast<const RectSlab*>(global_pool);
     }
 }

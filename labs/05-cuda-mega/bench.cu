@@ -7,18 +7,20 @@
 //                 [--repeat N] [--only NAME[,NAME...]] [--list]
 //
 // "reference" is what lab05-ref runs on the Cornell baseline: 32 threads per pixel, blocks of
-// 64, whole paths, at most 56 registers, the scene in the constant bank, a kernel compiled for
-// the scene's kinds of material (DiffuseOnly) and primitive (spheres and axis-aligned
-// rectangles: BoxGeometry). Every other shape changes one thing: the scene's primitives
-// (its rectangles as convex quads, or every quad as two triangles, general_geometry.h, each
-// with a kernel for those kinds; "general" is what lab05-ref runs with
-// RT_LAB05_GEOMETRY=general), the kinds compiled in, where the scene lives, how a thread
-// traces its samples (path regeneration, lanes kept together), the register cap, the work
-// split or the block. "plain" is the first kernel anyone writes (one thread per pixel calling
+// 64, whole paths, at most 56 registers, the scene in the constant bank, the rectangles tested
+// as slabs (slab_geometry.cuh), a kernel compiled for the scene's kinds of material
+// (DiffuseOnly) and primitive (spheres and axis-aligned rectangles: BoxGeometry). Every other
+// shape changes one thing: the scene's primitives (its rectangles as convex quads, or every
+// quad as two triangles, general_geometry.h, each with a kernel for those kinds; "general" is
+// what lab05-ref runs with RT_LAB05_GEOMETRY=general), the rectangles' test (the core's exact
+// one), the kinds compiled in, where the scene lives, how a thread traces its samples (path
+// regeneration, lanes kept together, samples claimed by the warp), the register cap, the
+// work split or the block. "plain" is the first kernel anyone writes (one thread per pixel calling
 // the core's render_pixel, 16x16 blocks, the scene in global memory, no register cap). A shape compiled for kinds the scene does not fit (DiffuseOnly on
 // a scene with mirrors or glass, BoxGeometry on one with triangles) is left out; the first
 // shape run is the image the others are compared with, bit for bit where they render the
-// same primitives. The previous reference (triangles, branching primitive loops, shared
+// same primitives. The reference before the slabs (the core's exact rectangle test) is the
+// exact-rects shape; the one before that (triangles, branching primitive loops, shared
 // memory, path regeneration, at most 72 registers) is this file's "reference" at commit
 // df6fc16.
 #include <algorithm>
@@ -70,6 +72,7 @@ struct Variant {
     int block_threads;
     PathLoop loop;  // how a thread traces its samples (megakernel.cuh)
     int max_registers;  // render_kernel's cap (255: none)
+    bool slab_rects;  // the rectangles as slabs (slab_geometry.cuh), else the core's exact test
     bool diffuse_only;  // compiled for DiffuseOnly (material_set.h), else for AnyMaterial
     GeometryForm form;  // the scene's primitives as loaded, or re-expressed (general_geometry.h)
     const char* primitives;  // the primitive kinds compiled in (geometry_set.h)
@@ -79,11 +82,11 @@ struct Variant {
 };
 
 template <int kT, SceneMemory kM, int kB, PathLoop kLoop, int kMaxRegisters, class Materials,
-          class Primitives>
+          class Primitives, bool kSlabs>
 void launch_megakernel(const KernelArgs& args, size_t shared_bytes) {
     const long long threads = static_cast<long long>(args.rows) * args.settings.width * kT;
     const unsigned blocks = static_cast<unsigned>((threads + kB - 1) / kB);
-    render_kernel<kT, kM, kB, kLoop, kMaxRegisters, Materials, Primitives>
+    render_kernel<kT, kM, kB, kLoop, kMaxRegisters, Materials, Primitives, kSlabs>
         <<<blocks, kB, shared_bytes>>>(args);
 }
 
@@ -100,15 +103,17 @@ bool fits(const GeometryKinds& kinds) {
 }
 
 // One shape: t threads per pixel, scene memory m, blocks of b, path loop, register cap,
-// material kinds, primitive kinds, the scene's geometry form.
-#define MEGA(name, change, t, m, b, loop, regs, mats, prims, form)                       \
-    Variant {                                                                            \
-        name, change, t, SceneMemory::m, b, PathLoop::loop, regs,                        \
-            std::is_same_v<mats, DiffuseOnly>, GeometryForm::form, #prims, fits<prims>,  \
-            reinterpret_cast<const void*>(                                               \
-                render_kernel<t, SceneMemory::m, b, PathLoop::loop, regs, mats, prims>), \
-            launch_megakernel<t, SceneMemory::m, b, PathLoop::loop, regs, mats, prims>   \
+// material kinds, primitive kinds, the scene's geometry form, the rectangles as slabs.
+#define MEGA_TESTS(name, change, t, m, b, loop, regs, mats, prims, form, slabs)                 \
+    Variant {                                                                                   \
+        name, change, t, SceneMemory::m, b, PathLoop::loop, regs, slabs,                        \
+            std::is_same_v<mats, DiffuseOnly>, GeometryForm::form, #prims, fits<prims>,         \
+            reinterpret_cast<const void*>(                                                      \
+                render_kernel<t, SceneMemory::m, b, PathLoop::loop, regs, mats, prims, slabs>), \
+            launch_megakernel<t, SceneMemory::m, b, PathLoop::loop, regs, mats, prims, slabs>   \
     }
+#define MEGA(name, change, t, m, b, loop, regs, mats, prims, form) \
+    MEGA_TESTS(name, change, t, m, b, loop, regs, mats, prims, form, true)
 // The reference's shape with one change.
 #define SHAPE(name, change, t, m, b, loop, regs) \
     MEGA(name, change, t, m, b, loop, regs, DiffuseOnly, BoxGeometry, AsLoaded)
@@ -132,6 +137,10 @@ static const std::vector<Variant>& variants() {
              Constant, 64, WholePaths, 56, DiffuseOnly, SpheresAndTriangles, Triangles),
         MEGA("any-geometry", "compiled for every primitive kind", 32, Constant, 64, WholePaths, 56,
              DiffuseOnly, AnyGeometry, AsLoaded),
+        // The rectangles' test.
+        MEGA_TESTS("exact-rects",
+                   "the rectangles by the core's exact test (axis_rect.h), not as slabs", 32,
+                   Constant, 64, WholePaths, 56, DiffuseOnly, BoxGeometry, AsLoaded, false),
         // Where the scene lives.
         SHAPE("scene-shared", "scene in shared memory", 32, Shared, 64, WholePaths, 56),
         SHAPE("scene-global", "scene in global memory", 32, Global, 64, WholePaths, 56),
@@ -142,6 +151,10 @@ static const std::vector<Variant>& variants() {
               Regenerate, 56),
         SHAPE("together", "the warp's lanes kept together (trace_samples_together)", 32, Constant,
               64, Together, 56),
+        SHAPE("claimed", "samples claimed by the warp's lanes (trace_samples_claimed)", 32,
+              Constant, 64, Claimed, 56),
+        SHAPE("claimed-regs-64", "samples claimed by the warp's lanes, at most 64 registers", 32,
+              Constant, 64, Claimed, 64),
         SHAPE("no-register-cap", "registers left to the compiler", 32, Constant, 64, WholePaths,
               255),
         SHAPE("regs-64", "at most 64 registers", 32, Constant, 64, WholePaths, 64),
@@ -151,7 +164,7 @@ static const std::vector<Variant>& variants() {
         SHAPE("block-32", "blocks of 32", 32, Constant, 32, WholePaths, 56),
         SHAPE("block-128", "blocks of 128", 32, Constant, 128, WholePaths, 56),
         {"plain", "render_pixel per pixel, 16x16 blocks, global memory, every kind", 1,
-         SceneMemory::Global, 256, PathLoop::WholePaths, 255, false, GeometryForm::AsLoaded,
+         SceneMemory::Global, 256, PathLoop::WholePaths, 255, false, false, GeometryForm::AsLoaded,
          "AnyGeometry", fits<AnyGeometry>, reinterpret_cast<const void*>(plain_kernel),
          launch_plain},
     };
@@ -161,6 +174,7 @@ static const std::vector<Variant>& variants() {
 static const char* path_loop_name(PathLoop loop) {
     return loop == PathLoop::Together     ? "together"
            : loop == PathLoop::Regenerate ? "regenerate"
+           : loop == PathLoop::Claimed    ? "claimed"
                                           : "whole paths";
 }
 
@@ -370,7 +384,7 @@ static int run(int argc, char** argv) {
             "%s\n  {\"name\": \"%s\", \"change\": \"%s\", \"threads_per_pixel\": %d, "
             "\"scene_memory\": \"%s\", \"block_threads\": %d, \"path_loop\": \"%s\", "
             "\"max_registers\": %d, \"materials\": \"%s\", \"primitives\": \"%s\", "
-            "\"geometry\": \"%s\", \"registers\": %d, \"local_bytes\": %zu, "
+            "\"rect_test\": \"%s\", \"geometry\": \"%s\", \"registers\": %d, \"local_bytes\": %zu, "
             "\"blocks_per_sm\": %d, \"occupancy\": %.3f, \"best_ms\": %.3f, "
             "\"median_ms\": %.3f, \"paths_per_second\": %.4g, \"nonfinite_pixels\": %zu, "
             "\"identical_to_reference\": %s, \"max_relative_difference\": %.3g, "
@@ -380,9 +394,9 @@ static int run(int argc, char** argv) {
             : v.memory == SceneMemory::Constant ? "constant"
                                                 : "shared",
             v.block_threads, path_loop_name(v.loop), v.max_registers,
-            v.diffuse_only ? "diffuse only" : "any", v.primitives, form.name, attr.numRegs,
-            attr.localSizeBytes, blocks_per_sm, occupancy, t.best_ms, t.median_ms,
-            paths / (t.best_ms * 1e-3), nonfinite, identical ? "true" : "false",
+            v.diffuse_only ? "diffuse only" : "any", v.primitives, v.slab_rects ? "slabs" : "exact",
+            form.name, attr.numRegs, attr.localSizeBytes, blocks_per_sm, occupancy, t.best_ms,
+            t.median_ms, paths / (t.best_ms * 1e-3), nonfinite, identical ? "true" : "false",
             max_relative_difference(reference_image, image),
             reference_mean > 0 ? image_mean(image) / reference_mean : 0.0);
         std::fflush(stdout);
@@ -399,7 +413,8 @@ static int run(int argc, char** argv) {
         "\"scene_upload\": %.3f, \"image_allocation\": %.3f, \"image_download\": %.3f}, "
         "\"targets\": %s}\n",
         context_ms, first_load_ms, scene_upload_ms, image_alloc_ms, download_ms,
-        targets_json(kLab05Targets, best_of, why_not_judged(prop, options.scene_path, settings))
+        targets_json(kLab05Targets, best_of, why_not_judged(prop, options.scene_path, settings),
+                     prop.name)
             .c_str());
     return 0;
 }

@@ -97,7 +97,8 @@ KIND_SETS = {
 
 
 # megakernel.cuh's PathLoop, as the demangler writes its values.
-PATH_LOOPS = {"(PathLoop)0": "whole", "(PathLoop)1": "together", "(PathLoop)2": "regenerate"}
+PATH_LOOPS = {"(PathLoop)0": "whole", "(PathLoop)1": "together", "(PathLoop)2": "regenerate",
+              "(PathLoop)3": "claimed"}
 
 
 def short(name: str) -> str:
@@ -108,6 +109,10 @@ def short(name: str) -> str:
     for kinds, alias in KIND_SETS.items():
         name = name.replace(kinds, alias)
     name = re.sub(r"\s+>", ">", name)  # the demangler writes "Foo<Bar<int> >"
+    # render_kernel's last argument: the rectangles as slabs (the default, left unsaid) or by
+    # the core's exact test.
+    name = re.sub(r"(render_kernel<.*), true>", r"\1>", name)
+    name = re.sub(r"(render_kernel<.*), false>", r"\1, exact rectangles>", name)
     return re.sub(r"^void |\(.*\)$", "", name)
 
 

@@ -1,9 +1,9 @@
-"""The handouts, the README and the GPU labs' timed renders quote the GPU record
-(reference/gpu/h200/) as it is: every generated table is what tools/gpu/figures.py makes of
-the record, every phrase of PROSE stands in its file as the record renders it, no "N.NN ms"
-is a number the record does not hold, and labs.toml's timed_spp is what the record gives for
-the grader's timed render. A figure edited away from the record, or a record changed without
-the text, fails here. Reads files only: well under a second."""
+"""The handouts, the README and the GPU labs' timed renders quote the GPU records (one per
+card, reference/gpu/<card>/) as they are: every generated table is what tools/gpu/figures.py
+makes of the record its marker names, every phrase of PROSE stands in its file as its
+record renders it, no "N.NN ms" is a number no record holds, and labs.toml's timed_spp is
+what the record gives for the grader's timed render. A figure edited away from its record,
+or a record changed without the text, fails here. Reads files only: well under a second."""
 import dataclasses
 import re
 import shutil
@@ -85,22 +85,46 @@ def test_a_record_changed_without_the_text_fails(copy, tmp_path_factory):
     text = bench.read_text()
     assert f'"best_ms": {best}' in text
     bench.write_text(text.replace(f'"best_ms": {best}', f'"best_ms": {faster}', 1))
-    found = figures.problems(root=copy, record=record)
+    records = {card: rec.record_of(card) for card in rec.CARDS} | {rec.CURRENT: record}
+    found = figures.problems(root=copy, records=records)
     assert any("table 'lab05-targets'" in line for line in found), found
     assert any(f"takes **{faster:.2f} ms**" in line for line in found), found
-    # and regenerating puts the record's tables back in place of the old ones
-    figures.rewrite(root=copy, record=record)
-    assert f"| `reference` | {faster:.2f} |" in (copy / "handouts/05-cuda-mega.md").read_text()
+
+
+def test_every_table_names_a_card_with_a_record():
+    """Each generated table's marker names the record it comes from, one of the cards'."""
+    cards = {card for name in figures.FILES
+             for _, _, card in figures.generated((figures.ROOT / name).read_text()).values()}
+    assert cards and cards <= set(rec.CARDS), cards
+    assert all((rec.record_of(card) / "bench-lab05.json").exists() for card in cards)
+
+
+def test_a_table_of_another_cards_record_fails(copy):
+    """A table whose marker names the other card's record is not that record's table."""
+    path = copy / "handouts/05-cuda-mega.md"
+    text = path.read_text()
+    other = next(card for card in rec.CARDS if card != rec.CURRENT)
+    path.write_text(text.replace(f"'lab05-targets': generated from reference/gpu/{rec.CURRENT}/",
+                                 f"'lab05-targets': generated from reference/gpu/{other}/", 1))
+    found = figures.problems(root=copy)
+    assert any(f"table 'lab05-targets' is not the record's ({other})" in line
+               for line in found), found
+
+
+def test_cards_are_told_by_name():
+    assert rec.card_of("NVIDIA H100 80GB HBM3") == "h100"
+    assert rec.card_of("NVIDIA H200") == "h200"
+    assert rec.card_of("NVIDIA A100-SXM4-80GB") is None
 
 
 def test_the_timed_renders_are_sized_from_the_record():
     """Each GPU lab's timed render takes the grader's GPU_TIMED_SECONDS of its reference's
     kernel time at the record's throughput, to within the spp's rounding."""
-    r = rec.read()
     side = figures.grade_view_side() * grade.GPU_TIMED_SCALE
     for lab in registry.labs():
         if not lab.gpu:
             continue
+        r = figures.read_card(rec.TIMED_SPP_CARD[lab.number])
         assert lab.timed_spp == figures.derived_spp(r, lab.number), lab.number
         seconds = rec.timed_seconds(r, lab.number, side * side, lab.timed_spp)
         step = rec.timed_seconds(r, lab.number, side * side, rec.SPP_STEP)
@@ -112,11 +136,13 @@ def test_a_timed_spp_the_record_does_not_give_fails(monkeypatch):
                  for lab in registry.labs())
     monkeypatch.setattr(registry, "labs", lambda: labs)
     found = [line for line in figures.problems() if line.startswith("labs/labs.toml")]
-    assert found and re.search(r"lab 05's timed_spp is 4096; the record gives \d+", found[0])
+    assert found and re.search(r"lab 05's timed_spp is 4096; the record \(h100\) gives \d+",
+                               found[0])
 
 
-def test_the_ncu_rows_name_the_shapes_the_handout_quotes():
-    shapes = rec.read()["ncu"]
+@pytest.mark.parametrize("card", list(rec.CARDS))
+def test_the_ncu_rows_name_the_shapes_the_handout_quotes(card):
+    shapes = figures.read_card(card)["ncu"]
     assert {"reference", "plain", "showcase", "reference, 1 bounce"} <= set(shapes)
     assert 1 <= shapes["reference"]["active"] <= 32
 
@@ -133,7 +159,7 @@ def absolute_paths(value) -> list[str]:
 def test_the_record_names_no_machines_paths():
     """A record is read on other machines: it names a scene as the repository does."""
     import json
-    found = {path.name: absolute_paths(json.loads(path.read_text()))
-             for path in sorted(rec.RECORD.glob("*.json"))}
+    found = {str(path): absolute_paths(json.loads(path.read_text()))
+             for path in sorted(rec.RECORDS.glob("*/*.json"))}
     assert found and all(paths == [] for paths in found.values()), found
     assert absolute_paths({"scene": ["/work/scene.json"]}) == ["/work/scene.json"]

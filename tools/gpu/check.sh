@@ -15,9 +15,13 @@
 #      counters, where ncu can read them;
 #   8. the wavefront labs (06, 07) on four scenes: labs/06-cuda-split/measure.sh, into
 #      DIR/wavefront.tar.gz.
-# Writes DIR/gpu-check.json (everything) and DIR/summary.md (the tables, the speed targets
-# first), plus the logs; exits 0 only when every step that ran succeeded.
-# GPU_CHECK_SKIP="tests bench sanitizer ncu report wavefront" leaves any of those steps out, and
+# Writes DIR/gpu-check.json (everything), DIR/summary.md (the tables, the speed targets
+# first) and DIR/machine.txt, plus the logs; exits 0 only when every step that ran succeeded.
+# `python3 -m tools.gpu.record --install DIR` makes DIR the record of the card it ran on
+# (reference/gpu/h100/, reference/gpu/h200/: one record per card).
+# GPU_CHECK_SKIP="kernel_report tests bench sanitizer ncu report wavefront" leaves any of those
+# steps out (GPU_CHECK_KERNEL_REPORT=FILE: a `make kernel-report` made elsewhere for sm_90,
+# build/kernel-report.md, stands in for the compiler's report), and
 # GPU_CHECK_TESTS="FILE ..." runs only those test files: one call can be split into several
 # that each fit a time limit (build outputs are reused; each call writes its own DIR).
 #
@@ -70,6 +74,7 @@ run_step() {  # run_step NAME COMMAND...: output to the log, status recorded
     echo "cpus: $(nproc)"
 } > /tmp/gpu-check-machine.txt
 cat /tmp/gpu-check-machine.txt | tee -a "$log"
+cp /tmp/gpu-check-machine.txt "$out/machine.txt"
 
 # The scene loader needs the JSON library; a machine without it gets the carried copy.
 if ! echo '#include <nlohmann/json.hpp>' | ${CXX:-g++} -std=c++17 -x c++ -fsyntax-only - 2>/dev/null; then
@@ -101,9 +106,16 @@ gpu_targets=$(for lab in $gpu_labs; do python3 -m labkit.registry targets "$lab"
 run_step build make -j"$jobs" lab01-ref $gpu_targets
 say "build took $(( $(date +%s) - start )) s"
 
+# A step named in GPU_CHECK_SKIP is recorded as skipped and left out.
+skipped() { [[ " ${GPU_CHECK_SKIP:-} " == *" $1 "* ]] && { step[$1]=skipped; say "$1: skipped (GPU_CHECK_SKIP)"; }; }
+
 # ---- 3. the compiler's report -----------------------------------------------------------
-run_step kernel_report make -s kernel-report
-cp build/kernel-report.md /tmp/gpu-check-kernel-report.md 2>/dev/null
+if ! skipped kernel_report; then
+    run_step kernel_report make -s kernel-report
+    cp build/kernel-report.md /tmp/gpu-check-kernel-report.md 2>/dev/null
+elif [ -n "${GPU_CHECK_KERNEL_REPORT:-}" ]; then
+    cp "$GPU_CHECK_KERNEL_REPORT" /tmp/gpu-check-kernel-report.md && say "kernel_report: $GPU_CHECK_KERNEL_REPORT"
+fi
 # Which load instructions read the scene: LDC (constant bank), LDS (shared), LDG (global).
 if command -v cuobjdump >/dev/null && [ -x lab05-bench ]; then
     cuobjdump -sass lab05-bench 2>/dev/null | awk '
@@ -111,9 +123,6 @@ if command -v cuobjdump >/dev/null && [ -x lab05-bench ]; then
         /LDC|LDS|LDG|ULDC/ { for (i = 1; i <= NF; i++) if ($i ~ /^(LDC|LDS|LDG|ULDC)/) { split($i, a, "."); n[f "\t" a[1]]++ } }
         END { for (k in n) print k "\t" n[k] }' | sort > /tmp/gpu-check-sass-loads.tsv
 fi
-
-# A step named in GPU_CHECK_SKIP is recorded as skipped and left out.
-skipped() { [[ " ${GPU_CHECK_SKIP:-} " == *" $1 "* ]] && { step[$1]=skipped; say "$1: skipped (GPU_CHECK_SKIP)"; }; }
 
 # ---- 4. the GPU tests -------------------------------------------------------------------
 lab_tests=$(for lab in $gpu_labs; do printf 'tests/labs/test_lab%s.py ' "$lab"; done)
@@ -171,7 +180,7 @@ if ! skipped ncu && [ -n "$ncu_bin" ] && [ -x lab05-bench ]; then
         timeout 180 "$ncu_bin" --clock-control none --metrics "$metrics" --csv --page raw \
             ./lab05-bench --repeat 1 "$@" > "/tmp/gpu-check-ncu-$label.csv" 2>> "$log"
     }
-    ncu_run cornell --spp 64 --only "${GPU_CHECK_NCU_VARIANTS:-plain,reference,no-register-cap,triangles,quads,general,regenerate,together,scene-shared}" &&
+    ncu_run cornell --spp 64 --only "${GPU_CHECK_NCU_VARIANTS:-plain,reference,exact-rects,no-register-cap,triangles,quads,general,regenerate,together,claimed,scene-shared}" &&
     ncu_run cornell-1-bounce --spp 64 --bounces 1 --only reference &&
     ncu_run showcase --spp 64 --width 600 --height 600 --scene common/scenes/showcase.json --only reference &&
         step[ncu]=ok || step[ncu]=failed

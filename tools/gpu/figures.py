@@ -1,18 +1,22 @@
-"""What the handouts and the README quote of the GPU record (reference/gpu/h200/), generated
-from it or checked against it, so that no figure there can drift from the record.
+"""What the handouts and the README quote of the GPU records (reference/gpu/<card>/, one per
+card), generated from them or checked against them, so that no figure there can drift from
+its record.
 
     python3 -m tools.gpu.figures              rewrite the generated tables
     python3 -m tools.gpu.figures --check      exit 1 naming every figure that differs
     python3 -m tools.gpu.figures --timed-spp  the GPU labs' timed spp the record gives
 
 Three kinds of figure:
-- a table between the marker lines of table_markers(NAME) is generated whole by TABLES[NAME];
-- a figure in the prose is one of PROSE's phrases, each a format string over the record
-  (figures()), which must stand in its file word for word as the record renders it;
-- any other "N.NN ms" outside the tables must be a number the record holds (stale()), so
-  an earlier run's figure left in the text fails too.
-The GPU labs' timed_spp in labs/labs.toml is the spp the record gives for the grader's
-GPU_TIMED_SECONDS (record.timed_spp). tests/tools/test_gpu_figures.py runs all of it.
+- a table between the marker lines of table_markers(NAME, CARD) is generated whole by
+  TABLES[NAME] from that card's record (the marker names it);
+- a figure in the prose is one of PROSE's phrases, each a format string over a record
+  (figures()): the file's (FILE_CARD) or the phrase's own (a (card, phrase) pair), which must
+  stand in its file word for word as that record renders it;
+- any other "N.NN ms" outside the tables must be a number one of the records holds (stale()),
+  so an earlier run's figure left in the text fails too.
+The GPU labs' timed_spp in labs/labs.toml is the spp the record of record.TIMED_SPP_CARD gives
+for the grader's GPU_TIMED_SECONDS (record.timed_spp). tests/tools/test_gpu_figures.py runs
+all of it.
 """
 from __future__ import annotations
 
@@ -30,8 +34,15 @@ FILES = ["README.md", "handouts/05-cuda-mega.md", "handouts/06-cuda-split.md",
          "labs/07-soa/README.md"]
 
 
-def table_markers(name: str) -> tuple[str, str]:
-    return (f"<!-- GPU record table '{name}': generated from reference/gpu/h200/ by "
+# The card whose record each file's prose quotes, where it is not the current one
+# (record.CURRENT): labs 06 and 07, whose references the current record did not change, keep
+# the H200's.
+FILE_CARD = {"handouts/06-cuda-split.md": "h200", "handouts/07-soa.md": "h200",
+             "labs/06-cuda-split/README.md": "h200", "labs/07-soa/README.md": "h200"}
+
+
+def table_markers(name: str, card: str) -> tuple[str, str]:
+    return (f"<!-- GPU record table '{name}': generated from reference/gpu/{card}/ by "
             f"`python3 -m tools.gpu.figures`; edit the record, not this table -->",
             f"<!-- end of GPU record table '{name}' -->")
 
@@ -61,11 +72,17 @@ def ncu_cells(r: dict, shape: str) -> list[str]:
 
 
 # ---- lab 05 -------------------------------------------------------------------------------
+def target_bar(r, config: str) -> str:
+    """A lab 05 speed target as the record's benchmark printed it, without its card and scene."""
+    bar = r["targets05"].get(config, {}).get("bar", "")
+    return bar.split(" on an NVIDIA")[0]
+
+
 def lab05_targets(r):
     b = r["lab05"]
     return rows(["shape", "kernel ms", "target"], ["---", "---:", "---"], [
-        ["`reference`", ms(b["reference"]["best_ms"]), "at most 13 ms"],
-        ["`general`", ms(b["general"]["best_ms"]), "at most 18 ms"],
+        ["`reference`", ms(b["reference"]["best_ms"]), target_bar(r, "reference")],
+        ["`general`", ms(b["general"]["best_ms"]), target_bar(r, "general")],
         ["`plain` (section 2)", ms(b["plain"]["best_ms"]), ""]])
 
 
@@ -130,7 +147,10 @@ def lab05_geometry(r):
     b = r["lab05"]
     walls = {"triangles": "10 triangles", "triangles-shared": "10 triangles",
              "quads": "5 convex quads", "general": "5 convex quads",
-             "reference": "5 axis-aligned rectangles", "any-geometry": "5 axis-aligned rectangles"}
+             "exact-rects": "5 axis-aligned rectangles, the core's exact test",
+             "reference": "5 axis-aligned rectangles, slabs",
+             "any-geometry": "5 axis-aligned rectangles, slabs"}
+    walls = {s: w for s, w in walls.items() if s in b}
     kinds = {"SpheresAndTriangles": "spheres, triangles", "SpheresAndQuads": "spheres, quads",
              "GeneralGeometry": "every kind but rectangles (`GeneralGeometry`)",
              "BoxGeometry": "spheres, rectangles (`BoxGeometry`)",
@@ -146,7 +166,10 @@ def lab05_path_loops(r):
     b = r["lab05"]
     what = [("reference", "whole paths (`trace_samples`)"),
             ("regenerate", "path regeneration (`trace_samples_regenerating`)"),
-            ("together", "lanes kept together (`trace_samples_together`)")]
+            ("together", "lanes kept together (`trace_samples_together`)"),
+            ("claimed", "samples claimed by the warp (`trace_samples_claimed`)"),
+            ("claimed-regs-64", "samples claimed by the warp, at most 64 registers")]
+    what = [(s, how) for s, how in what if s in b]
     return rows(["shape", "a thread's samples by", "registers", "local bytes", "kernel ms",
                  "active threads per warp", "thread instructions per path"],
                 ["---", "---", "---:", "---:", "---:", "---:", "---:"],
@@ -316,11 +339,17 @@ def figures(r: dict) -> dict:
     slow_reserves = (cornell["AoS-atomic-each"], cornell["AoS-atomic-per-warp"])
     return {
         "device": r["baseline"]["device"].split(" (")[0],
+        "device_short": " ".join(w for w in r["baseline"]["device"].split(" (")[0].split()
+                                 if w in ("H100", "H200")),
         "ref": ms(b["reference"]["best_ms"]), "ref1": f"{b['reference']['best_ms']:.1f}",
         "general": ms(b["general"]["best_ms"]), "plain": ms(b["plain"]["best_ms"]),
         "plain_gpaths": f"{b['plain']['paths_per_second'] / 1e9:.1f}",
         "plain_regs": b["plain"]["registers"], "plain_occ": pct(b["plain"]["occupancy"]),
-        "ref_over_target": f"{b['reference']['best_ms'] / 13:.1f}",
+        "ref_target": target_bar(r, "reference"),
+        "exact_rects": ms(b["exact-rects"]["best_ms"]) if "exact-rects" in b else "",
+        "slab_saving": (pct(1 - b["reference"]["best_ms"] / b["exact-rects"]["best_ms"])
+                        if "exact-rects" in b else ""),
+        "claimed": ms(b["claimed"]["best_ms"]) if "claimed" in b else "",
         "ref_regs": b["reference"]["registers"], "ref_occ": pct(b["reference"]["occupancy"]),
         "ref_blocks": b["reference"]["blocks_per_sm"],
         "plain_saving": pct(1 - b["reference"]["best_ms"] / b["plain"]["best_ms"]),
@@ -365,17 +394,20 @@ def figures(r: dict) -> dict:
 # Each file's phrases that quote the record, as the record renders them (figures()).
 PROSE = {
     "README.md": [
-        "ready; {ref1} ms for the baseline on an H200",
-        "ready; {l6_1} ms on the H200 (lab 05's megakernel is faster on the baseline, "
-        "{l6_vs_mega}×; lab 06 wins only on the showcase at 16 bounces, {wins_show16}×",
-        "ready; {l7_1} ms on the H200",
+        "ready; {ref1} ms for the baseline on an {device_short}",
+        ("h200", "ready; {l6_1} ms on the H200 (lab 05's earlier megakernel is faster on the "
+                 "baseline, {l6_vs_mega}×; lab 06 wins only on the showcase at 16 bounces, "
+                 "{wins_show16}×"),
+        ("h200", "ready; {l7_1} ms on the H200"),
     ],
     "handouts/05-cuda-mega.md": [
         "takes **{plain} ms** for the baseline: {plain_gpaths} billion paths per second, "
         "{plain_regs} registers, {plain_occ} occupancy",
         "the {plain_saving} that the reference takes off that",
         "the kernel is bound by instruction issue, with about {active} of 32 lanes active",
-        "The reference takes **{ref} ms**, {ref_over_target} times its target of 13 ms",
+        "The reference takes **{ref} ms**, {slab_saving} less than the kernel before it (the "
+        "rectangles by the core's exact test, the `exact-rects` shape: {exact_rects} ms in the "
+        "same run), and still misses its target of {ref_target}",
         "With four bounces, {active} of 32 lanes are active. With one bounce, {active1}",
         "{active_show} active lanes",
         "Its schedulers issue in about {issue} of their cycles",
@@ -426,29 +458,42 @@ PROSE = {
 
 # ---- checking and rewriting ---------------------------------------------------------------
 def generated(text: str) -> dict:
-    """Each generated table a text holds, by name: (the whole block, its body)."""
+    """Each generated table a text holds, by name: (the whole block, its body, the card whose
+    record it is generated from)."""
     out = {}
-    for m in re.finditer(r"<!-- GPU record table '([\w-]+)'.*?-->\n(.*?)\n<!-- end of GPU "
-                         r"record table '\1' -->", text, re.S):
-        out[m.group(1)] = (m.group(0), m.group(2))
+    for m in re.finditer(r"<!-- GPU record table '([\w-]+)': generated from reference/gpu/"
+                         r"(\w+)/.*?-->\n(.*?)\n<!-- end of GPU record table '\1' -->", text, re.S):
+        out[m.group(1)] = (m.group(0), m.group(3), m.group(2))
     return out
 
 
-def block(name: str, r: dict) -> str:
-    begin, end = table_markers(name)
+def block(name: str, r: dict, card: str) -> str:
+    begin, end = table_markers(name, card)
     return f"{begin}\n{TABLES[name](r)}\n{end}"
 
 
+def read_card(card: str) -> dict:
+    return rec.read(rec.record_of(card))
+
+
+def phrases(name: str) -> list[tuple[str, str]]:
+    """A file's PROSE phrases, each with the card whose record it quotes."""
+    default = FILE_CARD.get(name, rec.CURRENT)
+    return [p if isinstance(p, tuple) else (default, p) for p in PROSE.get(name, [])]
+
+
 def without_tables(text: str) -> str:
-    for whole, _ in generated(text).values():
+    for whole, _, _ in generated(text).values():
         text = text.replace(whole, "")
     return text
 
 
-def record_numbers(record=rec.RECORD) -> set[float]:
-    """Every number the record's files hold, and each times 1000 (seconds as ms)."""
+def record_numbers(records=None) -> set[float]:
+    """Every number the records' files hold, and each times 1000 (seconds as ms)."""
     found = set()
-    for f in record.iterdir():
+    files = [f for d in (records or [rec.record_of(c) for c in rec.CARDS]) if d.is_dir()
+             for f in d.iterdir() if f.is_file()]
+    for f in files:
         for m in re.finditer(r"-?\d[\d,]*\.?\d*(?:e[-+]?\d+)?", f.read_text()):
             try:
                 x = float(m.group(0).replace(",", ""))
@@ -485,30 +530,42 @@ def stale(text: str, numbers: set[float]) -> list[str]:
     return bad
 
 
-def problems(root=ROOT, record=rec.RECORD) -> list[str]:
-    """Every figure of FILES that is not the record's, one line each."""
-    r, out = rec.read(record), []
-    values, numbers = figures(r), record_numbers(record)
+def problems(root=ROOT, records=None) -> list[str]:
+    """Every figure of FILES that is not its record's, one line each. records: the folder of
+    each card's record (by default reference/gpu/<card>/)."""
+    folders = records or {c: rec.record_of(c) for c in rec.CARDS}
+    out, read = [], {}
+
+    def record(card: str) -> dict:
+        if card not in read:
+            read[card] = rec.read(folders[card])
+        return read[card]
+
+    numbers = record_numbers(list(folders.values()))
     for name in FILES:
         text = (root / name).read_text()
-        for table, (whole, _) in generated(text).items():
+        for table, (whole, _, card) in generated(text).items():
             if table not in TABLES:
                 out.append(f"{name}: no table '{table}' in tools/gpu/figures.py")
-            elif whole != block(table, r):
-                out.append(f"{name}: table '{table}' is not the record's")
+            elif card not in folders:
+                out.append(f"{name}: table '{table}' names no record of a card: {card}")
+            elif whole != block(table, record(card), card):
+                out.append(f"{name}: table '{table}' is not the record's ({card})")
         flowing = " ".join(text.split())  # a phrase may break across lines
-        for phrase in PROSE.get(name, []):
-            if phrase.format(**values) not in flowing:
-                out.append(f"{name}: not found as the record gives it: "
-                           f"\"{phrase.format(**values)}\"")
-        out += [f"{name}: '{s}' is no figure of reference/gpu/h200/" for s in
+        for card, phrase in phrases(name):
+            said = phrase.format(**figures(record(card)))
+            if said not in flowing:
+                out.append(f"{name}: not found as the record ({card}) gives it: \"{said}\"")
+        out += [f"{name}: '{s}' is no figure of any record in reference/gpu/" for s in
                 stale(text, numbers)]
     placed = {t for name in FILES for t in generated((root / name).read_text())}
     out += [f"table '{t}' stands in no file" for t in TABLES if t not in placed]
     for lab in registry.labs():
-        if lab.gpu and lab.timed_spp != derived_spp(r, lab.number):
-            out.append(f"labs/labs.toml: lab {lab.number}'s timed_spp is {lab.timed_spp}; the "
-                       f"record gives {derived_spp(r, lab.number)}")
+        if lab.gpu:
+            want = derived_spp(record(rec.TIMED_SPP_CARD[lab.number]), lab.number)
+            if lab.timed_spp != want:
+                out.append(f"labs/labs.toml: lab {lab.number}'s timed_spp is {lab.timed_spp}; "
+                           f"the record ({rec.TIMED_SPP_CARD[lab.number]}) gives {want}")
     return out
 
 
@@ -523,14 +580,14 @@ def grade_view_side() -> int:
     return json.loads((ROOT / "reference/golden/cornell/meta.json").read_text())["width"]
 
 
-def rewrite(root=ROOT, record=rec.RECORD) -> list[str]:
-    r, changed = rec.read(record), []
+def rewrite(root=ROOT) -> list[str]:
+    changed = []
     for name in FILES:
         path = root / name
         text = new = path.read_text()
-        for table, (whole, _) in generated(text).items():
+        for table, (whole, _, card) in generated(text).items():
             if table in TABLES:
-                new = new.replace(whole, block(table, r))
+                new = new.replace(whole, block(table, read_card(card), card))
         if new != text:
             path.write_text(new)
             changed.append(name)
@@ -544,11 +601,11 @@ def main(argv=None) -> int:
                    help="the GPU labs' timed spp the record gives (labs/labs.toml's timed_spp)")
     a = p.parse_args(argv)
     if a.timed_spp:
-        r = rec.read()
         for lab in registry.labs():
             if lab.gpu:
-                print(f"lab {lab.number}: timed_spp = {derived_spp(r, lab.number)} "
-                      f"(labs.toml: {lab.timed_spp})")
+                card = rec.TIMED_SPP_CARD[lab.number]
+                print(f"lab {lab.number}: timed_spp = {derived_spp(read_card(card), lab.number)} "
+                      f"(labs.toml: {lab.timed_spp}; the {card} record)")
         return 0
     if a.check:
         bad = problems()

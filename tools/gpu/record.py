@@ -1,22 +1,87 @@
-"""The GPU record, reference/gpu/h200/, read as numbers: what `make gpu-check` wrote on the
-H200 (tools/gpu/check.sh) and what the handouts, the README and the GPU labs' timed renders
-quote of it (tools/gpu/figures.py, tests/tools/test_gpu_figures.py).
+"""The GPU records, one per card the course may get (reference/gpu/h100/, reference/gpu/h200/),
+read as numbers: what `make gpu-check` wrote on that card (tools/gpu/check.sh) and what the
+handouts, the README and the GPU labs' timed renders quote of it (tools/gpu/figures.py,
+tests/tools/test_gpu_figures.py), and what the GPU tests' loose bars read on that card.
 
     bench-lab05.json, bench-lab05-fast-math.json   lab05-bench: the megakernel's shapes
     bench-lab06.json, bench-lab07.json              lab06-bench, lab07-bench: the wavefront's
     gpu-check.json                                  accuracy, process time, Nsight Compute
     wavefront.md                                    labs/06-cuda-split/measure.sh's scenes
+    machine.txt, summary.md, tests.txt              the machine, the tables, the GPU tests
+
+    python3 -m tools.gpu.record --install DIR       DIR (check.sh's output) becomes the record
+                                                    of the card it ran on
 """
 from __future__ import annotations
 
+import argparse
 import functools
 import json
 import pathlib
 import re
+import shutil
+import sys
 
 from labkit.harness import ROOT
 
-RECORD = ROOT / "reference" / "gpu" / "h200"
+RECORDS = ROOT / "reference" / "gpu"
+# Each card's folder, by what its name holds ("NVIDIA H100 80GB HBM3").
+CARDS = {"h100": "H100", "h200": "H200"}
+# The card whose record is of the current code of every lab: the one the handouts' lab 05
+# figures and lab 05's timed render come from (the H200's record is of the kernel before).
+CURRENT = "h100"
+RECORD = RECORDS / CURRENT
+# The record each GPU lab's timed render is derived from (labs/labs.toml's timed_spp): lab 05's
+# reference changed with the current record; labs 06 and 07 keep the spp of their record.
+TIMED_SPP_CARD = {"05": CURRENT, "06": "h200", "07": "h200"}
+
+
+def card_of(gpu_name: str) -> str | None:
+    """The record folder of a GPU by its name, or None for a card the course has no record of."""
+    for card, token in CARDS.items():
+        if token in gpu_name:
+            return card
+    return None
+
+
+def record_of(card: str) -> pathlib.Path:
+    return RECORDS / card
+
+
+def best_ms(card: str, bench: str, config: str) -> float | None:
+    """A configuration's best kernel ms in a card's record (bench: "lab05", "lab06", "lab07"),
+    or None when the card has no such record."""
+    path = record_of(card) / f"bench-{bench}.json"
+    if not path.exists():
+        return None
+    data = json.loads(path.read_text())
+    for entry in data.get("variants", data.get("configs", [])):
+        if entry["name"] == config:
+            return entry["best_ms"]
+    return None
+
+
+# check.sh's output files, by the names the record gives them.
+RECORD_FILES = {"bench.json": "bench-lab05.json",
+                "bench-fast-math.json": "bench-lab05-fast-math.json",
+                "bench-lab06.json": "bench-lab06.json", "bench-lab07.json": "bench-lab07.json",
+                "gpu-check.json": "gpu-check.json", "summary.md": "summary.md",
+                "wavefront.md": "wavefront.md", "machine.txt": "machine.txt"}
+
+
+def install(out: pathlib.Path) -> pathlib.Path:
+    """Copies a check.sh output folder into the record of the card it ran on (its bench.json's
+    device); returns the record's folder."""
+    device = json.loads((out / "bench.json").read_text())["device"]
+    card = card_of(device)
+    if card is None:
+        raise SystemExit(f"gpu_record: no record folder for {device} (tools/gpu/record.py CARDS)")
+    target = record_of(card)
+    target.mkdir(parents=True, exist_ok=True)
+    for name, recorded in RECORD_FILES.items():
+        if (out / name).exists():
+            shutil.copy(out / name, target / recorded)
+    return target
 
 
 def load(name: str, record: pathlib.Path = RECORD) -> dict:
@@ -36,6 +101,7 @@ def read(record: pathlib.Path = RECORD) -> dict:
         "lab05": {v["name"]: v for v in lab05["variants"]},
         "lab05_fast": {v["name"]: v for v in fast["variants"]},
         "baseline": {k: lab05[k] for k in ("width", "height", "spp", "bounces", "device")},
+        "targets05": {t["config"]: t for t in lab05.get("targets", [])},
         "host_ms": lab05["host_ms"],
         "accuracy": check["accuracy"],
         "process": check["process_vs_kernel"],
@@ -54,6 +120,26 @@ def read(record: pathlib.Path = RECORD) -> dict:
 # lab05-bench's shapes each kernel is, by the run and the kernel's template arguments
 # (threads a pixel, scene memory, block, path loop, register cap, materials, geometry).
 NCU_SHAPES = {
+    # The kernels since the rectangles' slabs (render_kernel's last argument, slabs or not, as
+    # the demangler writes it: 1 or 0).
+    ("cornell", "32, 1, 64, 0, 56, Kinds<Diffuse>, Kinds<Sphere, AxisRect>, 1"): "reference",
+    ("cornell", "32, 1, 64, 0, 56, Kinds<Diffuse>, Kinds<Sphere, AxisRect>, 0"):
+        "exact-rects",
+    ("cornell", "32, 1, 64, 0, 56, Kinds<Diffuse>, Kinds<Sphere, Triangle, ConvexQuad>, 1"):
+        "general",
+    ("cornell", "32, 1, 64, 0, 56, Kinds<Diffuse>, Kinds<Sphere, ConvexQuad>, 1"): "quads",
+    ("cornell", "32, 1, 64, 0, 56, Kinds<Diffuse>, Kinds<Sphere, Triangle>, 1"): "triangles",
+    ("cornell", "32, 2, 64, 0, 56, Kinds<Diffuse>, Kinds<Sphere, AxisRect>, 1"): "scene-shared",
+    ("cornell", "32, 1, 64, 2, 56, Kinds<Diffuse>, Kinds<Sphere, AxisRect>, 1"): "regenerate",
+    ("cornell", "32, 1, 64, 1, 56, Kinds<Diffuse>, Kinds<Sphere, AxisRect>, 1"): "together",
+    ("cornell", "32, 1, 64, 3, 56, Kinds<Diffuse>, Kinds<Sphere, AxisRect>, 1"): "claimed",
+    ("cornell", "32, 1, 64, 0, 255, Kinds<Diffuse>, Kinds<Sphere, AxisRect>, 1"):
+        "no-register-cap",
+    ("cornell-1-bounce", "32, 1, 64, 0, 56, Kinds<Diffuse>, Kinds<Sphere, AxisRect>, 1"):
+        "reference, 1 bounce",
+    ("showcase", "32, 1, 64, 0, 56, Kinds<Diffuse, Mirror, Glass>, "
+                 "Kinds<Sphere, Triangle, ConvexQuad, AxisRect>, 1"): "showcase",
+    # The kernels before (the H200's record).
     ("cornell", "32, 1, 64, 0, 56, Kinds<Diffuse>, Kinds<Sphere, AxisRect>"): "reference",
     ("cornell", "32, 1, 64, 0, 56, Kinds<Diffuse>, Kinds<Sphere, Triangle, ConvexQuad>"): "general",
     ("cornell", "32, 1, 64, 0, 56, Kinds<Diffuse>, Kinds<Sphere, ConvexQuad>"): "quads",
@@ -158,3 +244,16 @@ def timed_spp(record: dict, lab: str, pixels: int, seconds: float) -> int:
 
 def timed_seconds(record: dict, lab: str, pixels: int, spp: int) -> float:
     return pixels * spp / throughput(record, lab)
+
+
+def main(argv=None) -> int:
+    p = argparse.ArgumentParser(description="the GPU records")
+    p.add_argument("--install", metavar="DIR", required=True,
+                   help="copy check.sh's output folder DIR into its card's record")
+    a = p.parse_args(argv)
+    print(f"gpu_record: {a.install} -> {install(pathlib.Path(a.install))}")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,8 +1,9 @@
 // Lab 05: your copy, yours to edit. Every place to fill in is marked TODO(lab05).
-// The megakernel: every thread traces whole camera paths, first ray to last bounce, with the
-// shared core (trace_path, or the bounce_step it loops over), so the GPU image is lab 01's
-// estimator with lab 01's random numbers. The threads of one pixel split its samples between
-// them and add their partial sums in a fixed order, so the image is reproducible bit for bit.
+// The megakernel: every thread traces camera paths, first ray to last bounce, with the shared
+// core (trace_path, or the bounce_step it loops over), so the GPU image is lab 01's estimator
+// with lab 01's random numbers. The threads of one pixel split its samples between them and
+// add their partial sums in a fixed order, so the image is reproducible bit for bit. The
+// primitive tests are the core's but for the rectangles', which are slabs (slab_geometry.cuh).
 #pragma once
 
 #include <cstdint>
@@ -11,6 +12,7 @@
 #include <path_tracer.h>
 
 #include <scene_pool.cuh>
+#include <slab_geometry.cuh>
 
 // What one launch renders: rows [first_row, first_row + rows) of the image, into `pixels`
 // (rows x width, row-major). A large image is rendered as several such bands.
@@ -50,13 +52,16 @@ __device__ inline CameraSample camera_sample(const KernelArgs& args, int x, int 
             args.camera.ray_through(x + real(rng.at(kDimPixelX)), y + real(rng.at(kDimPixelY)))};
 }
 
-// How a thread traces its samples. Every form draws the same numbers, runs the same
-// operations on each path and adds the samples in the same order: the same image, bit for
-// bit; lab05-bench times each (handouts/05-cuda-mega.md, section 7).
+// How a thread traces its samples. Every form draws the same numbers and runs the same
+// operations on each path; all but Claimed also add a lane's samples in the same order, so
+// they give the same image bit for bit; lab05-bench times each (handouts/05-cuda-mega.md,
+// "Divergence").
 enum class PathLoop {
     WholePaths,  // trace_samples: the core's trace_path, one sample after the other
     Together,    // trace_samples_together: the same, with the warp's lanes kept together
     Regenerate,  // trace_samples_regenerating: by bounces, a new sample as soon as one ends
+    Claimed,     // trace_samples_claimed: by bounces, the warp's lanes claiming the pixel's
+                 // samples as their paths end
 };
 
 // One thread's samples of pixel (x, y): s = first, first + stride, ... below spp, one after
@@ -65,15 +70,18 @@ enum class PathLoop {
 // another's bounces on), but they stay together: every lane starts its next sample at the
 // same time, and inside a path they run the same primitive loops. Materials and Primitives:
 // the material and primitive kinds compiled in (material_set.h, geometry_set.h), passed on
-// to the core.
-template <class Materials, class Primitives>
-__device__ inline SampleSum trace_samples(const SceneView& scene, const KernelArgs& args, int x,
-                                          int y, uint64_t pixel, int first, int stride) {
+// to the core; `geometry` is what the core's path loop tests rays against
+// (slab_geometry.cuh).
+template <class Materials, class Primitives, class Geometry>
+__device__ inline SampleSum trace_samples(const SceneView& scene, const Geometry& geometry,
+                                          const KernelArgs& args, int x, int y, uint64_t pixel,
+                                          int first, int stride) {
     SampleSum sum;  // in double, as render_pixel's
     // TODO(lab05): trace samples first, first + stride, ... below args.settings.spp with
-    // camera_sample and trace_path<Materials, Primitives>, adding each path's radiance to
-    // sum.
+    // camera_sample and trace_path<Materials, Primitives>(scene, geometry, ...), adding
+    // each path's radiance to sum.
     (void)scene;
+    (void)geometry;
     (void)x;
     (void)y;
     (void)pixel;
@@ -82,52 +90,88 @@ __device__ inline SampleSum trace_samples(const SceneView& scene, const KernelAr
     return sum;
 }
 
-// A ray that meets nothing: NaN fails every primitive test and every cull, so a lane that
-// traces it never keeps the warp inside a test that the other lanes skip.
-__device__ inline Ray ray_meeting_nothing() {
-    return {Vec3(0.0f), Vec3(__int_as_float(0x7fffffff))};
-}
+// A ray for a lane that traces no path: finite, so that no test takes the slow path of a
+// division or square root for it (a NaN direction would, in the rectangles' reciprocals);
+// what it meets is never used. As a shadow ray with t_max 0 it is blocked by nothing.
+__device__ inline Ray idle_ray() { return {Vec3(0.0f), Vec3(1.0f)}; }
 
 // trace_samples with the warp's lanes kept together. In trace_path's `while (path.alive)`
 // a lane whose path has ended leaves the loop and waits, and the warp runs every later
-// bounce split: each vote of a primitive test (any_lane) then goes through the slow path of
-// a warp-wide operation in a split warp, and each branch pays for joining the lanes again.
-// Here a lane whose path has ended stays in the loop and traces ray_meeting_nothing() until
-// every lane's path has ended, so the warp runs each bounce's primitive loops whole and only
-// the bounce step, branchy by nature, runs on the live lanes alone. Keeping count of which
-// lanes still run is not free: handouts/05-cuda-mega.md, section 7, weighs the two.
-template <class Materials, class Primitives>
-__device__ inline SampleSum trace_samples_together(const SceneView& scene, const KernelArgs& args,
-                                                   int x, int y, uint64_t pixel, int first,
-                                                   int stride) {
+// bounce split. Here a lane whose path has ended stays in the loop and traces idle_ray()
+// (its hit unused) until every lane's path has ended, so the warp runs each bounce's
+// primitive loops whole and only the bounce step, branchy by nature, runs on the live lanes
+// alone. Keeping count of which lanes still run is not free: handouts/05-cuda-mega.md weighs
+// the loops.
+template <class Materials, class Primitives, class Geometry>
+__device__ inline SampleSum trace_samples_together(const SceneView& scene, const Geometry& geometry,
+                                                   const KernelArgs& args, int x, int y,
+                                                   uint64_t pixel, int first, int stride) {
     SampleSum sum;
     // TODO(lab05, optional, once trace_samples works): the same samples with the warp's
     // lanes kept together: a lane whose path has ended stays in the bounce loop, tracing
-    // ray_meeting_nothing(), until every lane's has (any_lane). Until then: trace_samples.
-    sum = trace_samples<Materials, Primitives>(scene, args, x, y, pixel, first, stride);
+    // idle_ray(), until every lane's has (any_lane). Until then: trace_samples.
+    sum = trace_samples<Materials, Primitives>(scene, geometry, args, x, y, pixel, first, stride);
     return sum;
 }
 
 // The same samples, the same paths, the same sum, but by bounces: each iteration of the loop
 // is one bounce of the lane's current path (the core's closest_hit, bounce_step and shadow
 // query, as in trace_path's loop), and a lane whose path has ended starts its next sample in
-// the same iteration ("path regeneration"). The warp's lanes then stay busy until each has
-// run out of samples: a warp costs about its longest lane's total of bounces rather than the
-// sum over samples of the longest path. But starting a path is code that only the lanes whose
-// path ended run, in every iteration, while the others wait, and the loop carries more state
-// in registers: on the baseline the reference traces whole paths (handouts/05-cuda-mega.md,
-// "Where the time went"). The image is bit for bit trace_samples' (the same operations on
-// each path, the samples added in the same order).
-template <class Materials, class Primitives>
+// the same iteration ("path regeneration"). Each lane still traces its own share of the
+// samples (first, first + stride, ...), so a warp runs until the lane with the most bounces
+// in its share is done. The image is bit for bit trace_samples' (the same operations on each
+// path, the samples added in the same order).
+template <class Materials, class Primitives, class Geometry>
 __device__ inline SampleSum trace_samples_regenerating(const SceneView& scene,
+                                                       const Geometry& geometry,
                                                        const KernelArgs& args, int x, int y,
                                                        uint64_t pixel, int first, int stride) {
     SampleSum sum;
     // TODO(lab05, optional, once trace_samples works): the same samples, but one bounce
-    // per loop iteration (closest_hit<Primitives>, bounce_step<Materials, Primitives>,
-    // occluded<Primitives>, as trace_path's loop does), starting the lane's next sample as
-    // soon as its path ends. Until then: trace_samples.
-    sum = trace_samples<Materials, Primitives>(scene, args, x, y, pixel, first, stride);
+    // per loop iteration (closest_hit<Primitives>(geometry, ...), bounce_step<Materials,
+    // Primitives>, occluded<Primitives>(geometry, ...), as trace_path's loop does),
+    // starting the lane's next sample as soon as its path ends. Until then: trace_samples.
+    sum = trace_samples<Materials, Primitives>(scene, geometry, args, x, y, pixel, first, stride);
+    return sum;
+}
+
+// The two random numbers a bounce step draws (bounce_dimension(bounce, 0) and (bounce, 1)),
+// drawn before it is called: the bounce step reads them from here, and any other dimension
+// from the path's stream. The claimed loop draws them with the same instructions that draw
+// a new sample's pixel jitter.
+struct DrawnNumbers {
+    SampleStream stream;  // the path's
+    uint32_t first;  // bounce_dimension(bounce, 0)
+    float u0, u1;  // the numbers of dimensions first and first + 1
+
+    __device__ float at(uint32_t dimension) const {
+        return dimension == first ? u0 : dimension == first + 1 ? u1 : stream.at(dimension);
+    }
+};
+
+// A warp's 32 lanes share one pixel's samples by claiming them: each lane starts with sample
+// number `first` (its lane), and whenever paths end, the lanes whose path ends take the next
+// samples nobody has claimed, in lane order (a vote, __ballot_sync, says which lanes claim;
+// each counts the claimants below it). One iteration is one bounce of every lane's path, and
+// every lane runs the whole iteration: the closest hit, the bounce step, a shadow query (of
+// idle_ray() when the bounce step asked for none), and the next ray. So the lanes stay busy
+// until the pixel has no sample left: a pixel costs its bounces' total over 32, not its
+// longest paths'. What would split the warp is made one code for all lanes: a lane whose
+// path ends at this hit (it escapes, or this is its last bounce: the bounce step's own
+// rule) claims its next sample before the bounce step, and draws that sample's pixel jitter
+// where the others draw their bounce's two numbers, by the same instructions (DrawnNumbers).
+// Which lane traces which sample depends on the paths' lengths alone, so the image is the
+// same bit for bit on every run; each lane adds its samples in the order it claimed them.
+template <class Materials, class Primitives, class Geometry>
+__device__ inline SampleSum trace_samples_claimed(const SceneView& scene, const Geometry& geometry,
+                                                  const KernelArgs& args, int x, int y,
+                                                  uint64_t pixel, int first, int stride) {
+    SampleSum sum;
+    // TODO(lab05, optional, once trace_samples works): one pixel per warp, one bounce per
+    // loop iteration on every lane; a lane whose path ends claims the pixel's next
+    // unclaimed sample (__ballot_sync of the lanes that claim, __popc of those below it).
+    // Until then: trace_samples.
+    sum = trace_samples<Materials, Primitives>(scene, geometry, args, x, y, pixel, first, stride);
     return sum;
 }
 
@@ -149,21 +193,36 @@ __device__ inline SampleSum sum_across_lanes(SampleSum sum) {
     return sum;
 }
 
+// What the kernel tests rays against: the core's tests with the rectangles as slabs
+// (SlabGeometry), or with kSlabRects false the core's own loops over the scene, the
+// rectangles' exact test included (what lab05-bench's exact-rects shape measures).
+template <bool kSlabRects, SceneMemory kMemory>
+__device__ inline auto kernel_geometry(const SceneView& scene, const float4* global_pool,
+                                       const float4* shared_pool) {
+    if constexpr (kSlabRects) {
+        return SlabGeometry{scene, slabs_in<kMemory>(global_pool, shared_pool)};
+    } else {
+        return scene;
+    }
+}
+
 // kThreadsPerPixel threads per pixel, neighbours in one warp; thread k of a pixel traces its
 // samples k, k + kThreadsPerPixel, k + 2 kThreadsPerPixel, ... (the counts differ by at most
-// one), in the form kLoop says (PathLoop). kMemory: where the scene is read from
-// (scene_pool.cuh). __launch_bounds__ tells the compiler the block size; kMaxRegisters caps
-// the registers per thread (255, the hardware's most, caps nothing), so that more threads fit
-// on a multiprocessor, at the price of spills. Materials and Primitives: the material and
-// primitive kinds the scene uses (material_set.h, geometry_set.h); a kernel for DiffuseOnly
-// carries no mirror or glass code, one for BoxGeometry no triangle or quad test.
+// one), or with PathLoop::Claimed the samples it claims, in the form kLoop says (PathLoop).
+// kMemory: where the scene is read from (scene_pool.cuh). __launch_bounds__ tells the
+// compiler the block size; kMaxRegisters caps the registers per thread (255, the hardware's
+// most, caps nothing), so that more threads fit on a multiprocessor, at the price of spills.
+// Materials and Primitives: the material and primitive kinds the scene uses (material_set.h,
+// geometry_set.h); a kernel for DiffuseOnly carries no mirror or glass code, one for
+// BoxGeometry no triangle or quad test. kSlabRects: kernel_geometry.
 template <int kThreadsPerPixel, SceneMemory kMemory, int kBlockThreads,
           PathLoop kLoop = PathLoop::WholePaths, int kMaxRegisters = 255,
-          class Materials = AnyMaterial, class Primitives = AnyGeometry>
+          class Materials = AnyMaterial, class Primitives = AnyGeometry, bool kSlabRects = true>
 __global__ void __launch_bounds__(kBlockThreads) __maxnreg__(kMaxRegisters)
     render_kernel(const KernelArgs args) {
     extern __shared__ float4 shared_pool[];  // used only when kMemory is Shared
     const SceneView scene = scene_in<kMemory>(args.layout, args.scene_pool, shared_pool);
+    const auto geometry = kernel_geometry<kSlabRects, kMemory>(scene, args.scene_pool, shared_pool);
     const int width = args.settings.width;
     // TODO(lab05): the kernel. Give each thread its share of the band's work: from
     // blockIdx.x, kBlockThreads and threadIdx.x, its pixel (x, y) and the first of that
@@ -179,6 +238,6 @@ __global__ void __launch_bounds__(kBlockThreads) __maxnreg__(kMaxRegisters)
         const uint64_t pixel = static_cast<uint64_t>(y) * width + x;
         const CameraSample c = camera_sample(args, x, y, pixel, 0);
         args.pixels[static_cast<long long>(row) * width + x] =
-            trace_path(scene, c.ray, c.rng, args.settings.bounces);
+            trace_path(scene, geometry, c.ray, c.rng, args.settings.bounces);
     }
 }

@@ -26,14 +26,14 @@
 
 const char* const kLabName = "05-cuda-mega";
 
-// The launch shape, each choice measured on an H200 with lab05-bench (the shapes and their
-// times are in handouts/05-cuda-mega.md): 32 threads share a pixel's samples (a grid of
-// millions of threads, so the last wave of blocks is a small part of the work, while a
-// pixel's threads still fit in one warp for the shuffles; section 3); blocks of 64 threads
-// (section 5); whole paths (section 7: neither path regeneration nor keeping a warp's lanes
-// together paid); at most 56 registers a thread, for half again as many warps to hide the
-// latencies with, at the price of a few spilled bytes (section 7); only the kinds of
-// material and primitive the scene uses (sections 6 and 7).
+// The launch shape, each choice measured with lab05-bench (the shapes and their times are in
+// handouts/05-cuda-mega.md): 32 threads share a pixel's samples (a grid of millions of
+// threads, so the last wave of blocks is a small part of the work, while a pixel's threads
+// still fit in one warp for the shuffles; section 3); blocks of 64 threads (section 5); whole
+// paths (section 7: neither path regeneration, keeping a warp's lanes together nor samples
+// claimed by the warp paid); at most 56 registers a thread, for more warps to hide the
+// latencies with, at the price of a few spilled bytes (section 5); only the kinds of material
+// and primitive the scene uses (sections 6 and 7).
 constexpr int kThreadsPerPixel = 32;
 constexpr int kBlockThreads = 64;
 constexpr PathLoop kLoop = PathLoop::WholePaths;
