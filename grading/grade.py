@@ -132,9 +132,10 @@ def checked_golden(scene: str, points: int, **options) -> Item:
 GPU_SPEED_BAR = 0.75  # at least 3/4 of the reference's speed: at most 1.33x its time
 GPU_TIMED_SCALE = 10
 # Each GPU lab's spp is its timed_spp in labs/labs.toml: the spp at which the lab's reference,
-# at the throughput its newest GPU record (reference/gpu/<card>/) measured on the baseline, renders the
-# timed view in GPU_TIMED_SECONDS of kernel time (`python3 -m tools.gpu.figures --timed-spp`
-# computes it; tests/tools/test_gpu_figures.py fails when labs.toml and the record disagree).
+# at the throughput its newest GPU record (reference/gpu/<card>/) measured on the baseline,
+# renders the timed view in GPU_TIMED_SECONDS of kernel time (`python3 -m tools.gpu.figures
+# --timed-spp` computes it; tests/tools/test_gpu_figures.py fails when labs.toml and the record
+# disagree).
 GPU_TIMED_SECONDS = 0.35
 GPU_TIMED_SPP = {lab.number: lab.timed_spp for lab in registry.labs() if lab.gpu}
 

@@ -20,6 +20,7 @@ from __future__ import annotations
 import fnmatch
 import os
 import pathlib
+import re
 import secrets
 import shutil
 import signal
@@ -78,6 +79,17 @@ def skeleton_form(lab: str, folders: dict[str, str]) -> set[str]:
             for path in leaks.skeletons.SHARED_SOURCES.get(name, [])}
 
 
+# A lab README's lines that name what only the course repository holds (the lab's tests, the
+# GPU check that runs them), between these two lines, are left out of a release.
+COURSE_ONLY = re.compile(r"^<!-- course repository only -->\n.*?^<!-- end course repository "
+                         r"only -->\n", re.M | re.S)
+
+
+def for_students(text: str) -> str:
+    """A markdown file as a release ships it: without its course-repository-only parts."""
+    return COURSE_ONLY.sub("", text)
+
+
 def copy_sources(stage: pathlib.Path, lab: str, folders: dict[str, str],
                  files: list[str]) -> None:
     as_skeleton = skeleton_form(lab, folders)
@@ -88,6 +100,9 @@ def copy_sources(stage: pathlib.Path, lab: str, folders: dict[str, str],
         dst.parent.mkdir(parents=True, exist_ok=True)
         if f in as_skeleton:
             dst.write_text(leaks.skeletons.skeleton_text(src.read_text(), f))
+            shutil.copymode(src, dst)
+        elif f.endswith(".md") and COURSE_ONLY.search(src.read_text()):
+            dst.write_text(for_students(src.read_text()))
             shutil.copymode(src, dst)
         else:
             shutil.copy2(src, dst)

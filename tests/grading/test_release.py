@@ -7,9 +7,11 @@ Lab 03's `make grade` is not run here: its skeleton is a correct serial renderer
 parallel speedup, which a busy machine cannot measure (it then awards provisional points)
 and which takes over a minute. What lab 03's grade needs from a release (lab01-ref built from
 the shipped lab-01 solution, the prebuilt lab03-ref) is checked instead."""
+import fnmatch
 import json
 import os
 import pathlib
+import re
 import shutil
 import signal
 import subprocess
@@ -364,3 +366,16 @@ def test_leak_check_finds_the_hidden_scene(tmp_path, pristine01):
     scenes.write_scene(release / "common" / "scenes" / "mine.json", hidden.hidden_scene(secret))
     assert leaks.leaks(release, "01", FOLDERS, secret) == \
         ["common/scenes/mine.json: is the hidden scene made from the secret"]
+
+
+def test_lab_readmes_in_a_release_name_nothing_it_lacks():
+    """A lab's README as a release ships it (its course-repository-only parts left out) names
+    no test the release does not ship and no `make gpu-check`, which runs those tests."""
+    from grading import leaks, release
+    for readme in sorted(ROOT.glob("labs/*/README.md")):
+        text = release.for_students(readme.read_text())
+        named = set(re.findall(r"tests/[\w/]+\.(?:py|cpp|cu)", text))
+        absent = [t for t in named if not any(fnmatch.fnmatch(t, p) for p in leaks.PUBLIC_TESTS)]
+        assert not absent and "gpu-check" not in text, (readme, absent)
+    course = (ROOT / "labs/05-cuda-mega/README.md").read_text()
+    assert "tests/labs/test_lab05.py" in course and "make gpu-check" in course
