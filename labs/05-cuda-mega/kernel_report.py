@@ -101,11 +101,17 @@ PATH_LOOPS = {"(PathLoop)0": "whole", "(PathLoop)1": "together", "(PathLoop)2": 
               "(PathLoop)3": "claimed"}
 
 
+# path_queue.cuh's Reserve: how a wavefront kernel's pushes reserve their places.
+RESERVES = {"(Reserve)0": "per block", "(Reserve)1": "per warp", "(Reserve)2": "per thread"}
+
+
 def short(name: str) -> str:
     for value, loop in PATH_LOOPS.items():
         name = name.replace(value, loop)
     name = name.replace("(SceneMemory)0", "global").replace("(SceneMemory)1", "constant")
     name = name.replace("(SceneMemory)2", "shared").replace("SceneMemory::", "")
+    for value, how in RESERVES.items():
+        name = name.replace(value, how)
     for kinds, alias in KIND_SETS.items():
         name = name.replace(kinds, alias)
     name = re.sub(r"\s+>", ">", name)  # the demangler writes "Foo<Bar<int> >"
@@ -113,7 +119,9 @@ def short(name: str) -> str:
     # the core's exact test.
     name = re.sub(r"(render_kernel<.*), true>", r"\1>", name)
     name = re.sub(r"(render_kernel<.*), false>", r"\1, exact rectangles>", name)
-    return re.sub(r"^void |\(.*\)$", "", name)
+    # The kernel's parameter list (after its template arguments) says nothing new: dropped, so
+    # that every template argument stays and no two kernels read alike.
+    return re.sub(r"^void |(?<=>)\(.*\)$", "", name)
 
 
 def main() -> int:

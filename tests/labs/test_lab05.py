@@ -139,6 +139,11 @@ def test_kernel_report(nvcc):
     for cap in (48, 64):
         registers, _, _ = row(reference.replace("whole, 56", f"whole, {cap}"))
         assert registers <= cap, (cap, registers)
+    # Every row names its kernel whole: no two rows read alike (the wavefront kernels' nine
+    # template arguments included).
+    names = [ln.split("|")[1].strip() for ln in report.splitlines() if ln.startswith("| `")]
+    assert len(names) == len(set(names)), sorted(n for n in names if names.count(n) > 1)
+    assert any("WavefrontConfig<SoaPathPool, global, per block, " in n for n in names), names
 
 
 def test_loop_branches_reads_machine_code():
