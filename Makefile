@@ -68,8 +68,8 @@ PHONY_EXTRA += lint format gpu-figures
 .DEFAULT_GOAL := help
 
 # The staff section only where its targets work: the course repository, not a release (which
-# has no grading/release.py, no solutions to build every lab from).
-help: help-students $(if $(wildcard grading/release.py),help-staff)
+# has no grading/releases/release.py, no solutions to build every lab from).
+help: help-students $(if $(wildcard grading/releases/release.py),help-staff)
 .PHONY: help-students help-staff
 help-students:
 	@echo "For students"
@@ -285,9 +285,9 @@ grade:
 	$(PYTHON) -m grading.grade $(LAB) --trusted $(GRADE_ARGS)
 
 # The hand-in zip of lab LAB's skeleton files, for Gradescope and make grade-batch
-# (grading/handin.py).
+# (grading/releases/handin.py).
 handin:
-	@$(PYTHON) -m grading.handin $(LAB)
+	@$(PYTHON) -m grading.releases.handin $(LAB)
 
 golden: lab01-ref
 	$(PYTHON) -m tools.make_golden
