@@ -68,8 +68,8 @@ PHONY_EXTRA += lint format gpu-figures
 .DEFAULT_GOAL := help
 
 # The staff section only where its targets work: the course repository, not a release (which
-# has no grading/release.py, no solutions to build every lab from).
-help: help-students $(if $(wildcard grading/release.py),help-staff)
+# has no grading/releases/release.py, no solutions to build every lab from).
+help: help-students $(if $(wildcard grading/releases/release.py),help-staff)
 .PHONY: help-students help-staff
 help-students:
 	@echo "For students"
@@ -116,7 +116,7 @@ help-staff:
 	@echo "  make tradeoff-gpu OUT=DIR  on a GPU machine: make tradeoff's GPU rows (no plots)"
 	@echo "  make golden       regenerate the golden images in reference/ (minutes)"
 	@echo "  make skeletons    regenerate the skeletons from the solutions (check-skeletons: check)"
-	@echo "  make lint         ruff on the Python, clang-format --dry-run on the C++/CUDA (make test runs it)"
+	@echo "  make lint         ruff on the Python and its layers, clang-format --dry-run on the C++/CUDA (make test runs it)"
 	@echo "  make format       apply clang-format and ruff's fixes, then regenerate the skeletons"
 	@echo "  make labs         every binary of the course (needs the solutions)"
 	@echo "  make clean        remove build products"
@@ -243,14 +243,17 @@ skeletons:
 	$(PYTHON) -m labkit.skeletons
 
 # Style: ruff (pyproject.toml) on the Python, clang-format (.clang-format) on every tracked
-# C++/CUDA file, both at the versions of tools/requirements.txt (make deps). The skeletons are
+# C++/CUDA file, both at the versions of tools/requirements.txt (make deps); and the Python's
+# layers (tests/tools/test_python_layout.py: which package imports which, the grader's floors
+# and its top's size; files read only, a second or two). The skeletons are
 # generated from the solutions, so make format regenerates them after formatting.
 CLANG_FORMAT ?= $(PYTHON) -c 'import clang_format; clang_format.clang_format()'
 CXX_SOURCES = $(shell git ls-files '*.cpp' '*.h' '*.cu' '*.cuh')
 lint:
 	$(PYTHON) -m ruff check --quiet .
 	@$(CLANG_FORMAT) --dry-run --Werror $(CXX_SOURCES)
-	@echo "lint: ruff and clang-format find nothing to change"
+	$(PYTHON) -m pytest -qq -p no:cacheprovider tests/tools/test_python_layout.py
+	@echo "lint: ruff and clang-format find nothing to change; the Python keeps its layers"
 
 format:
 	$(PYTHON) -m ruff check --quiet --fix .
@@ -285,9 +288,9 @@ grade:
 	$(PYTHON) -m grading.grade $(LAB) --trusted $(GRADE_ARGS)
 
 # The hand-in zip of lab LAB's skeleton files, for Gradescope and make grade-batch
-# (grading/handin.py).
+# (grading/releases/handin.py).
 handin:
-	@$(PYTHON) -m grading.handin $(LAB)
+	@$(PYTHON) -m grading.releases.handin $(LAB)
 
 golden: lab01-ref
 	$(PYTHON) -m tools.make_golden

@@ -53,7 +53,7 @@ def build_in_sandbox(variant_lab: str, handin: pathlib.Path, target: str = "vari
     for a hand-in refused before compiling, else the compiler's output; `note` says which
     expected files the skeleton's stubs stood in for. `files` (already read from the hand-in)
     and `tree_lab` (the lab whose students' tree it is built in) build a part of a lab
-    (grading/part_a.py: lab 02's Part A, variant 02-simd-a, in lab 02's tree)."""
+    (grading/checks/part_a.py: lab 02's Part A, variant 02-simd-a, in lab 02's tree)."""
     try:
         files, missing = (files, []) if files is not None else \
             students_tree.collect(handin, variant_lab)

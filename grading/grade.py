@@ -20,20 +20,27 @@ import sys
 import time
 from typing import Callable
 
-from grading import (
-    checks,
+from grading import references, report_html
+from grading.checks import (
+    analytic,
+    check_result,
     draws,
     golden_sums,
     hidden,
+    identity,
+    invariance,
+    mpi,
     part_a,
-    race_checks,
-    references,
-    report_html,
+    races,
+    speed,
     symptoms,
 )
+from grading.checks.golden import check_golden
+from grading.checks.layout import check_structure_of_arrays
 from grading.results import Results, Test
 from labkit import gpu, registry, sandbox
 from labkit.harness import ROOT, RunPolicy, available_cores, policy, rerun_as
+from labkit.mpi import mpirun
 
 LAB01_REFERENCE = ROOT / "lab01-ref"
 LAB04_REFERENCE = ROOT / "lab04-ref"
@@ -48,7 +55,7 @@ class Item:
     id: str
     label: str
     points: int
-    run: Callable  # run(binary, **kwargs) -> checks.CheckResult
+    run: Callable  # run(binary, **kwargs) -> check_result.CheckResult
     heatmaps: bool = False  # run() takes heatmap_dir=: an image comparison
     requires: tuple[str, ...] = ()  # counted only once the items with these ids have passed
     # Runs even while a requirement fails (its points still wait for it): lab 03/04's bit
@@ -64,18 +71,18 @@ class Item:
 
 def golden(scene: str, points: int, **options) -> Item:
     return Item(f"golden-{scene}", f"golden image '{scene}'", points,
-                lambda b, **k: checks.check_golden(b, scene, **options, **k), heatmaps=True)
+                lambda b, **k: check_golden(b, scene, **options, **k), heatmaps=True)
 
 
 def bitwise(points: int, **options) -> Item:
     return Item("bitwise", "bit-identical to lab 01", points,
-                lambda b: checks.check_bitwise_equal(b, LAB01_REFERENCE, **options),
+                lambda b: identity.check_bitwise_equal(b, LAB01_REFERENCE, **options),
                 always_runs=True)
 
 
 def hidden_scene(**options) -> Item:
-    """A scene made from a secret at grading time (grading/hidden.py): worth no points itself,
-    but the golden images count only when it passes, so printing the stored golden images
+    """A scene made from a secret at grading time (grading/checks/hidden.py): worth no points
+    itself, but the golden images count only when it passes, so printing the stored golden images
     earns nothing."""
     return Item("hidden", "hidden scene", 0,
                 lambda b, secret, **k: hidden.check_hidden(b, LAB01_REFERENCE, secret,
@@ -85,7 +92,7 @@ def hidden_scene(**options) -> Item:
 
 def parallel_speedup(points: int, **options) -> Item:
     return Item("parallel-speedup", "parallel speedup", points,
-                lambda b: checks.check_parallel_speedup(b, LAB01_REFERENCE, **options))
+                lambda b: speed.check_parallel_speedup(b, LAB01_REFERENCE, **options))
 
 
 def worth(item: Item, points: int) -> Item:
@@ -97,16 +104,16 @@ def needs(item: Item, *ids: str) -> Item:
 
 
 SPHERE_INTERIOR = Item("sphere-interior", "analytic sphere interior", 0,
-                       checks.check_sphere_interior)
-LIT_PLANE = Item("lit-plane", "analytic lit plane", 0, checks.check_lit_plane)
-GLASS_PANE = Item("glass-pane", "analytic glass pane (Fresnel)", 0, checks.check_glass_slab)
+                       analytic.check_sphere_interior)
+LIT_PLANE = Item("lit-plane", "analytic lit plane", 0, analytic.check_lit_plane)
+GLASS_PANE = Item("glass-pane", "analytic glass pane (Fresnel)", 0, analytic.check_glass_slab)
 # Robustness counts only for a renderer that renders light: a flat-colour skeleton is
 # trivially scale-invariant.
-SCALE = Item("scale", "scale invariance 1e-4..1e5", 0, checks.check_scale_invariance,
+SCALE = Item("scale", "scale invariance 1e-4..1e5", 0, invariance.check_scale_invariance,
              requires="golden-cornell")
-REPRODUCIBLE = Item("reproducible", "reproducible", 0, checks.check_reproducible)
+REPRODUCIBLE = Item("reproducible", "reproducible", 0, invariance.check_reproducible)
 STRUCTURE_OF_ARRAYS = Item("structure-of-arrays", "path pool laid out as a structure of arrays", 10,
-                           checks.check_structure_of_arrays)
+                           check_structure_of_arrays)
 GOLDENS = ("golden-cornell", "golden-showcase")
 
 
@@ -120,7 +127,7 @@ def checked_golden(scene: str, points: int, **options) -> Item:
 # Their correctness checks are lab 01's, run on the student's GPU binary. Their speed is
 # compared with the lab's own reference (labNN-ref, built from labs/NN-*/solution) on the same
 # GPU in the same run, interleaved, best of 3, in wall-clock time the grader measures around
-# each process (checks.check_speedup). A GPU process spends about 0.3 s creating its CUDA
+# each process (speed.check_speedup). A GPU process spends about 0.3 s creating its CUDA
 # context and loading its kernels before any pixel is rendered, ten times the kernel time of
 # the baseline (handouts/05-cuda-mega.md, section 8), which would squash every ratio towards 1.
 # So the timed render is the golden Cornell view at GPU_TIMED_SCALE times its size (640x640,
@@ -148,9 +155,9 @@ def gpu_speed(lab: str, points: int) -> Item:
     """Speed against the lab's reference; counts only once both golden images pass."""
     reference = gpu_reference(lab)
     return Item("speed", f"speed >= {GPU_SPEED_BAR:g}x the lab {lab} reference", points,
-                lambda b: checks.check_speedup(b, reference, GPU_SPEED_BAR,
-                                               spp=GPU_TIMED_SPP[lab], scale=GPU_TIMED_SCALE,
-                                               overhead_reference=reference),
+                lambda b: speed.check_speedup(b, reference, GPU_SPEED_BAR,
+                                              spp=GPU_TIMED_SPP[lab], scale=GPU_TIMED_SCALE,
+                                              overhead_reference=reference),
                 requires=GOLDENS)
 
 
@@ -171,7 +178,7 @@ def gpu_rubric(lab: str, layout_lesson: bool = False) -> list[Item]:
 
 
 # Points per check, per kind of rubric (grading/README.md gives the formulas); each lab names
-# its rubric in labs/labs.toml. The checks are described in grading/checks.py. In labs 03 and
+# its rubric in labs/labs.toml. The checks are described in grading/checks/. In labs 03 and
 # 04 the point is parallelism: a correct serial renderer (lab 03's skeleton is one) earns
 # nothing there until its parallel speedup is shown, and the speedup counts only when the
 # timed images are lab 01's bits.
@@ -190,7 +197,7 @@ RUBRIC_KINDS: dict[str, Callable[[str], list[Item]]] = {
         # two-core machine in a short run, both sides on one CPU (the lesson is SIMD, not
         # threads). Speed counts only for a correct renderer.
         Item("speedup", "speedup >= 1.5x on one core", 30,
-             lambda b: checks.check_speedup(b, LAB01_REFERENCE, 1.5, one_core=True),
+             lambda b: speed.check_speedup(b, LAB01_REFERENCE, 1.5, one_core=True),
              requires=GOLDENS),
         Item("part-a", "Part A (./lab02a)", 20,
              lambda b, secret: part_a.check_part_a(b, secret, LAB01_REFERENCE), part="a"),
@@ -204,7 +211,7 @@ RUBRIC_KINDS: dict[str, Callable[[str], list[Item]]] = {
         # handout's bar, 0.9 x cores, is measured by tools/bench/openmp.py on a quiet machine.
         parallel_speedup(30),
         # The races no image shows: the hand-in built for ThreadSanitizer (its own binary).
-        Item("races", "no data race", 10, race_checks.check_races, requires="parallel-speedup",
+        Item("races", "no data race", 10, races.check_races, requires="parallel-speedup",
              part="race"),
     ],
     # Every task of the handout: the gather (the bits at 2, 3, 5 ranks), the interleaved and
@@ -213,20 +220,20 @@ RUBRIC_KINDS: dict[str, Callable[[str], list[Item]]] = {
     # and a rank's threads sharing its work, which no image shows either).
     "mpi": lambda lab: [
         needs(bitwise(20, runs={
-            **{f"{n} ranks": {"launcher": checks.mpirun(n), "threads": 1} for n in (1, 2, 3, 5)},
-            **{f"3 ranks {d}": {"launcher": checks.mpirun(3, d), "threads": 1}
-               for d in checks.DISTRIBUTIONS if d != "dynamic"},
-            "2 ranks x 2 threads": {"launcher": checks.mpirun(2), "threads": 2}}),
+            **{f"{n} ranks": {"launcher": mpirun(n), "threads": 1} for n in (1, 2, 3, 5)},
+            **{f"3 ranks {d}": {"launcher": mpirun(3, d), "threads": 1}
+               for d in mpi.DISTRIBUTIONS if d != "dynamic"},
+            "2 ranks x 2 threads": {"launcher": mpirun(2), "threads": 2}}),
             "parallel-speedup"),
-        Item("distributions", "rows per distribution", 20, checks.check_distributions,
+        Item("distributions", "rows per distribution", 20, mpi.check_distributions,
              requires=("bitwise",)),
-        Item("hybrid", "hybrid threads", 10, checks.check_hybrid_threads, requires=("bitwise",)),
-        hidden_scene(launcher=checks.mpirun(2), threads=1),
-        needs(checked_golden("cornell", 15, launcher=checks.mpirun(2)), "parallel-speedup"),
-        needs(checked_golden("showcase", 10, launcher=checks.mpirun(2)), "parallel-speedup"),
+        Item("hybrid", "hybrid threads", 10, mpi.check_hybrid_threads, requires=("bitwise",)),
+        hidden_scene(launcher=mpirun(2), threads=1),
+        needs(checked_golden("cornell", 15, launcher=mpirun(2)), "parallel-speedup"),
+        needs(checked_golden("showcase", 10, launcher=mpirun(2)), "parallel-speedup"),
         # 2048 spp: mpirun's start-up, whose CPU time counts in the cores a run used, must be
         # small beside the render, or a parallel reference reads as serial.
-        parallel_speedup(25, threads=1, launcher=checks.mpirun(available_cores()),
+        parallel_speedup(25, threads=1, launcher=mpirun(available_cores()),
                          overhead_reference=LAB04_REFERENCE, spp=2048),
     ],
     "gpu": gpu_rubric,
@@ -357,7 +364,7 @@ def grade_items(rubric, binary, heatmap_dir, secret, results, run_policy, limits
             with policy(dataclasses.replace(run_policy, limits=limits)):
                 result = run_check(item, target, heatmap_dir, secret)
             if not result.passed and reference_problem and (why := reference_problem()):
-                result = checks.CheckResult(item.label, False, why, regrade=True)
+                result = check_result.CheckResult(item.label, False, why, regrade=True)
             credit = result.credit if result.credit is not None else float(result.passed)
             if waiting:  # it ran, and says what it saw; its points wait for the gate
                 mark = "" if result.detail.startswith(("PASS", "FAIL")) else \
@@ -467,14 +474,14 @@ def gpu_problem(lab: str, run_policy: RunPolicy) -> str | None:
     return None
 
 
-def run_check(item: Item, binary, heatmap_dir, secret: str = "") -> checks.CheckResult:
+def run_check(item: Item, binary, heatmap_dir, secret: str = "") -> check_result.CheckResult:
     kwargs = {"heatmap_dir": heatmap_dir} if item.heatmaps else {}
     if item.id in ("hidden", "part-a"):
         kwargs["secret"] = secret
     try:
         result = item.run(binary, **kwargs)
     except Exception as e:  # a crash, a timeout, a missing image: no points, say why
-        return checks.CheckResult(item.label, False, f"could not run: {e}")
+        return check_result.CheckResult(item.label, False, f"could not run: {e}")
     if heatmap_dir:  # the images the page shows beside the check (grading/report_html.py)
         for scene, (yours, want) in result.images.items():
             report_html.write_images(heatmap_dir, scene, yours, want)
@@ -596,7 +603,7 @@ def build_lab(lab: str, sources: pathlib.Path | None = None, trusted: bool = Tru
 
 
 def part_a_binary(a, results: Results) -> pathlib.Path | str:
-    """Lab 02's Part A binary for this grade (grading/part_a.py), or why there is none."""
+    """Lab 02's Part A binary for this grade (grading/checks/part_a.py), or why there is none."""
     if a.binary:
         if a.part_a and pathlib.Path(a.part_a).is_file():
             return pathlib.Path(a.part_a).resolve()
@@ -613,14 +620,14 @@ def part_a_binary(a, results: Results) -> pathlib.Path | str:
 
 
 def race_binary(a, results: Results) -> pathlib.Path | str:
-    """Lab 03's ThreadSanitizer build for this grade (grading/race_checks.py), or why there is
+    """Lab 03's ThreadSanitizer build for this grade (grading/checks/races.py), or why there is
     none."""
     if a.binary:
         if a.race_binary and pathlib.Path(a.race_binary).is_file():
             return pathlib.Path(a.race_binary).resolve()
         return "no ThreadSanitizer build was given (--race-binary BINARY)"
-    binary, errors = race_checks.build(registry.lab(a.lab).folder,
-                                       pathlib.Path(a.sources) if a.sources else None, a.trusted)
+    binary, errors = races.build(registry.lab(a.lab).folder,
+                                 pathlib.Path(a.sources) if a.sources else None, a.trusted)
     if binary is None:
         return errors.removeprefix("refused: ") if errors.startswith("refused: ") else \
             f"the ThreadSanitizer build (clang++) does not compile: {first_errors(errors, 5)}"
@@ -702,7 +709,7 @@ def main(argv=None) -> int:
         parts = {}
         if part_a.has_part_a(a.lab):
             parts["a"] = part_a_binary(a, results)
-        if registry.lab(a.lab).rubric in race_checks.RUBRICS:
+        if registry.lab(a.lab).rubric in races.RUBRICS:
             parts["race"] = race_binary(a, results)
         heatmaps = pathlib.Path(a.heatmaps)
         clear_report(heatmaps)

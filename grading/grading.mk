@@ -5,7 +5,7 @@
 
 # make gradescope LAB=NN: the Gradescope autograder zip for lab NN in build/.
 gradescope:
-	$(PYTHON) -m grading.gradescope $(LAB)
+	$(PYTHON) -m grading.releases.gradescope $(LAB)
 
 # make grade-batch LAB=NN SUBMISSIONS=DIR [REPORT=DIR] [ONLY=flagged]: one folder or hand-in
 # zip per student, graded in the sandbox; REPORT (default grades/) gets each results.json,
@@ -13,19 +13,19 @@ gradescope:
 # its saved secret.
 grade-batch:
 	@test -n "$(SUBMISSIONS)" || { echo "grade-batch: needs SUBMISSIONS=DIR" >&2; exit 2; }
-	@$(PYTHON) -m grading.batch $(LAB) $(SUBMISSIONS) --out $(or $(REPORT),grades) \
+	@$(PYTHON) -m grading.classes.batch $(LAB) $(SUBMISSIONS) --out $(or $(REPORT),grades) \
 	    $(if $(ONLY),--only $(ONLY))
 
-# make release LAB=NN OUT=DIR: the student repository for lab NN (grading/release.py). LAB and
+# make release LAB=NN OUT=DIR: the student repository for lab NN (grading/releases/release.py). LAB and
 # OUT have defaults in the Makefiles (for make grade, make gpu-check); a release must name both.
 release:
 	@test "$(origin LAB)" != file -a "$(origin OUT)" != file -a -n "$(OUT)" || \
 	    { echo "release: needs LAB=NN and OUT=DIR" >&2; exit 2; }
-	@test -f grading/release.py || \
+	@test -f grading/releases/release.py || \
 	    { echo "release: made from the course repository; this is a release" >&2; exit 2; }
 	@$(PYTHON) -c 'import numpy' 2>/dev/null || \
 	    { echo "release: $(PYTHON) has no numpy: run make deps first (it installs what the grader needs)" >&2; exit 2; }
-	@$(PYTHON) -m grading.release '$(LAB)' '$(OUT)'
+	@$(PYTHON) -m grading.releases.release '$(LAB)' '$(OUT)'
 
 # The driver objects a variant of VARIANT_LAB links, and nothing else: the grader builds them
 # in a students' tree (grading/students_tree.py) before compiling a submission there.
@@ -33,7 +33,7 @@ release:
 variant-driver: $(VARIANT_DRIVER_$(VARIANT_LAB))
 cuda-variant-driver: $(COMMON_OBJ)
 
-# ThreadSanitizer builds, for lab 03's race check (grading/race_checks.py): LLVM's clang and
+# ThreadSanitizer builds, for lab 03's race check (grading/checks/races.py): LLVM's clang and
 # OpenMP runtime, whose Archer tool tells ThreadSanitizer what OpenMP's barriers and loops
 # order (GCC's libgomp tells it nothing, and every barrier would read as a race). The lab's
 # own files at -O0, so that a variable its threads share is read and written in memory as the
@@ -60,18 +60,17 @@ lab03-race: $(RACE_DRIVER) $(wildcard $(LAB03)/skeleton/*.cpp $(LAB03)/skeleton/
 
 # make test-gradescope: the lab-01 Gradescope bundle built into a Docker image on a debootstrap
 # Debian base and graded in containers with Docker's default seccomp at 0.5 CPU and 768 MB
-# (grading/gradescope/test_gradescope.py). Needs Docker and debootstrap; not part of make test.
-# A script beside grading/gradescope.py (a module of the same name), so it is run by path,
-# with the repository on the import path.
+# (grading/releases/gradescope_image/test_gradescope.py). Needs Docker and debootstrap; not part
+# of make test. A script beside its Dockerfile, run by path with the repository on the import path.
 .PHONY: test-gradescope
 test-gradescope:
-	PYTHONPATH=$(CURDIR) $(PYTHON) grading/gradescope/test_gradescope.py
+	PYTHONPATH=$(CURDIR) $(PYTHON) grading/releases/gradescope_image/test_gradescope.py
 # make grade-slurm LAB=NN SUBMISSIONS=DIR [REPORT=DIR] [PARTITION=P] [TIME=H:MM:SS] [MEM=4G]
 # [ONLY=flagged]: the same as a Slurm job array, one task per submission, and a merge job for
-# grades.csv and report.html (grading/slurm.py, which says its defaults); the tasks run
+# grades.csv and report.html (grading/classes/slurm.py, which says its defaults); the tasks run
 # $(PYTHON) by name. ONLY=flagged submits the tasks of the students REPORT flagged.
 grade-slurm:
 	@test -n "$(SUBMISSIONS)" || { echo "grade-slurm: needs SUBMISSIONS=DIR" >&2; exit 2; }
-	@$(PYTHON) -m grading.slurm $(LAB) $(SUBMISSIONS) --out $(or $(REPORT),grades) \
+	@$(PYTHON) -m grading.classes.slurm $(LAB) $(SUBMISSIONS) --out $(or $(REPORT),grades) \
 	    --python $(PYTHON) $(if $(PARTITION),--partition $(PARTITION)) \
 	    $(if $(TIME),--time $(TIME)) $(if $(MEM),--mem $(MEM)) $(if $(ONLY),--only $(ONLY))

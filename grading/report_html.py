@@ -1,5 +1,5 @@
 """One submission's grade as a page an instructor (or a student at home) looks at: the score
-table with what each check saw (the named symptoms included: grading/symptoms.py), and for
+table with what each check saw (the named symptoms included: grading/checks/symptoms.py), and for
 each golden scene the submission's image, the golden image and, where the comparison failed,
 the diff heatmap, side by side. Written next to the images, as `report.html` in the folder
 the grader was given for heatmaps (`--heatmaps`; `make grade-batch` gives each student one).

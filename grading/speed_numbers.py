@@ -1,12 +1,12 @@
 """The numbers of a grade's speed check, read back from its results.json: the grader's
-times, the speedup and the capacity. grades.csv (grading/batch.py) and Gradescope's
+times, the speedup and the capacity. grades.csv (grading/classes/batch.py) and Gradescope's
 leaderboard (grading/results.py) show them."""
 from __future__ import annotations
 
 import re
 
 SPEED_CHECKS = ("parallel-speedup", "speedup", "speed")
-# What the speed checks print (grading/speed_checks.py): "... 1.85x over the serial reference
+# What the speed checks print (grading/checks/speed.py): "... 1.85x over the serial reference
 # (0.600 s -> 0.324 s) on 2 cores giving 1.98x capacity ..." and "1.62x (0.412 s -> 0.254 s
 # wall clock ...)". Structured numbers in a test's extra_data, where the grader gives them,
 # come first.

@@ -9,7 +9,7 @@ build/ are the references'. So a submission is compiled in a students' tree made
   labkit/registry.py, which the Makefile reads), every lab's lab.mk and top-level files (the
   drivers a lab links), and common/ with every shared file whose solution regions belong to
   this lab or a later one in its skeleton form (what a student release holds:
-  grading/release.py); an earlier lab's shared files stay solutions (lab 07 builds on lab
+  grading/releases/release.py); an earlier lab's shared files stay solutions (lab 07 builds on lab
   06's reference queue and stage loop in common/wavefront/);
 - in its own build/, the driver objects compiled from those files, by the grader, outside the
   sandbox (course code), once per content: cached under build/students-trees/ and copied for
@@ -63,8 +63,8 @@ def lab_number(lab_folder: str) -> str:
 
 def skeleton_form(lab_folder: str) -> set[str]:
     """Shared files (paths from the root) that a student of `lab_folder` holds as skeletons:
-    those of this lab and of every later one, as in a release (grading/release.py). Empty in
-    a release, whose shared files are skeletons already."""
+    those of this lab and of every later one, as in a release (grading/releases/release.py).
+    Empty in a release, whose shared files are skeletons already."""
     skeletons = _skeletons()
     if skeletons is None:
         return set()

@@ -84,7 +84,7 @@ Assumptions, and what happens when they are violated
 
 Small blocks and pooled variance
 --------------------------------
-A small image with small features (grading/hidden.py's 32x32 scene, whose turned panel and
+A small image with small features (grading/checks/hidden.py's 32x32 scene, whose turned panel and
 triangle cover a few pixels each) needs 4x4 blocks: a renderer that misses one of them moves
 a few pixels far, which 8x8 blocks dilute (over 26 secrets with a lighter panel and a smaller
 triangle, lab 01's closest hit without convex quads reached the 8x8/16x16 limit in 20, with
@@ -126,7 +126,7 @@ when that mean exceeds ``CHI_MEAN_MAX`` or the median falls below ``CHI_MEDIAN_M
 Measured on lab 01's reference at 64 spp against the stored golden data (6 seeds each): mean
 1.00-1.07 (cornell) and 0.95-1.10 (showcase), median 0.45-0.49; at 16 spp mean 4.0-4.2; blurred
 over 3x3 pixels median 0.10-0.18; flattened into 8x8 blocks mean 36-149 (uncapped).  On the
-hidden scene (grading/hidden.py, with its glass and mirror balls, turned panel and triangle;
+hidden scene (grading/checks/hidden.py, with its glass and mirror balls, turned panel and triangle;
 lab 01's reference on an Intel Xeon): capped mean 0.96-1.22, median 0.32-0.55 (200 secrets);
 at 16 spp capped mean 2.5-4.0, blurred over 3x3 pixels 3.8-7.7, both failing in 20 of 20.
 With a lighter panel and a smaller triangle (150 secrets) the uncapped mean reached 1.42 (up

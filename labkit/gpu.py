@@ -109,7 +109,7 @@ def gpu_minor_numbers(proc: str = "/proc/driver/nvidia/gpus") -> dict[str, str]:
 
 def assigned_node(environment=None, minors=None) -> str | None:
     """The device node of the one GPU this grader was given, or None (then every GPU's node is
-    shown). grading/batch.py gives each grader one GPU as CUDA_VISIBLE_DEVICES=<nvidia-smi
+    shown). grading/classes/batch.py gives each grader one GPU as CUDA_VISIBLE_DEVICES=<nvidia-smi
     index> with CUDA_DEVICE_ORDER=PCI_BUS_ID (so CUDA counts as nvidia-smi does). The sandbox
     clears the environment, so the assignment reaches a sandboxed program as the one node it
     shows: CUDA then finds that GPU only, as in a container given one GPU."""

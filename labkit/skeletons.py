@@ -24,7 +24,7 @@ file.
 
 The grader and the release tools import it (labkit/, not tools/): both need the markers and
 SHARED_SOURCES, and the grader imports nothing from tools/. A student release ships neither it
-nor the solutions it reads (grading/leaks.py).
+nor the solutions it reads (grading/releases/leaks.py).
 """
 import argparse
 import pathlib

@@ -1,5 +1,5 @@
 """The numerical-stability suite at the extremes, measured in float and in double: each case
-of the render-level suite (the checks of grading/checks.py and tests/labs/test_extremes.py),
+of the render-level suite (the checks of grading/checks/ and tests/labs/test_extremes.py),
 run with lab01-ref's renderer in float and with lab01-ref-double, with its property, its
 tolerance and what each build measured; printed as the Markdown table of docs/extremes.md.
 
@@ -14,7 +14,7 @@ import re
 import sys
 import tempfile
 
-from grading import checks
+from grading.checks import analytic, invariance
 from labkit import scenes
 from labkit.harness import build, run_lab
 from labkit.variants import build_sources, lab_sources
@@ -74,19 +74,19 @@ def nonfinite(binary):
 # case, property, tolerance, measurement
 CASES = [
     ("camera inside a sphere", "the zero-variance sphere interior equals its closed form at 1, 2 "
-     "and 4 bounces", "relative error < 3e-4", from_check(checks.check_sphere_interior)),
+     "and 4 bounces", "relative error < 3e-4", from_check(analytic.check_sphere_interior)),
     ("millions of samples", "the mean at 2^22 spp equals the mean at 2^12 spp (zero variance)",
-     "< 1e-5", from_check(checks.check_million_samples)),
+     "< 1e-5", from_check(analytic.check_million_samples)),
     ("light near a surface, per pixel", "a lit floor equals the per-pixel integral of its closed "
-     "form", "mean 3e-3, max 2e-2", from_check(checks.check_lit_plane)),
+     "form", "mean 3e-3, max 2e-2", from_check(analytic.check_lit_plane)),
     ("glass pane", "Fresnel reflectance at normal incidence through a pane", "mean within 5%",
-     from_check(checks.check_glass_slab)),
+     from_check(analytic.check_glass_slab)),
     ("scale", "the Cornell box scaled 1e-4 .. 1e5 renders as at scale 1",
-     "the scale check's", from_check(checks.check_scale_invariance)),
+     "the scale check's", from_check(invariance.check_scale_invariance)),
     ("far from the origin", "sphere interior and lit floor moved 1e4 times their size",
-     "2e-3; 1.5e-2 mean", from_check(checks.check_translation_invariance)),
+     "2e-3; 1.5e-2 mean", from_check(invariance.check_translation_invariance)),
     ("huge next to small", "floors (quad, sphere) of half-size up to 1e5 seen from 1 unit",
-     "mean 1.5e-2", from_check(checks.check_large_primitives)),
+     "mean 1.5e-2", from_check(invariance.check_large_primitives)),
     ("the loader's range", "every scale 1e-14 .. 1e14 renders as scale 1, or is refused in one "
      "line; none renders wrong", "mean within 1%", every_scale),
     ("NaN and Inf", "never reach the image", "0", nonfinite),

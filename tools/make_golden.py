@@ -21,7 +21,7 @@ import tempfile
 
 import numpy as np
 
-from grading import golden_sums
+from grading.checks import golden_sums
 from labkit.harness import run_lab
 from labkit.pfm import write_pfm
 
@@ -80,7 +80,8 @@ def main() -> int:
     args = parser.parse_args()
     for scene in args.scene or sorted(GOLDEN_SCENES):
         make_golden(scene, pathlib.Path(args.binary))
-    # The grader refuses golden data that does not match this record (grading/golden_sums.py).
+    # The grader refuses golden data that does not match this record
+    # (grading/checks/golden_sums.py).
     golden_sums.RECORD.write_text(golden_sums.record())
     print(f"checksums -> {golden_sums.RECORD.relative_to(ROOT)}")
     return 0

@@ -10,7 +10,7 @@ import dataclasses
 import pathlib
 import subprocess
 
-from grading.leaks import skeletons
+from grading.releases.leaks import skeletons
 from labkit.harness import ROOT
 from labkit.variants import lab_sources
 

@@ -6,7 +6,7 @@ import math
 import numpy as np
 import pytest
 
-from grading import checks
+from grading.checks import analytic
 from labkit import scenes
 from labkit.harness import build
 
@@ -54,5 +54,5 @@ def test_oblique_pane_is_told_from_schlick():
 
 def test_reference_matches_the_glass_pane_head_on_and_oblique():
     reference, = build("lab01-ref")
-    result = checks.check_glass_slab(reference)
+    result = analytic.check_glass_slab(reference)
     assert result.passed, result.detail

@@ -1,4 +1,4 @@
-"""`make grade-batch` for instructors (grading/batch.py): grades.csv carries per student the
+"""`make grade-batch` for instructors (grading/classes/batch.py): grades.csv carries per student the
 points, provisional points apart, times, speedup, capacity and the cause of a failure, then
 a class row with the flagged count; progress is `[k/N] name ...`; hand-in zips are graded
 as folders; ONLY=flagged regrades only the flagged, with the batch's saved secret, and
@@ -10,7 +10,7 @@ import zipfile
 
 import pytest
 
-from grading import batch
+from grading.classes import batch
 
 
 def result_test(check, name, score, max_score, output, passed=None, regrade=False,
@@ -224,7 +224,7 @@ def test_a_gpu_lab_grades_one_submission_per_gpu_at_once(tmp_path, monkeypatch):
 
 
 def test_a_race_and_a_work_split_are_told_apart():
-    """The bit check's two diagnoses (grading/identity_checks.py) are two causes in grades.csv."""
+    """The bit check's two diagnoses (grading/checks/identity.py) are two causes in grades.csv."""
     def failed(output):
         return {"score": 40, "tests": [{"name": "bit for bit", "score": 0, "max_score": 20,
                                         "output": output}]}
@@ -289,11 +289,11 @@ def test_the_cause_is_the_failing_gates_verdict_not_a_check_that_passed():
 def test_a_timed_serial_verdict_shows_its_numbers():
     """A serial program whose runs were timed: the verdict keeps the times, speedup and
     capacity measured, and the class page reads them beside it."""
-    from grading import checks
+    from grading.checks import speed
     from labkit.harness import ParallelTiming
     timing = ParallelTiming(base=0.6, best={"yours": 0.61}, capacity=1.96, cores=2)
-    verdict = checks.serial_by_thread([0.99, 0.98], "1.01 cores' worth at most, on a machine "
-                                      "giving 1.96", timing.describe("yours"))
+    verdict = speed.serial_by_thread([0.99, 0.98], "1.01 cores' worth at most, on a machine "
+                                     "giving 1.96", timing.describe("yours"))
     results = {"tests": [result_test("parallel-speedup", "parallel speedup", 0, 40,
                                      verdict.detail)]}
     assert batch.speed_numbers(results) == {"reference_s": "0.600", "yours_s": "0.610",
@@ -327,7 +327,7 @@ def test_the_class_page_names_links_sorts_plots_and_says_a_shared_note_once(tmp_
 
 
 def test_a_cause_is_cut_between_words():
-    from grading.verdicts import clipped
+    from grading.classes.verdicts import clipped
     text = "the timed render differs from the serial reference " * 10
     cut = clipped(text, 60)
     assert len(cut) <= 60 and cut.endswith("…") and text.startswith(cut[:-1])

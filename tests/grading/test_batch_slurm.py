@@ -1,4 +1,4 @@
-"""A class graded as a Slurm job array (grading/slurm.py) on a one-node Slurm that this test
+"""A class graded as a Slurm job array (grading/classes/slurm.py) on a one-node Slurm that this test
 starts: its own munge daemon and key, slurmctld and slurmd on free ports, all in a scratch
 folder (Debian's slurm-wlm and munge packages). Two lab-01 hand-ins, one finished and one that
 does not compile, are graded one per array task in the sandbox; the merge job writes
@@ -144,14 +144,14 @@ def test_a_class_graded_as_a_job_array(tmp_path, slurm):
 
 
 def test_the_scripts_say_what_they_ask_and_call_python_by_name(tmp_path):
-    from grading import slurm
+    from grading.classes import slurm
     array, merge = slurm.scripts("03", tmp_path / "subs", tmp_path / "out", 4, "gpu", None,
                                  "00:45:00", "8G", "python3")
     for script in (array, merge):
         assert "#SBATCH --time=00:45:00" in script and "#SBATCH --mem=8G" in script
         assert "#SBATCH --partition=gpu" in script
-        command = next(line for line in script.splitlines() if "-m grading.batch" in line)
-        assert command.startswith("python3 -m grading.batch"), command
+        command = next(line for line in script.splitlines() if "-m grading.classes.batch" in line)
+        assert command.startswith("python3 -m grading.classes.batch"), command
     default = slurm.scripts("03", tmp_path / "subs", tmp_path / "out", 4, None, None)[0]
     assert f"--time={slurm.DEFAULT_TIME}" in default and f"--mem={slurm.DEFAULT_MEM}" in default
 
@@ -174,7 +174,7 @@ def test_only_flagged_submits_the_flagged_students_tasks(tmp_path, capsys):
     holds the tasks of the students the report flagged or never graded, no others."""
     import json
 
-    from grading import batch, slurm
+    from grading.classes import batch, slurm
     subs, report = tmp_path / "subs", tmp_path / "report"
     for student in ("ann", "ben", "cy"):
         (subs / student).mkdir(parents=True)

@@ -1,5 +1,5 @@
-"""Grading a class (grading/batch.py) and the Gradescope bundle (grading/gradescope.py), run
-in a scratch /autograder layout."""
+"""Grading a class (grading/classes/batch.py) and the Gradescope bundle
+(grading/releases/gradescope.py), run in a scratch /autograder layout."""
 import csv
 import json
 import os
@@ -35,7 +35,7 @@ def test_batch_grades_each_student_into_csv_and_html(tmp_path):
     sub.exec_reference(subs / "bob")          # a program only: never run, nothing to build
     (subs / "carol" / "render.cpp").write_text("int broken( {\n")  # does not compile
     report = tmp_path / "report"
-    p = subprocess.run([sys.executable, "-m", "grading.batch", "01", str(subs), "--out",
+    p = subprocess.run([sys.executable, "-m", "grading.classes.batch", "01", str(subs), "--out",
                         str(report)], cwd=ROOT, capture_output=True, text=True, timeout=600)
     assert p.returncode == 0, p.stdout + p.stderr
     rows = {r["student"]: r for r in csv.DictReader((report / "grades.csv").open())}
@@ -53,7 +53,7 @@ def test_gradescope_bundle_grades_a_submission(tmp_path, request):
     student's render.cpp and path_tracer.h: 100 points in /autograder/results/results.json.
     The render.cpp alone is built against the skeleton's path_tracer.h (the students' tree),
     as a student's own would be, and scores what the skeleton scores."""
-    from grading.gradescope import bundle
+    from grading.releases.gradescope import bundle
     # Gradescope's /autograder is open to all; pytest's tmp_path is not (0700 above it), and
     # the sandboxed build runs as an unprivileged user that must read the unpacked tree.
     scratch = pathlib.Path(tempfile.mkdtemp(prefix="autograder-test-"))
@@ -95,7 +95,7 @@ def test_gradescope_bundle_grades_a_submission(tmp_path, request):
 def test_gradescope_bundle_says_its_settings(tmp_path, capsys):
     """`make gradescope` prints, and the zip's own README.md carries at its top, what to choose
     on Gradescope: labs 03 and 04 need 2 CPUs, and the default's consequence is said."""
-    from grading import gradescope
+    from grading.releases import gradescope
     assert gradescope.main(["03", "--out", str(tmp_path / "lab03.zip")]) == 0
     printed = capsys.readouterr().out
     with zipfile.ZipFile(tmp_path / "lab03.zip") as z:

@@ -1,10 +1,10 @@
 """Every diagnostic, and only true ones: lab 01 built with the classic mistakes in its source
 (one bounce too many or too few, the diffuse BRDF without its 1/pi) and lab 03 with a racy
 or a split-dependent loop, each graded and told exactly its mistake by the check that
-identifies it (grading/symptoms.py, checks.check_bitwise_equal), and never another's."""
+identifies it (grading/checks/symptoms.py, identity.check_bitwise_equal), and never another's."""
 import pytest
 
-from grading import checks, draws
+from grading.checks import draws, identity
 from grading.grade import LAB01_REFERENCE, describe, grade
 from labkit.harness import ROOT, build
 from labkit.variants import build_variant
@@ -80,7 +80,7 @@ def reference_bits():
 def test_a_racy_lab03_is_told_nondeterministic_with_rows(variant, reference_bits):
     binary = build(variant)[0]
     with draws.secret("diagnostics"):
-        result = checks.check_bitwise_equal(binary, LAB01_REFERENCE)
+        result = identity.check_bitwise_equal(binary, LAB01_REFERENCE)
     assert not result.passed, result
     assert "nondeterministic: a data race or shared generator" in result.detail, result
     assert "rows " in result.detail and "work split" not in result.detail, result
@@ -103,7 +103,7 @@ shift "$n"
 exec ./ref "$@"
 """, reference=lab01_ref)
     with draws.secret("diagnostics"):
-        result = checks.check_bitwise_equal(wrapper, LAB01_REFERENCE)
+        result = identity.check_bitwise_equal(wrapper, LAB01_REFERENCE)
     assert not result.passed, result
     assert "deterministic but different: work split" in result.detail, result
     assert "2 threads, 3 threads, 7 threads" in result.detail, result

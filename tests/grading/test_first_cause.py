@@ -3,7 +3,9 @@ can rerun at home: an MPI error by name with mpirun's own text, a deadlock as a 
 for a message, lab 04's missing gather as rows never gathered (not as a work split)."""
 import pytest
 
-from grading import checks, draws, grade, symptoms
+from grading import grade
+from grading.checks import draws, symptoms
+from grading.checks.golden import check_golden
 from labkit.harness import (
     ROOT,
     RunError,
@@ -15,6 +17,7 @@ from labkit.harness import (
     rerun_as,
     run_lab,
 )
+from labkit.mpi import mpirun
 from labkit.sandbox import Limits
 from labkit.variants import build_pristine_skeleton, build_variant, lab_sources
 
@@ -43,7 +46,7 @@ def test_an_mpi_type_mismatch_is_named_with_a_command_to_rerun(tmp_path):
     # rank's stderr first (mpi_main.cpp), so it is named every time, in one run.
     with policy(UNTRUSTED), rerun_as("./lab04"), pytest.raises(RunError) as failed:
         run_lab(mutant, scene=ROOT / "common/scenes/cornell.json", width=16, height=12,
-                spp=2, launcher=checks.mpirun(2))
+                spp=2, launcher=mpirun(2))
     message = str(failed.value)
     assert "MPI_ERR_TRUNCATE" in message.split("; rerun: ")[0], message  # named first
     assert "An error occurred in MPI_Recv" in message  # the rank's own words reach the student
@@ -68,7 +71,7 @@ def test_a_check_on_a_scene_made_for_it_names_a_scene_that_exists(tmp_path):
 
 
 def test_a_deadlock_is_a_rank_waiting_for_a_message():
-    message = failure_message("timed out after 20 s", "", checks.mpirun(2), "mpirun ./lab04")
+    message = failure_message("timed out after 20 s", "", mpirun(2), "mpirun ./lab04")
     assert "a rank waits for a message that never comes" in message
 
 
@@ -100,7 +103,7 @@ def test_a_wrong_lane_mask_in_lab02_is_named_by_its_kind_before_the_statistics(t
         source = source.replace(old, new)
     mutant = build_variant("02-simd", tmp_path, {"packet_tracer.h": source})
     with draws.secret("lanes"), symptoms.grading("02"), policy(UNTRUSTED), rerun_as("./lab02"):
-        result = checks.check_golden(mutant, "showcase")
+        result = check_golden(mutant, "showcase")
     assert not result.passed
     cause = result.detail.split("; ", 1)[0]
     assert cause.startswith("lanes: ") and "lane mask" in cause, result.detail

@@ -1,11 +1,11 @@
-"""The golden data's checksums (grading/golden_sums.py): the committed record matches the
+"""The golden data's checksums (grading/checks/golden_sums.py): the committed record matches the
 committed data, a changed byte or a missing record is found and named, and the grader then
 refuses to grade, with the reason, marked for regrade."""
 import shutil
 
 import pytest
 
-from grading import golden_sums
+from grading.checks import golden_sums
 from grading.grade import grade
 from labkit.harness import GOLDEN, ROOT
 

@@ -26,7 +26,8 @@ import sys
 
 import pytest
 
-from grading import checks
+from grading.checks import analytic, check_result, speed
+from grading.checks.layout import check_structure_of_arrays
 from grading.grade import (
     GOLDENS,
     GPU_TIMED_SCALE,
@@ -91,11 +92,11 @@ def test_speed_is_measured_against_the_labs_own_reference(lab, monkeypatch):
 
     def fake_speedup(binary, baseline, min_speedup, **options):
         seen.update(binary=binary, baseline=baseline, bar=min_speedup, **options)
-        return checks.CheckResult("speedup", True, "")
+        return check_result.CheckResult("speedup", True, "")
 
-    monkeypatch.setattr(checks, "check_speedup", fake_speedup)
-    speed = next(i for i in RUBRICS[lab] if i.id == "speed")
-    speed.run("student-binary")
+    monkeypatch.setattr(speed, "check_speedup", fake_speedup)
+    item = next(i for i in RUBRICS[lab] if i.id == "speed")
+    item.run("student-binary")
     assert seen["binary"] == "student-binary"
     assert seen["baseline"] == seen["overhead_reference"] == ROOT / f"lab{lab}-ref"
     assert seen["scale"] == GPU_TIMED_SCALE >= 8 and 0 < seen["bar"] < 1
@@ -241,7 +242,7 @@ def test_gpu_binds_are_built_from_what_exists(tmp_path):
         "--ro-bind", str(from_env), str(from_env),
         "--ro-bind", str(with_driver), str(with_driver),
         "--setenv", "LD_LIBRARY_PATH", f"{from_env}:{with_driver}"]
-    # A grader given one GPU (grading/batch.py) shows that GPU's node only, found by its
+    # A grader given one GPU (grading/classes/batch.py) shows that GPU's node only, found by its
     # minor number, with the nodes all GPUs share; an index nvidia-smi does not list shows all.
     one = gpu.sandbox_args(dev=str(dev), libs=[], sysfs=(),
                            only=gpu.assigned_node({"CUDA_VISIBLE_DEVICES": "1"}, {"1": "0"}))
@@ -373,17 +374,17 @@ def altered_reference(folder: pathlib.Path, change: str) -> pathlib.Path:
 
 
 def test_black_pixels_are_named(tmp_path):
-    result = checks.check_sphere_interior(altered_reference(tmp_path, "image * 0"))
+    result = analytic.check_sphere_interior(altered_reference(tmp_path, "image * 0"))
     assert not result.passed
     assert "256 of 256 pixels are exactly black" in result.detail, result.detail
     assert "copied back before the kernel had written them" in result.detail
 
 
 def test_swapped_x_and_y_are_named(tmp_path):
-    result = checks.check_lit_plane(altered_reference(tmp_path, "image.transpose(1, 0, 2)"))
+    result = analytic.check_lit_plane(altered_reference(tmp_path, "image.transpose(1, 0, 2)"))
     assert not result.passed
     assert "right with x and y swapped" in result.detail, result.detail
-    right = checks.check_lit_plane(build("lab01-ref")[0])
+    right = analytic.check_lit_plane(build("lab01-ref")[0])
     assert right.passed and "swapped" not in right.detail, right.detail
 
 
@@ -416,7 +417,7 @@ def test_the_layout_check_reads_the_probe(tmp_path, layout, passes, says):
     """Lab 07's layout check on stand-ins reporting each kind of probe result: only a
     structure of arrays passes, and a pool that stores nothing, or a program that does not
     say, fails with a reason."""
-    result = checks.check_structure_of_arrays(reporting_layout(tmp_path, layout))
+    result = check_structure_of_arrays(reporting_layout(tmp_path, layout))
     assert result.passed == passes and says in result.detail, result.detail
 
 
@@ -428,9 +429,9 @@ def test_a_timed_render_is_checked_at_the_golden_size():
     from labkit.harness import golden
     g = golden("cornell")
     big = np.kron(g.mean, np.ones((GPU_TIMED_SCALE, GPU_TIMED_SCALE, 1), np.float32))
-    assert checks.box_filtered(big, GPU_TIMED_SCALE).shape == g.mean.shape
-    assert checks.wrong_timed_image(big, 64, GPU_TIMED_SCALE) is None
-    wrong = checks.wrong_timed_image(big.transpose(1, 0, 2), 64, GPU_TIMED_SCALE)
+    assert speed.box_filtered(big, GPU_TIMED_SCALE).shape == g.mean.shape
+    assert speed.wrong_timed_image(big, 64, GPU_TIMED_SCALE) is None
+    wrong = speed.wrong_timed_image(big.transpose(1, 0, 2), 64, GPU_TIMED_SCALE)
     assert wrong and wrong.startswith("the timed render is wrong"), wrong
 
 

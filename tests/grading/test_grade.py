@@ -93,9 +93,9 @@ def test_lab03_serial_hand_in_earns_nothing(lab01_ref, tmp_path):
 
 
 def test_lab03_reference_gets_full_marks(tmp_path):
-    from grading import race_checks
-    race, errors = race_checks.build("03-openmp", ROOT / "labs" / "03-openmp" / "solution",
-                                     trusted=True)
+    from grading.checks import races
+    race, errors = races.build("03-openmp", ROOT / "labs" / "03-openmp" / "solution",
+                               trusted=True)
     assert race is not None, errors
     results = grade_in_process("03", build("lab03-ref")[0], tmp_path, parts={"race": race})
     skip_if_not_measurable(results)

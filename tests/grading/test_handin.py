@@ -1,4 +1,4 @@
-"""`make handin` and what the grader does with a hand-in (grading/handin.py): the zip holds
+"""`make handin` and what the grader does with a hand-in (grading/releases/handin.py): the zip holds
 exactly the lab's files; the grader finds a nested hand-in, names a missing file, and refuses
 an empty one in one line, with a results.json that says the same."""
 import json
@@ -8,7 +8,8 @@ import zipfile
 
 import pytest
 
-from grading import handin, students_tree
+from grading import students_tree
+from grading.releases import handin
 from labkit.harness import ROOT
 
 

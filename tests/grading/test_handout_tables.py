@@ -1,18 +1,20 @@
-"""Handouts say what the grader does: each grading table is the one grading/handout_tables.py
-makes of the rubric, and a table edited away from it, or a rubric changed without
-regenerating the tables, fails here. Every handout ends with its hand-in section."""
+"""Handouts say what the grader does: each grading table is the one
+grading/releases/handout_tables.py makes of the rubric, and a table edited away from it, or a
+rubric changed without regenerating the tables, fails here. Every handout ends with its hand-in
+section."""
 import dataclasses
 import re
 import shutil
 
 import pytest
 
-from grading import grade, handin, handout_tables
+from grading import grade
+from grading.releases import handin, handout_tables
 
 
 def test_every_handout_holds_its_generated_table():
     assert handout_tables.differing() == [], \
-        "regenerate with python3 -m grading.handout_tables"
+        "regenerate with python3 -m grading.releases.handout_tables"
 
 
 def copy_handouts(tmp_path, monkeypatch):

@@ -85,7 +85,7 @@ def test_the_hidden_scene_holds_every_kind_of_the_lists(lab01_ref, tmp_path):
     in the hidden scene, so a kind added to a list and left out of the scene fails here."""
     import json
 
-    from grading import hidden
+    from grading.checks import hidden
     from labkit.harness import RunPolicy, policy, run_lab
     path = tmp_path / "hidden.json"
     path.write_text(json.dumps(hidden.hidden_scene("kinds")))
@@ -99,7 +99,7 @@ def test_the_hidden_scene_holds_every_kind_of_the_lists(lab01_ref, tmp_path):
 def test_a_renderer_that_skips_a_primitive_kind_fails_the_hidden_scene(lab01_ref, tmp_path):
     """The hidden scene holds every primitive kind (the Cornell box holds only rectangles and a
     sphere): a renderer whose closest hit misses triangles, or convex quads, fails there."""
-    from grading import hidden
+    from grading.checks import hidden
     from labkit.variants import build_variant
     assert hidden.check_hidden(lab01_ref, lab01_ref, "kinds").passed
     for name, kind in (("triangles", "Triangle"), ("quads", "ConvexQuad")):
@@ -113,7 +113,7 @@ def test_the_reference_passes_the_showcase_at_seeds_where_its_glass_strays(lab01
     glass makes block sums skewed, a tail the normal model underestimates). At alpha 1e-4
     over the raw variance each of them failed its golden test; the grader draws a new seed
     every grade, so it compares at GRADING_ALPHA over pooled variance, and they pass."""
-    from grading.checks import check_golden
+    from grading.checks.golden import check_golden
     for seed in (227, 564, 1311, 1500):
         result = check_golden(lab01_ref, "showcase", seed=seed)
         assert result.passed, f"seed {seed}: {result.detail}"
@@ -142,7 +142,7 @@ if "--pfm" in args and args[args.index("--width") + 1] == "32" and (
 def test_one_stray_render_of_the_hidden_scene_is_rendered_again(lab01_ref, tmp_path):
     """A failed render of the hidden scene is rendered once more with another seed: a stray
     block in one render passes, the same block in every render fails."""
-    from grading import hidden
+    from grading.checks import hidden
     for always in (False, True):
         strayer = tmp_path / f"lab-{always}"
         strayer.write_text(STRAYER.format(python=sys.executable, root=str(ROOT),

@@ -100,7 +100,7 @@ def test_copying_the_golden_images_earns_nothing(tmp_path):
 
 
 def test_the_hidden_scene_depends_on_the_secret():
-    from grading.hidden import hidden_scene
+    from grading.checks.hidden import hidden_scene
     assert hidden_scene("a") == hidden_scene("a") != hidden_scene("b")
 
 
@@ -441,7 +441,7 @@ def test_values_at_the_float_limit_fail_every_image_check(tmp_path):
     assert "radiance is never negative and no test scene gives more" in describe(results)
 
 
-# ---- speed that fails closed (grading/speed_checks.py) ----------------------------------------
+# ---- speed that fails closed (grading/checks/speed.py) ----------------------------------------
 
 @contextlib.contextmanager
 def burning_one_core():
@@ -544,9 +544,9 @@ def test_the_public_golden_image_plus_noise_for_the_timed_runs_earns_no_speed(tm
     secret, so the public golden image with calibrated noise (which the stored golden data
     would pass) is a wrong image there: no speed, no more than the honest serial work it
     replaces (the reference handed in for lab 02: 70)."""
-    from grading import checks
+    from grading.checks import speed
     image = noisy_golden(256)
-    assert checks.wrong_timed_image(image, 256) is None  # the public scene's data pass it
+    assert speed.wrong_timed_image(image, 256) is None  # the public scene's data pass it
     results = grade("02", golden_plus_noise(tmp_path, image), tmp_path)
     speed = speed_test(results, "speedup")
     assert speed["score"] == 0 and "the timed render is wrong" in speed["output"], \
@@ -554,7 +554,7 @@ def test_the_public_golden_image_plus_noise_for_the_timed_runs_earns_no_speed(tm
     assert results["score"] <= 70, describe(results)
 
 
-# ---- nothing precomputable (grading/draws.py) -----------------------------------------------
+# ---- nothing precomputable (grading/checks/draws.py) ----------------------------------------
 
 def test_printing_the_published_analytic_answers_earns_nothing(tmp_path):
     """The analytic scenes' parameters come from the grading secret: the answers printed for
@@ -566,12 +566,12 @@ def test_printing_the_published_analytic_answers_earns_nothing(tmp_path):
 def test_the_secret_draws_the_timed_and_tested_renders():
     """The timed scene, its seed and the analytic scenes come from the secret: another secret,
     another camera, light, colours and sphere; the same secret (a regrade), the same."""
-    from grading import checks, draws
+    from grading.checks import draws, graded_scenes, speed
     from labkit import scenes
 
     def drawn():
-        scene = checks.drawn_timed_scene()
-        return (checks.timed_settings(64, pathlib.Path("x"))["seed"], checks.drawn_interior(),
+        scene = graded_scenes.drawn_timed_scene()
+        return (speed.timed_settings(64, pathlib.Path("x"))["seed"], graded_scenes.drawn_interior(),
                 scene["camera"], scene["light"], scene["materials"], scene["spheres"])
     with draws.secret("one"):
         one = drawn()
@@ -580,10 +580,10 @@ def test_the_secret_draws_the_timed_and_tested_renders():
     assert all(a != b for a, b in zip(one, two)), (one, two)
     with draws.secret("one"):
         assert drawn() == one  # a regrade draws the same
-    public = scenes.load(checks.TIMED_SCENE)
+    public = scenes.load(graded_scenes.TIMED_SCENE)
     assert one[2:] != (public["camera"], public["light"], public["materials"], public["spheres"])
-    assert [q["vertices"] for q in scenes.load(checks.TIMED_SCENE)["quads"]] == \
-        [q["vertices"] for q in checks.drawn_timed_scene()["quads"]]  # the same box: its cost
+    assert [q["vertices"] for q in scenes.load(graded_scenes.TIMED_SCENE)["quads"]] == \
+        [q["vertices"] for q in graded_scenes.drawn_timed_scene()["quads"]]  # the same box
 
 
 def test_the_reference_objects_are_out_of_the_compilers_reach(tmp_path):
@@ -611,7 +611,7 @@ def test_the_reference_objects_are_out_of_the_compilers_reach(tmp_path):
 def test_a_binary_handed_in_beside_the_skeleton_is_never_run_in_a_batch(tmp_path):
     """A release ships the reference prebuilt: handed in as `lab` beside the skeleton's
     sources, a batch must grade the sources (the skeleton's score) and say what it ignored."""
-    from grading import batch
+    from grading.classes import batch
     from grading.students_tree import pristine_skeleton
     subs, report = tmp_path / "subs", tmp_path / "report"
     folder = handin(subs / "ann", pristine_skeleton("01-serial"))
@@ -658,7 +658,8 @@ def test_hostile_strings_are_cleaned_in_every_sink(tmp_path, monkeypatch, capsys
     character survives, no cell starts a formula, no markup reaches a page."""
     import csv
 
-    from grading import batch, report_html, slurm
+    from grading import report_html
+    from grading.classes import batch, slurm
     from grading.grade import RUBRICS, print_table
     from grading.results import Results, Test
     hostile = "|".join(HOSTILE_STRINGS)
@@ -701,7 +702,7 @@ def test_hostile_strings_are_cleaned_in_every_sink(tmp_path, monkeypatch, capsys
 
 
 def bad_zip(path: pathlib.Path, kind: str) -> pathlib.Path:
-    """A hand-in zip over one of the intake's limits (grading/batch.py)."""
+    """A hand-in zip over one of the intake's limits (grading/classes/batch.py)."""
     import zipfile
     with zipfile.ZipFile(path, "w", zipfile.ZIP_DEFLATED) as z:
         z.writestr("render.cpp", "int x;\n")
@@ -729,7 +730,7 @@ def test_a_hostile_zip_is_its_rows_cause_and_the_class_is_graded(tmp_path, monke
     refused in one line, which becomes that student's cause; the others are graded."""
     import csv
 
-    from grading import batch
+    from grading.classes import batch
     subs, report = tmp_path / "subs", tmp_path / "report"
     handin(subs / "ann", {"render.cpp": "int x;\n"})
     bad_zip(subs / "bob.zip", kind)
@@ -756,7 +757,7 @@ def test_a_linked_submission_folder_is_its_rows_cause(tmp_path, monkeypatch):
     it points at, the solution here: refused, that row's cause."""
     import csv
 
-    from grading import batch
+    from grading.classes import batch
     subs, report = tmp_path / "subs", tmp_path / "report"
     handin(subs / "ann", {"render.cpp": "int x;\n"})
     (subs / "eve").symlink_to(ROOT / "labs" / "01-serial" / "solution")
@@ -770,7 +771,7 @@ def test_a_linked_submission_folder_is_its_rows_cause(tmp_path, monkeypatch):
 def stub_grades(monkeypatch, score: int) -> list[str]:
     """grade-batch's grader replaced by one giving `score` to every hand-in; the names of the
     folders it was given, in order."""
-    from grading import batch
+    from grading.classes import batch
     graded = []
 
     def grade_one(lab, folder, out, extra, env):
@@ -792,7 +793,7 @@ def test_a_hostile_export_metadata_never_stops_the_class(tmp_path, monkeypatch, 
     submissions are graded all the same, the metadata's fault said in one line."""
     import csv
 
-    from grading import batch
+    from grading.classes import batch
     subs, report = tmp_path / "subs", tmp_path / "report"
     for name in ("submission_1", "submission_2"):
         handin(subs / name, {"render.cpp": "int x;\n"})
@@ -809,7 +810,7 @@ def test_a_hostile_export_metadata_never_stops_the_class(tmp_path, monkeypatch, 
 def test_a_submission_the_export_lists_without_its_folder_is_a_row(tmp_path, monkeypatch):
     import csv
 
-    from grading import batch
+    from grading.classes import batch
     subs = tmp_path / "subs"
     handin(subs / "submission_1", {"render.cpp": "int x;\n"})
     (subs / "submission_metadata.yml").write_text(

@@ -7,7 +7,8 @@ import pathlib
 
 import pytest
 
-from grading import checks, source_rules
+from grading import source_rules
+from grading.checks import graded_scenes
 from grading.grade import build_lab, describe, grade
 from labkit import boxes, sandbox, scenes
 from labkit.harness import run_lab
@@ -124,11 +125,11 @@ def test_the_references_double_build_runs_staged(mode, tmp_path, lab01_ref):
     """The reference hands a scene float cannot place to the double build it carries: in the
     sandbox the grader stages that build and the reference runs it from there."""
     scene = scenes.write_scene(tmp_path / "big.json", scenes.scaled(
-        scenes.sphere_interior(**checks.INTERIOR), 1e12))
+        scenes.sphere_interior(**graded_scenes.INTERIOR), 1e12))
     from labkit.harness import RunPolicy, policy
     with policy(RunPolicy(trusted=False, limits=sandbox.Limits(wall_seconds=60))):
         run = run_lab(lab01_ref, scene, width=8, height=8, spp=4, bounces=2)
-    want = scenes.sphere_interior_radiance(**checks.INTERIOR, bounces=2)
+    want = scenes.sphere_interior_radiance(**graded_scenes.INTERIOR, bounces=2)
     assert run.json["precision"] == "double" and abs(run.image / want - 1).max() < 3e-4
 
 
@@ -233,7 +234,7 @@ def test_a_runs_inputs_are_closed_to_other_runs(mode, tmp_path):
 def test_a_class_open_to_every_user_is_refused_without_landlock(monkeypatch):
     """In the user sandbox without Landlock only permissions keep a run from the class's
     hand-ins: a batch whose folder any user may enter is refused in one line."""
-    from grading import batch
+    from grading.classes import batch
     if os.geteuid() != 0:
         pytest.skip("the user sandbox needs the grader to run as root")
     monkeypatch.setattr(sandbox, "_probe_result", [None])

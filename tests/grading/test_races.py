@@ -1,4 +1,4 @@
-"""Lab 03's race check (grading/race_checks.py): the hand-in built for ThreadSanitizer with
+"""Lab 03's race check (grading/checks/races.py): the hand-in built for ThreadSanitizer with
 LLVM's OpenMP, in the sandbox, and run on a small render. The classic mistake whose every
 image is right, a pixel index declared outside the parallel loop (the optimiser keeps it in a
 register), is caught and named by its line; the solution is clean; a serial hand-in is never
@@ -7,7 +7,7 @@ import shutil
 
 import pytest
 
-from grading import race_checks
+from grading.checks import races
 from grading.grade import RUBRICS
 from labkit.harness import RunPolicy, policy
 from labkit.sandbox import Limits
@@ -38,7 +38,7 @@ def built(tmp_path, sources: dict[str, str]):
     folder.mkdir()
     for name, text in sources.items():
         (folder / name).write_text(text)
-    binary, errors = race_checks.build("03-openmp", folder, trusted=False)
+    binary, errors = races.build("03-openmp", folder, trusted=False)
     assert binary is not None, errors
     return binary
 
@@ -46,7 +46,7 @@ def built(tmp_path, sources: dict[str, str]):
 def test_the_shared_index_is_a_race_named_by_its_line(tmp_path):
     binary = built(tmp_path, shared_index_sources())
     with policy(UNTRUSTED):
-        result = race_checks.check_races(binary)
+        result = races.check_races(binary)
     assert not result.passed and result.credit == 0, result
     line = next(i + 1 for i, text in enumerate(shared_index_sources()["render.cpp"].splitlines())
                 if text == INNER.replace("int x = 0", "x = 0"))
@@ -58,7 +58,7 @@ def test_the_solution_is_clean(tmp_path):
     binary = built(tmp_path, lab_sources("03-openmp"))
     with policy(UNTRUSTED):
         for _ in range(2):
-            result = race_checks.check_races(binary)
+            result = races.check_races(binary)
             assert result.passed and result.credit == 1, result
 
 

@@ -1,6 +1,6 @@
-"""`make release LAB=NN OUT=DIR` (grading/release.py): releases for labs 01 and 03 are made in
-a scratch folder, searched for solutions, and used there as a student would: the public tests
-(`make test-labs` in lab 03's), `make grade` (lab 01), the references built or served
+"""`make release LAB=NN OUT=DIR` (grading/releases/release.py): releases for labs 01 and 03 are
+made in a scratch folder, searched for solutions, and used there as a student would: the public
+tests (`make test-labs` in lab 03's), `make grade` (lab 01), the references built or served
 prebuilt. Then every way it must refuse, and the leak check on leaks planted in a copy.
 
 Lab 03's `make grade` is not run here: its skeleton is a correct serial renderer, graded on
@@ -20,7 +20,7 @@ import time
 
 import pytest
 
-from grading import leaks
+from grading.releases import leaks
 from labkit import registry
 from labkit.harness import ROOT
 
@@ -150,7 +150,8 @@ def test_lab01_release_layout(pristine01):
         ]
         + (GPU_SHIPS if shutil.which("nvcc") else [])
     )
-    for gone in ("tests/grading", "labkit/skeletons.py", "grading/release.py", "ref", ".ci"):
+    for gone in ("tests/grading", "labkit/skeletons.py", "grading/releases/release.py", "ref",
+                 ".ci"):
         assert not (release01 / gone).exists(), gone
     assert not list(pristine01.parent.glob(".*partial*")), "a partial release was left behind"
 
@@ -209,9 +210,9 @@ def test_without_nvcc_the_gpu_references_are_left_out(tmp_path, release01):
     """Where the CUDA toolkit is missing, a release still comes, saying what it lacks."""
     path = os.pathsep.join(d for d in os.environ["PATH"].split(os.pathsep)
                            if not (pathlib.Path(d) / "nvcc").exists())
-    p = subprocess.run([sys.executable, "-m", "grading.release", "05", str(tmp_path / "out")],
-                       cwd=ROOT, capture_output=True, text=True, timeout=900,
-                       env={**CLEAN_ENV, "PATH": path})
+    p = subprocess.run([sys.executable, "-m", "grading.releases.release", "05",
+                        str(tmp_path / "out")], cwd=ROOT, capture_output=True, text=True,
+                       timeout=900, env={**CLEAN_ENV, "PATH": path})
     assert p.returncode == 0, p.stderr
     left_out = p.stderr.split("left out ", 1)[-1].split(" (", 1)[0].split(", ")
     assert left_out == GPU_SHIPS, p.stderr
@@ -221,7 +222,7 @@ def test_without_nvcc_the_gpu_references_are_left_out(tmp_path, release01):
 # ---- refusals: one line, exit status 2, nothing written ---------------------------------
 
 def run_tool(*args, env=None):
-    return subprocess.run([sys.executable, "-m", "grading.release", *args], cwd=ROOT,
+    return subprocess.run([sys.executable, "-m", "grading.releases.release", *args], cwd=ROOT,
                           capture_output=True, text=True, timeout=900,
                           env={**CLEAN_ENV, **(env or {})})
 
@@ -260,7 +261,7 @@ def test_refuses_a_non_empty_out(tmp_path):
 
 def test_stale_skeletons_refuse_the_release(tmp_path, monkeypatch):
     """A solution edited without `make skeletons`: its students would get the old skeleton."""
-    from grading import release
+    from grading.releases import release
     generated = list(leaks.skeletons.generated_files())
     path, text = generated[0]
     monkeypatch.setattr(leaks.skeletons, "generated_files",
@@ -275,7 +276,7 @@ def test_a_leaked_secret_refuses_the_release(tmp_path, release01):
     committed in one): the release is refused and nothing is left."""
     out = tmp_path / "out"
     p = run_tool("01", str(out), env={"GRADING_SECRET": "def hidden_scene(secret: str)"})
-    assert_refused(p, "grading/hidden.py: holds the hidden scene's secret", out)
+    assert_refused(p, "grading/checks/hidden.py: holds the hidden scene's secret", out)
     assert not out.exists()
 
 
@@ -284,8 +285,8 @@ def test_interrupted_release_leaves_nothing(tmp_path, release01):
     go): nothing is left, or, had the signal come during the final rename, the whole release."""
     for attempt in range(3):
         out = tmp_path / f"out{attempt}"
-        p = subprocess.Popen([sys.executable, "-m", "grading.release", "01", str(out)], cwd=ROOT,
-                             stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
+        p = subprocess.Popen([sys.executable, "-m", "grading.releases.release", "01", str(out)],
+                             cwd=ROOT, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
                              env=CLEAN_ENV)
         deadline = time.monotonic() + 60
         while not list(tmp_path.glob(f".{out.name}.partial-*")) and time.monotonic() < deadline:
@@ -357,7 +358,7 @@ def test_leak_check_reads_the_releases_repository_through_git(tmp_path, pristine
 
 def test_leak_check_finds_the_hidden_scene(tmp_path, pristine01):
     """The secret's scene saved among the scenes leaks the secret as surely as the secret."""
-    from grading import hidden
+    from grading.checks import hidden
     from labkit import scenes
     release = tmp_path / "release"
     shutil.copytree(pristine01, release, symlinks=True)
@@ -371,7 +372,7 @@ def test_leak_check_finds_the_hidden_scene(tmp_path, pristine01):
 def test_lab_readmes_in_a_release_name_nothing_it_lacks():
     """A lab's README as a release ships it (its course-repository-only parts left out) names
     no test the release does not ship and no `make gpu-check`, which runs those tests."""
-    from grading import leaks, release
+    from grading.releases import leaks, release
     for readme in sorted(ROOT.glob("labs/*/README.md")):
         text = release.for_students(readme.read_text())
         named = set(re.findall(r"tests/[\w/]+\.(?:py|cpp|cu)", text))

@@ -31,7 +31,7 @@ import time
 
 import pytest
 
-from grading import leaks
+from grading.releases import leaks
 from labkit import registry
 from labkit.harness import ROOT
 

@@ -8,7 +8,7 @@ import time
 
 from grading import grade as grader
 from grading import references
-from grading.checks import CheckResult
+from grading.checks.check_result import CheckResult
 from grading.results import Results, Test
 from labkit.harness import ROOT, RunPolicy, build, policy, run_lab
 from labkit.sandbox import Limits

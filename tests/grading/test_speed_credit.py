@@ -1,11 +1,12 @@
-"""Speed grading's partial credit and its provisional points (grading/speed_checks.py,
+"""Speed grading's partial credit and its provisional points (grading/checks/speed.py,
 grading/results.py): the curve, and points a regrade may add kept out of every total."""
 import math
 import time
 
 import pytest
 
-from grading.checks import ZERO_CREDIT_AT, CheckResult, speed_credit
+from grading.checks.check_result import CheckResult
+from grading.checks.speed import ZERO_CREDIT_AT, speed_credit
 from grading.results import Results, Test
 
 
@@ -47,11 +48,11 @@ def test_a_cpu_quota_below_two_cores_times_nothing(monkeypatch):
     """Gradescope's default container (--cpus=0.5) sees every CPU of the host, but may use
     half of one: the capacity is the cgroup's quota, and a parallel lab is not timed there:
     correctness is graded, the speed marked for regrade with its points shown apart."""
-    from grading import speed_checks
+    from grading.checks import speed
     from labkit import harness
     monkeypatch.setattr(harness, "cpu_quota", lambda: 0.5)
     assert harness.cpu_capacity() == 0.5 and harness.available_cores() == 1
-    result = speed_checks.check_parallel_speedup("/nonexistent", "/nonexistent")
+    result = speed.check_parallel_speedup("/nonexistent", "/nonexistent")
     assert result.regrade and result.passed and result.credit == 0 and result.provisional == 1
     assert result.detail.startswith("not timed: this machine gives 0.5 cores"), result.detail
 
@@ -67,7 +68,7 @@ def test_the_quota_is_read_from_the_cgroup():
 
 
 def test_one_thread_doing_the_work_is_told_from_work_shared():
-    from grading.checks import ONE_THREAD, one_thread_did_it
+    from grading.checks.speed import ONE_THREAD, one_thread_did_it
     assert one_thread_did_it([1.0, ONE_THREAD]) and not one_thread_did_it([1.0, 0.5])
     assert not one_thread_did_it([]) and not one_thread_did_it([math.nan, 1.0])
 
@@ -78,11 +79,11 @@ def test_serial_is_final_even_where_nothing_is_timed(monkeypatch, binary, serial
     shows whose work it is: a serial program's one thread did all of it (final: no points,
     no regrade, the gated checks closed), a parallel one shares it (correctness graded,
     speed left to a regrade)."""
-    from grading import speed_checks
+    from grading.checks import speed
     from labkit import harness
     monkeypatch.setattr(harness, "cpu_quota", lambda: 0.5)
     program, = harness.build(binary)
-    result = speed_checks.check_parallel_speedup(program, speed_checks.LAB01_REFERENCE, threads=2)
+    result = speed.check_parallel_speedup(program, speed.LAB01_REFERENCE, threads=2)
     if serial:
         assert not result.regrade and not result.passed and result.credit == 0, result
         assert result.detail.startswith("serial: in every timed run one thread did"), result.detail
@@ -96,7 +97,7 @@ def timed_with(monkeypatch, before: float, yours: float, after: float):
     after it. Returns the result and how many runs of the program it measured."""
     import numpy as np
 
-    from grading import speed_checks
+    from grading.checks import speed
     from labkit.harness import Run
     calls = {"yours": 0, "reference": 0}
 
@@ -109,11 +110,11 @@ def timed_with(monkeypatch, before: float, yours: float, after: float):
             calls["reference"] += 1
         return Run(0, "", "", {}, np.zeros((1, 1, 3), np.float32), seconds, seconds, 1.0)
 
-    monkeypatch.setattr(speed_checks, "run_lab", run_lab)
-    monkeypatch.setattr(speed_checks, "timed_golden", lambda scene: None)
-    monkeypatch.setattr(speed_checks, "wrong_timed_image", lambda *args: None)
-    monkeypatch.setattr(speed_checks.time, "sleep", lambda seconds: None)
-    result = speed_checks.check_speedup("yours", "reference", 1.5)
+    monkeypatch.setattr(speed, "run_lab", run_lab)
+    monkeypatch.setattr(speed, "timed_golden", lambda scene: None)
+    monkeypatch.setattr(speed, "wrong_timed_image", lambda *args: None)
+    monkeypatch.setattr(speed.time, "sleep", lambda seconds: None)
+    result = speed.check_speedup("yours", "reference", 1.5)
     return result, calls["yours"]
 
 
@@ -147,7 +148,7 @@ def parallel_timed(monkeypatch, *, capacity: float, base: float, yours: float, c
     thread `busiest` of it."""
     import numpy as np
 
-    from grading import speed_checks
+    from grading.checks import speed
     from labkit import harness
     from labkit.harness import ParallelTiming, Run
 
@@ -158,11 +159,11 @@ def parallel_timed(monkeypatch, *, capacity: float, base: float, yours: float, c
     def measure_parallel(baseline, candidates, **_):
         return ParallelTiming(2, capacity, base, {n: c() for n, c in candidates.items()})
 
-    monkeypatch.setattr(speed_checks, "run_lab", run_lab)
+    monkeypatch.setattr(speed, "run_lab", run_lab)
     monkeypatch.setattr(harness, "cpu_capacity", lambda: 2.0)
     monkeypatch.setattr(harness, "measure_parallel", measure_parallel)
-    monkeypatch.setattr(speed_checks.time, "sleep", lambda seconds: None)
-    return speed_checks.check_parallel_speedup("yours", "reference")
+    monkeypatch.setattr(speed.time, "sleep", lambda seconds: None)
+    return speed.check_parallel_speedup("yours", "reference")
 
 
 def test_a_speedup_beyond_the_machines_capacity_is_refused_as_impossible(monkeypatch):
@@ -186,7 +187,7 @@ def test_a_spinning_thread_opens_no_gate_on_cpu_share_alone(monkeypatch, tmp_pat
     looks shared among threads, so the speed is left to a regrade, and the checks gated on
     it (bit identity, golden images) are graded with their points provisional, never in the
     score, until the regrade measures a speedup."""
-    from grading import checks
+    from grading.checks import check_result
     from grading.grade import Item, grade_items
     from labkit.harness import RunPolicy
     from labkit.sandbox import Limits
@@ -196,7 +197,7 @@ def test_a_spinning_thread_opens_no_gate_on_cpu_share_alone(monkeypatch, tmp_pat
     assert speed.passed and speed.regrade and speed.credit == 0, speed
     rubric = [Item("parallel-speedup", "parallel speedup", 40, lambda b: speed),
               Item("bitwise", "bit-identical to lab 01", 30,
-                   lambda b: checks.CheckResult("bit-identical", True, "identical"),
+                   lambda b: check_result.CheckResult("bit-identical", True, "identical"),
                    requires="parallel-speedup")]
     results = Results()
     results.add_all([Test(i.id, i.label, i.points) for i in rubric])

@@ -1,11 +1,11 @@
 """The classic image mistakes, each handed in as lab 01's reference with its image changed the
 way the mistake changes it, graded by lab 01's rubric: each loses the points it should, and a
-failing check's message names the symptom (grading/symptoms.py). The table of these
+failing check's message names the symptom (grading/checks/symptoms.py). The table of these
 mistakes, the check that catches each and its message is in grading/README.md."""
 import numpy as np
 import pytest
 
-from grading import symptoms
+from grading.checks import symptoms
 from grading.grade import describe, grade, passed_by_check
 from labkit.harness import build
 from tests.grading.submissions import altered_reference

@@ -109,7 +109,7 @@ def test_only_mpiruns_runs_get_ip_sockets(user_sandbox, tmp_path):
     """Lab 04 in the user sandbox: OpenMPI's PMIx reaches every rank over loopback TCP, so a
     run the grader starts under mpirun has IP sockets (lab04-ref renders there, and a client
     under mpirun connects), and a run without it has none."""
-    from grading.mpi_checks import mpirun
+    from grading.checks.mpi import mpirun
     from labkit.harness import RunPolicy, policy, run_lab
     build("lab04-ref")
     client = sub.socket_client(tmp_path)
@@ -171,7 +171,7 @@ def test_a_batch_grades_the_sources_beside_a_binary_without_namespaces(tmp_path)
         (subs / "ann" / name).write_text(text)
     shutil.copyfile(sub.REFERENCE, subs / "ann" / "lab")
     (subs / "ann" / "lab").chmod(0o755)
-    p = subprocess.run([*NO_NAMESPACES, sys.executable, "-m", "grading.batch", "01", str(subs),
+    p = subprocess.run([*NO_NAMESPACES, sys.executable, "-m", "grading.classes.batch", "01", str(subs),
                         "--out", str(report)], cwd=ROOT, capture_output=True, text=True,
                        timeout=600)
     results = json.loads((report / "ann" / "results.json").read_text())

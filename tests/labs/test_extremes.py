@@ -13,7 +13,8 @@ common/core/real.h); docs/extremes.md tabulates what each measured
 """
 import pytest
 
-from grading import checks
+from grading.checks import invariance
+from grading.checks.golden import GOLDEN_TEST_SPP
 from labkit import scenes
 from labkit.compare import compare
 from labkit.harness import build, golden, run_lab
@@ -27,13 +28,13 @@ def renderer(request):
 
 def test_translation_invariance(renderer):
     """The sphere interior and a lit floor, moved by up to 1e4 times their size."""
-    result = checks.check_translation_invariance(renderer)
+    result = invariance.check_translation_invariance(renderer)
     assert result.passed, str(result)
 
 
 def test_large_primitives(renderer):
     """Floors (quads and spheres) of half-size up to 1e5, seen from 1 unit above."""
-    result = checks.check_large_primitives(renderer)
+    result = invariance.check_large_primitives(renderer)
     assert result.passed, str(result)
 
 
@@ -42,7 +43,7 @@ def test_large_primitives(renderer):
 def test_floor_of_any_size_at_any_scale(renderer, factor, half):
     """The lit floor scaled as a whole by 1e-4 or 1e5 (up to the loader's 1e9 coordinates),
     with a floor 10 or 1e4 times the camera's height: closed form per pixel."""
-    err = checks.render_floor(renderer, scenes.scaled(scenes.floor_view(half), factor))
+    err = invariance.render_floor(renderer, scenes.scaled(scenes.floor_view(half), factor))
     assert err.mean() < 1.5e-2, f"mean relative error {err.mean():.2e}"
 
 
@@ -56,7 +57,7 @@ def test_cornell_moved_far_matches_golden(renderer, tmp_path, distance):
     g = golden("cornell")
     scene = scenes.translated(scenes.load("cornell"), [distance, -0.7 * distance, 0.3 * distance])
     path = scenes.write_scene(tmp_path / "moved.json", scene)
-    spp = checks.GOLDEN_TEST_SPP
+    spp = GOLDEN_TEST_SPP
     run = run_lab(renderer, path, width=g.meta["width"], height=g.meta["height"], spp=spp,
                   bounces=g.meta["bounces"], seed=7)
     report = compare(run.image, spp, g.mean, g.variance, g.meta["golden_spp"])

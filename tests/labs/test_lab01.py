@@ -5,8 +5,9 @@ import sys
 
 import pytest
 
-from grading import checks
-from grading.renderer_checks import CHECKS
+from grading.checks import analytic
+from grading.checks.golden import check_golden
+from grading.checks.renderer import CHECKS
 from labkit.harness import ROOT, run_lab
 
 
@@ -19,7 +20,7 @@ def test_reference_passes(lab01_ref, check, tmp_path):
 def test_skeleton_is_visibly_incomplete(lab01_pristine_skeleton):
     """Until students fill it in, the skeleton builds and runs but fails the image checks."""
     skeleton = lab01_pristine_skeleton
-    results = [checks.check_sphere_interior(skeleton), checks.check_golden(skeleton, "cornell")]
+    results = [analytic.check_sphere_interior(skeleton), check_golden(skeleton, "cornell")]
     assert not any(r.passed for r in results), "\n".join(map(str, results))
 
 

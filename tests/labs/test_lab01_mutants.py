@@ -3,7 +3,7 @@
 Each mutant is the lab-01 reference with one plausible student bug. It is built from a copy
 of a solution or shared file with one edit (the edited header comes first on the include
 path), then run through the correctness checks
-(grading/checks.py). A mutant must fail the checks named for it: that documents which bug
+(grading/checks/). A mutant must fail the checks named for it: that documents which bug
 each check catches, and proves that no check is one that cannot fail. Run with `-s` to see
 the full matrix.
 """
@@ -12,20 +12,21 @@ import pathlib
 
 import pytest
 
-from grading import checks
+from grading.checks import analytic, invariance
+from grading.checks.golden import check_golden
 from labkit.harness import ROOT
 from labkit.variants import build_variant
 
 CHECKS = {
-    "interior": checks.check_sphere_interior,
-    "millions": checks.check_million_samples,
-    "plane": checks.check_lit_plane,
-    "glass": checks.check_glass_slab,
-    "cornell": lambda b: checks.check_golden(b, "cornell"),
-    "showcase": lambda b: checks.check_golden(b, "showcase"),
-    "scale": checks.check_scale_invariance,
-    "moved": checks.check_translation_invariance,
-    "large": checks.check_large_primitives,
+    "interior": analytic.check_sphere_interior,
+    "millions": analytic.check_million_samples,
+    "plane": analytic.check_lit_plane,
+    "glass": analytic.check_glass_slab,
+    "cornell": lambda b: check_golden(b, "cornell"),
+    "showcase": lambda b: check_golden(b, "showcase"),
+    "scale": invariance.check_scale_invariance,
+    "moved": invariance.check_translation_invariance,
+    "large": invariance.check_large_primitives,
 }
 
 # name: (file under common/core or the solution dir, original text, mutated text, checks that

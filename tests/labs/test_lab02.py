@@ -24,8 +24,8 @@ import subprocess
 
 import pytest
 
-from grading import checks
-from grading.renderer_checks import CHECKS as RENDERER_CHECKS
+from grading.checks.golden import check_golden
+from grading.checks.renderer import CHECKS as RENDERER_CHECKS
 from labkit.harness import (
     ROOT,
     available_cores,
@@ -268,7 +268,7 @@ def test_part_b_skeleton_is_visibly_incomplete(lab02_pristine_skeleton):
     """Until students write the 8-wide triangle test, only lane 0 of each packet sees the
     triangles: the walls are missing from 7 of every 8 samples."""
     skeleton = lab02_pristine_skeleton
-    results = [checks.check_golden(skeleton, "cornell"), checks.check_golden(skeleton, "showcase")]
+    results = [check_golden(skeleton, "cornell"), check_golden(skeleton, "showcase")]
     assert not any(r.passed for r in results), "\n".join(map(str, results))
     run = run_lab(skeleton, width=32, height=32, spp=8)
     assert run.image is not None and run.image.max() > 0  # an image, not a crash or a blank
@@ -336,7 +336,7 @@ def test_part_a_skeleton_is_correct_but_scalar(lab02a_pristine_skeleton):
     run = run_lab(skeleton, width=8, height=8, spp=1)
     assert run.json["lab"] == "02-simd-a"
     assert "scalar fallback" in run.json["device"], run.json["device"]
-    result = checks.check_golden(skeleton, "cornell")
+    result = check_golden(skeleton, "cornell")
     assert result.passed, str(result)
 
 
@@ -367,8 +367,8 @@ def part_a_build(tmp_path, vec3: str):
 
 
 def graded_part_a(binary):
-    from grading import draws
-    from grading.part_a import check_part_a
+    from grading.checks import draws
+    from grading.checks.part_a import check_part_a
     with draws.secret("part-a"):
         return check_part_a(binary, "part-a", build("lab01-ref")[0])
 

@@ -6,7 +6,7 @@ import os
 
 import pytest
 
-from grading import checks
+from grading.checks.golden import check_golden
 from labkit.harness import (
     available_cores,
     build,
@@ -65,7 +65,7 @@ def test_every_schedule_is_lab01_bit_for_bit(lab01_bits, schedule, monkeypatch):
 
 
 def test_reference_passes_golden(lab03_ref):
-    result = checks.check_golden(lab03_ref, "cornell")
+    result = check_golden(lab03_ref, "cornell")
     assert result.passed, str(result)
 
 
@@ -143,9 +143,9 @@ def test_skeleton_is_serial(speedups):
 
 def test_threads_taking_turns_stay_below_the_grader_s_turns_bar(speedups):
     """An ordered row loop, where the machine has room for a parallel program: no faster than
-    the grader's bar for threads that ran one at a time (grading/speed_checks.py), while the
+    the grader's bar for threads that ran one at a time (grading/checks/speed.py), while the
     reference, in the same rounds, is well above it."""
-    from grading.speed_checks import TURNS_SPEEDUP
+    from grading.checks.speed import TURNS_SPEEDUP
     assert speedups.speedup("ordered") <= TURNS_SPEEDUP, speedups.describe("ordered")
     assert speedups.speedup("lab03-ref") > TURNS_SPEEDUP + 0.2, speedups.describe("lab03-ref")
 
@@ -160,7 +160,7 @@ def lab03_simd_ref():
 
 
 def test_simd_variant_passes_golden(lab03_simd_ref):
-    result = checks.check_golden(lab03_simd_ref, "cornell")
+    result = check_golden(lab03_simd_ref, "cornell")
     assert result.passed, str(result)
 
 

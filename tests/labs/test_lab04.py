@@ -21,7 +21,8 @@ import subprocess
 import numpy as np
 import pytest
 
-from grading import checks
+from grading.checks import mpi
+from grading.checks.golden import check_golden
 from labkit.harness import ROOT, available_cores, build, cpu_has_avx2, render_seconds, run_lab
 
 DISTRIBUTIONS = ["block", "interleaved", "dynamic"]
@@ -117,7 +118,7 @@ def test_hybrid_is_bitwise_identical(lab04_ref, small_reference, monkeypatch, di
 
 def test_golden_image(lab04_ref):
     """The noise-aware comparison with the converged image, through mpirun."""
-    result = checks.check_golden(lab04_ref, "cornell", launcher=mpirun(3))
+    result = check_golden(lab04_ref, "cornell", launcher=mpirun(3))
     assert result.passed, str(result)
 
 
@@ -177,7 +178,7 @@ def test_simd_variant(lab01_ref, lab04_simd_ref, monkeypatch):
     assert "AVX2, 8 paths per packet" in run.json["device"], run.json["device"]
     assert_bitwise(run.image, lab01.image, "SIMD, 8 lanes, 2 ranks", "lab 01")
     monkeypatch.delenv("RT_FORCE_NO_AVX512")
-    result = checks.check_golden(lab04_simd_ref, "cornell", launcher=mpirun(2))
+    result = check_golden(lab04_simd_ref, "cornell", launcher=mpirun(2))
     assert result.passed, str(result)
 
 
@@ -457,7 +458,7 @@ def test_grader_takes_the_points_of_an_undone_distribution(lab04_ref, task, tmp_
     assert old in source
     mutant = build_variant("04-mpi", tmp_path, {"render.cpp": source.replace(old, new)})
     item = next(i for i in RUBRICS["04"] if i.id == "distributions")
-    done, undone = checks.check_distributions(lab04_ref), checks.check_distributions(mutant)
+    done, undone = mpi.check_distributions(lab04_ref), mpi.check_distributions(mutant)
     assert done.passed and done.credit == 1, str(done)
     assert not undone.passed and undone.credit == 0.5, str(undone)
     assert round(item.points * undone.credit) < item.points
@@ -474,7 +475,7 @@ def test_grader_takes_the_points_of_an_undone_hybrid_task(lab04_ref, tmp_path):
     assert source.count(pragma) == 1
     mutant = build_variant("04-mpi", tmp_path, {"render.cpp": source.replace(pragma, "")})
     assert any(i.id == "hybrid" and i.points > 0 for i in RUBRICS["04"])
-    done, undone = checks.check_hybrid_threads(lab04_ref), checks.check_hybrid_threads(mutant)
+    done, undone = mpi.check_hybrid_threads(lab04_ref), mpi.check_hybrid_threads(mutant)
     assert done.passed and done.credit == 1, str(done)
     assert not undone.passed and undone.credit == 0 and not undone.regrade, str(undone)
     assert "task 4" in undone.detail, str(undone)

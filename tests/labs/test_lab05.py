@@ -15,8 +15,9 @@ import numpy as np
 import pytest
 from cuda_env import gpu_name, missing_gpu
 
-from grading import checks
-from grading.renderer_checks import CHECKS
+from grading.checks import analytic, invariance
+from grading.checks.golden import check_golden
+from grading.checks.renderer import CHECKS
 from labkit import scenes
 from labkit.compare import compare
 from labkit.harness import ROOT, build, golden, run_lab
@@ -252,12 +253,12 @@ def test_reference_passes(gpu, lab05_ref, check):
 
 
 GENERAL_CHECKS = {
-    "sphere-interior": checks.check_sphere_interior,
-    "lit-plane": checks.check_lit_plane,
-    "golden-cornell": lambda b: checks.check_golden(b, "cornell"),
-    "golden-showcase": lambda b: checks.check_golden(b, "showcase"),
-    "scale": checks.check_scale_invariance,
-    "reproducible": checks.check_reproducible,
+    "sphere-interior": analytic.check_sphere_interior,
+    "lit-plane": analytic.check_lit_plane,
+    "golden-cornell": lambda b: check_golden(b, "cornell"),
+    "golden-showcase": lambda b: check_golden(b, "showcase"),
+    "scale": invariance.check_scale_invariance,
+    "reproducible": invariance.check_reproducible,
 }
 
 
@@ -313,9 +314,9 @@ def test_agrees_with_lab01(gpu, lab05_ref):
 
 
 @pytest.mark.parametrize("check", [
-    checks.check_sphere_interior,
-    lambda b: checks.check_golden(b, "cornell"),
-    lambda b: checks.check_golden(b, "showcase"),
+    analytic.check_sphere_interior,
+    lambda b: check_golden(b, "cornell"),
+    lambda b: check_golden(b, "showcase"),
 ], ids=["sphere-interior", "golden-cornell", "golden-showcase"])
 def test_double_build_passes(gpu, check):
     """The megakernel in double (common/core/real.h, make lab05-ref-double) renders the
@@ -395,7 +396,7 @@ def test_skeleton_is_visibly_incomplete(gpu, lab05_pristine_skeleton):
     """Until students fill it in, the skeleton builds and renders, but not the right image:
     the spheres only, one path per pixel."""
     skeleton = lab05_pristine_skeleton
-    assert not checks.check_golden(skeleton, "cornell").passed
+    assert not check_golden(skeleton, "cornell").passed
     image = run_lab(skeleton, width=32, height=32, spp=4).image
     assert image is not None and image.max() > 0
 

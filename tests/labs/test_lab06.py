@@ -22,8 +22,8 @@ import numpy as np
 import pytest
 from cuda_env import gpu_name, missing_gpu
 
-from grading import checks
-from grading.renderer_checks import CHECKS
+from grading.checks.golden import check_golden
+from grading.checks.renderer import CHECKS
 from labkit.compare import compare
 from labkit.harness import ROOT, build, golden, run_lab
 
@@ -208,7 +208,7 @@ def test_student_files_are_what_the_build_requires(folder):
     """The files a hand-in must hold (cuda.mk's CUDA_STUDENT_FILES_<lab>) are the shared files
     the lab's students write (labkit/skeletons.py's SHARED_SOURCES), each of which their
     skeleton/ holds and no solution/ does: the shared file is the reference."""
-    from grading.leaks import skeletons
+    from grading.releases.leaks import skeletons
     p = make("--eval", f"print-student-files: ; @echo $(CUDA_STUDENT_FILES_{folder})",
              "print-student-files")
     required = set(p.stdout.split())
@@ -354,7 +354,7 @@ def test_skeleton_is_visibly_incomplete(gpu, lab06_pristine_skeleton):
     not the right image: its racy reserve loses nearly every path (measured on an H200: a black
     32x32 image), and only the first interaction runs."""
     skeleton = lab06_pristine_skeleton
-    assert not checks.check_golden(skeleton, "cornell").passed
+    assert not check_golden(skeleton, "cornell").passed
     image = run_lab(skeleton, width=32, height=32, spp=4).image
     assert image is not None and np.isfinite(image).all()
 

@@ -19,7 +19,7 @@ from test_lab06 import (
     waves_do_not_change_the_image,
 )
 
-from grading import checks
+from grading.checks.golden import check_golden
 from labkit.harness import ROOT, build, golden, run_lab
 
 LAB = "07-soa"
@@ -131,7 +131,7 @@ def test_skeleton_is_visibly_incomplete(gpu, lab07_pristine_skeleton):
     """Until students write the SoA pool, nothing is stored: the skeleton builds and renders
     a black image."""
     skeleton = lab07_pristine_skeleton
-    assert not checks.check_golden(skeleton, "cornell").passed
+    assert not check_golden(skeleton, "cornell").passed
     image = run_lab(skeleton, width=32, height=32, spp=4).image
     assert image is not None and np.isfinite(image).all() and image.max() == 0
 

@@ -10,8 +10,8 @@ import subprocess
 
 import pytest
 
-from grading import checks
-from grading.renderer_checks import CHECKS
+from grading.checks import graded_scenes
+from grading.checks.renderer import CHECKS
 from labkit import scenes
 from labkit.harness import ROOT, build, run_lab
 
@@ -64,7 +64,7 @@ def test_the_reference_renders_wider_scales_in_double(lab01_ref, lab01_ref_doubl
     (1e30). The students' float build refuses it in one line; the reference renders it in
     double by itself, as the double build does, like the unit-size scene, and says why."""
     def interior(scale):
-        scene = scenes.sphere_interior(**checks.INTERIOR)
+        scene = scenes.sphere_interior(**graded_scenes.INTERIOR)
         return scenes.write_scene(tmp_path / f"scaled-{scale:g}.json",
                                   scenes.scaled(scene, scale))
     big = interior(1e12)
@@ -75,7 +75,7 @@ def test_the_reference_renders_wider_scales_in_double(lab01_ref, lab01_ref_doubl
     assert p.returncode == 2 and len(lines) == 1 and "1e9" in lines[0], p.stderr
     assert "double places it" in lines[0] and "lab01-ref" in lines[0], lines[0]
     settings = dict(width=8, height=8, spp=4, bounces=2)
-    want = scenes.sphere_interior_radiance(**checks.INTERIOR, bounces=2)
+    want = scenes.sphere_interior_radiance(**graded_scenes.INTERIOR, bounces=2)
     for binary in (lab01_ref, lab01_ref_double):
         run = run_lab(binary, big, **settings)
         assert abs(run.image / want - 1).max() < 3e-4, binary.name
@@ -88,8 +88,9 @@ def test_a_piped_scene_only_double_places_is_refused_in_one_line(lab01_ref, tmp_
     cannot give: the reference says so in one line (a file renders: the test above); a scene
     float places renders from a pipe as from a file."""
     big = scenes.write_scene(tmp_path / "big.json", scenes.scaled(
-        scenes.sphere_interior(**checks.INTERIOR), 1e12))
-    small = scenes.write_scene(tmp_path / "small.json", scenes.sphere_interior(**checks.INTERIOR))
+        scenes.sphere_interior(**graded_scenes.INTERIOR), 1e12))
+    small = scenes.write_scene(tmp_path / "small.json",
+                               scenes.sphere_interior(**graded_scenes.INTERIOR))
     args = ["--scene", "/dev/stdin", "--width", "4", "--height", "4", "--spp", "1", "--quiet",
             "--out", str(tmp_path / "out.ppm")]
     p = subprocess.run([str(lab01_ref), *args], input=big.read_text(), capture_output=True,

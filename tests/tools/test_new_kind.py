@@ -152,7 +152,7 @@ def test_a_rough_metal_renders_its_closed_form(copy, tmp_path):
 
 
 def test_the_labs_render_the_hidden_scene_with_both_kinds_alike(copy, tmp_path):
-    made = run(copy, "python3", "-c", "import json; from grading import hidden; "
+    made = run(copy, "python3", "-c", "import json; from grading.checks import hidden; "
                "print(json.dumps(hidden.hidden_scene('0123456789abcdef0123456789abcdef')))")
     scene = json.loads(made.stdout)
     assert scene["disks"] and any(m["type"] == "rough_metal" for m in scene["materials"].values())

@@ -149,7 +149,7 @@ def test_it_is_graded_on_its_rubric(repo, tmp_path):
 def test_it_is_handed_in(repo, tmp_path):
     root, _ = repo
     out = tmp_path / "handin.zip"
-    run(root, sys.executable, "-m", "grading.handin", LAB, "--out", str(out))
+    run(root, sys.executable, "-m", "grading.releases.handin", LAB, "--out", str(out))
     with zipfile.ZipFile(out) as z:
         assert z.namelist() == ["render.cpp"]
 

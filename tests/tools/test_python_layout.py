@@ -1,10 +1,12 @@
 """How the kit's Python fits together (DESIGN.md section 1): labkit/, grading/, tools/ and tests/
 import each other as packages from the repository root, never by editing sys.path or loading a
-file by path; the grader imports nothing from tools/, labkit/ nothing from either; every
-command under tools/ is reached from a make target that `make help` lists; every Python or
-shell path and every `python3 -m` module the repository names exists. Reads files only: well
-under a second."""
+file by path; the grader imports nothing from tools/, labkit/ nothing from either; the grader's
+modules import down its floors (GRADER_FLOORS) and at most MAX_GRADER_TOP of them sit at its
+top; every command under tools/ is reached from a make target that `make help` lists; every
+Python or shell path and every `python3 -m` module the repository names exists. Reads files
+only: well under a second; `make lint` runs it."""
 import ast
+import fnmatch
 import importlib.util
 import re
 import subprocess
@@ -145,20 +147,28 @@ def test_paths_and_modules_the_repository_names_exist():
     assert not missing, missing
 
 
+def module_of(path) -> str:
+    """grading/checks/speed.py -> grading.checks.speed; a package's __init__.py -> its name."""
+    parts = path.relative_to(ROOT).with_suffix("").parts
+    return ".".join(parts[:-1] if parts[-1] == "__init__" else parts)
+
+
 def module_graph(package: str) -> dict[str, set[str]]:
-    """Module -> the modules of `package` it imports (at its top or inside a function)."""
+    """Module -> the modules of `package` (its subpackages' included) it imports, at its top or
+    inside a function, by dotted name: `from grading.checks import speed` is grading.checks.speed,
+    `from grading.checks.speed import x` too."""
+    files = tracked(f"{package}/*.py", f"{package}/**/*.py")
+    modules = {module_of(f) for f in files}
     graph = {}
-    for f, tree in trees(tracked(f"{package}/*.py")):
+    for f, tree in trees(files):
         deps = set()
         for node in ast.walk(tree):
-            if isinstance(node, ast.ImportFrom) and node.module == package:
-                deps |= {a.name for a in node.names}
-            elif isinstance(node, ast.ImportFrom) and (node.module or "").startswith(package + "."):
-                deps.add(node.module.split(".")[1])
+            if isinstance(node, ast.ImportFrom) and (node.module or "").split(".")[0] == package:
+                deps |= {f"{node.module}.{a.name}" if f"{node.module}.{a.name}" in modules
+                         else node.module for a in node.names}
             elif isinstance(node, ast.Import):
-                deps |= {a.name.split(".")[1] for a in node.names
-                         if a.name.startswith(package + ".")}
-        graph[f.stem] = deps - {f.stem}
+                deps |= {a.name for a in node.names if a.name.split(".")[0] == package}
+        graph[module_of(f)] = deps - {module_of(f), package}
     return graph
 
 
@@ -185,3 +195,49 @@ def test_the_graders_modules_import_in_one_direction():
     has one job, and a check's module needs nothing from the grade that runs it."""
     assert cycles(module_graph("grading")) == []
     assert cycles({"checks": {"hidden"}, "hidden": {"checks"}}) == [["checks", "hidden", "checks"]]
+
+
+# The grader's floors, lowest first. A module imports modules of its own floor or a lower one,
+# never a higher one, and never a floor beside its own: the classes (batch, Slurm, the class's
+# page) and the releases (student repositories, hand-ins, Gradescope) both stand on the grade
+# and know nothing of each other. The grader's top holds the grade and the modules every floor
+# shares; a module at the top not named in a higher floor is a shared one (floor 0).
+GRADER_FLOORS = [
+    ("shared", 0, ("grading.*",)),  # shown, results, compile, students_tree, references...
+    ("checks", 1, ("grading.checks", "grading.checks.*")),
+    ("grade", 2, ("grading.grade",)),  # the rubrics and their order: the one grade-level module
+    ("classes", 3, ("grading.classes", "grading.classes.*")),
+    ("releases", 3, ("grading.releases", "grading.releases.*")),
+]
+MAX_GRADER_TOP = 14  # .py files directly in grading/, __init__.py included
+
+
+def floor_of(module: str) -> tuple[str, int]:
+    """The last floor whose patterns match `module` (grading.grade matches "grading.*" too)."""
+    found = [(name, level) for name, level, patterns in GRADER_FLOORS
+             if any(fnmatch.fnmatchcase(module, p) for p in patterns)]
+    return found[-1]
+
+
+def test_the_graders_modules_import_down_its_floors():
+    """The checks never import the grade, a class's or a release's modules; the shared modules
+    at the top import no subpackage; classes and releases never import each other."""
+    upward = []
+    for module, deps in module_graph("grading").items():
+        if module == "grading":
+            continue
+        name, level = floor_of(module)
+        for dep in deps:
+            dep_name, dep_level = floor_of(dep)
+            if dep_level > level or (dep_level == level and dep_name != name):
+                upward.append(f"{module} ({name}) imports {dep} ({dep_name})")
+    assert not upward, upward
+    assert floor_of("grading.shown") == ("shared", 0)
+    assert floor_of("grading.grade") == ("grade", 2)
+    assert floor_of("grading.checks.speed") == ("checks", 1)
+
+
+def test_the_graders_top_holds_at_most_a_few_modules():
+    """What is not the grade or shared by its floors lives in a subpackage by concern."""
+    top = sorted(f.name for f in tracked("grading/*.py") if f.parent == ROOT / "grading")
+    assert len(top) <= MAX_GRADER_TOP, top

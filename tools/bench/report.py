@@ -30,7 +30,6 @@ import shutil
 import subprocess
 import sys
 
-from grading.checks import mpirun
 from labkit import registry
 from labkit.harness import (
     ImageError,
@@ -40,6 +39,7 @@ from labkit.harness import (
     measure_parallel,
     run_lab,
 )
+from labkit.mpi import mpirun
 from tools.bench import report_data as report
 from tools.tradeoff import report as tradeoff_report  # (Machine: CPU model, cores, date, load)
 from tools.tradeoff import (

@@ -26,7 +26,7 @@ def collect(out: pathlib.Path) -> dict:
     """Everything gpu-check.json holds. Runs the lab binaries in the repository root."""
     import numpy as np
 
-    from grading.renderer_checks import CHECKS as RENDERER_CHECKS
+    from grading.checks.renderer import CHECKS as RENDERER_CHECKS
     from labkit.compare import compare
     from labkit.harness import golden, run_lab
 

@@ -39,7 +39,7 @@ from tools.tradeoff.series import first_words
 ROOT = pathlib.Path(__file__).resolve().parents[2]
 
 ALPHA = 1e-4
-# Float rounding of a path's value: the zero-variance interior of grading/analytic_checks.py differs
+# Float rounding of a path's value: the zero-variance interior of grading/checks/analytic.py differs
 # from its closed form by ~1e-5 relative; 1e-4 of the converged radiance leaves a margin.
 ROUNDING = 1e-4
 SWEEP_SEED = 3000  # + bounces: every bounce count its own seed, none the reference's

@@ -32,7 +32,7 @@ def extreme() -> dict:
 # The sphere interior of the bias sweep: albedo, radius, intensity, and a light well off the
 # centre (0.54 R), so that wall points see very different direct light and the indirect
 # bounces are a real Monte Carlo estimate (with the light at the centre, as in
-# grading/analytic_checks.py, every path returns the same value and there is nothing to estimate).
+# grading/checks/analytic.py, every path returns the same value and there is nothing to estimate).
 INTERIOR = dict(albedo=0.8, radius=2.0, intensity=3.0, light=(0.8, 0.6, 0.4))
 
 

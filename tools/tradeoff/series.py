@@ -21,8 +21,8 @@ import shutil
 import subprocess
 from typing import Callable
 
-from grading.checks import mpirun
 from labkit.cuda_env import missing_gpu as gpu_missing
+from labkit.mpi import mpirun
 from labkit.variants import build_sources, lab_sources
 
 ROOT = pathlib.Path(__file__).resolve().parents[2]

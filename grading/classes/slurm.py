@@ -2,10 +2,10 @@
 
     make grade-slurm LAB=NN SUBMISSIONS=DIR [REPORT=DIR] [PARTITION=P] [TIME=H:MM:SS]
                      [MEM=SIZE] [PYTHON=python3] [ONLY=flagged]
-    python3 -m grading.slurm NN SUBMISSIONS --out REPORT [--partition P] [--time T] [--mem M]
-                             [--python NAME] [--only flagged] [--no-submit]
+    python3 -m grading.classes.slurm NN SUBMISSIONS --out REPORT [--partition P] [--time T]
+                                     [--mem M] [--python NAME] [--only flagged] [--no-submit]
 
-One array task per submission (`python3 -m grading.batch ... --task K`: the K-th in name
+One array task per submission (`python3 -m grading.classes.batch ... --task K`: the K-th in name
 order, in its own grader process, in the sandbox, with the batch's hidden-scene secret that
 this step saves in REPORT before anything is submitted), then a merge job that runs once every
 task has ended, however it ended (`--dependency=afterany`), and writes grades.csv and
@@ -34,7 +34,8 @@ import subprocess
 import sys
 import tempfile
 
-from grading import batch, references, shown
+from grading import references, shown
+from grading.classes import batch
 from grading.grade import RUBRICS
 from labkit.harness import ROOT
 
@@ -80,7 +81,7 @@ def scripts(lab: str, submissions: pathlib.Path, out: pathlib.Path, n: int,
     part += f"# {shown.line(asked(partition, time_limit, mem, python))}\n"
     extra = f" --run-seconds {run_seconds:g}" if run_seconds else ""
     common = (f"cd {q(str(ROOT))}\n"
-              f"{q(python)} -m grading.batch {lab} {q(str(submissions))} "
+              f"{q(python)} -m grading.classes.batch {lab} {q(str(submissions))} "
               f"--out {q(str(out))}{extra}")
     array = f"""#!/bin/bash
 #SBATCH --job-name=grade-lab{lab}
@@ -88,14 +89,14 @@ def scripts(lab: str, submissions: pathlib.Path, out: pathlib.Path, n: int,
 #SBATCH --exclusive
 #SBATCH --nodes=1
 #SBATCH --output={out_line}/slurm-%A_%a.log
-{part}# One submission per task: the K-th in name order (grading/slurm.py).
+{part}# One submission per task: the K-th in name order (grading/classes/slurm.py).
 {common} --task "$SLURM_ARRAY_TASK_ID"
 """
     merge = f"""#!/bin/bash
 #SBATCH --job-name=grade-lab{lab}-merge
 #SBATCH --nodes=1
 #SBATCH --output={out_line}/slurm-merge-%j.log
-{part}# grades.csv and report.html from every task's results.json (grading/slurm.py).
+{part}# grades.csv and report.html from every task's results.json (grading/classes/slurm.py).
 {common} --merge
 """
     return array, merge

@@ -1,7 +1,7 @@
 """What a student hands in for lab NN, packed, and found again in what was uploaded.
 
     make handin                 (a release: its lab)  -> handin-labNN.zip
-    python3 -m grading.handin NN [--out FILE.zip]
+    python3 -m grading.releases.handin NN [--out FILE.zip]
 
 The hand-in is the lab's skeleton files, as the student finished them: the files of
 labs/NN-name/skeleton/ that labs/labs.toml lists as its hand-in, at the top of the zip

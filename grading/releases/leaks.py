@@ -1,5 +1,5 @@
 """What a student release for lab NN must not hold, checked on the finished folder before it is
-given its name (grading/release.py). The check is independent of how the release chose its
+given its name (grading/releases/release.py). The check is independent of how the release chose its
 files: it reads every file that ended up there, so a mistake in the selection, a solution
 pasted into a shared file or a secret committed by accident is caught all the same.
 
@@ -14,7 +14,7 @@ A release for lab NN leaks when it holds
 - a test that is not public (PUBLIC_TESTS);
 - an executable outside reference-bin/ (a binary built from solution sources, committed by
   accident);
-- the hidden scene's secret (GRADING_SECRET, grading/hidden.py), anywhere, in any file, or
+- the hidden scene's secret (GRADING_SECRET, grading/checks/hidden.py), anywhere, in any file, or
   the scene made from it, as a scene file (what a saved copy of it would be);
 - in its git repository (.git/), anything but one commit of the files as they are: the objects
   there are compressed, so they are not read byte by byte (compressed data holds a marker's
@@ -28,7 +28,7 @@ import json
 import pathlib
 import subprocess
 
-from grading import hidden
+from grading.checks import hidden
 from labkit import (  # skeletons: the one definition of the markers and of SHARED_SOURCES
     registry,
     skeletons,
@@ -39,8 +39,8 @@ from labkit import (  # skeletons: the one definition of the markers and of SHAR
 # Gradescope bundle), the labs' tests (they test the references, mutants of the solutions and
 # the skeletons' sync with them), CI, and this release tool itself.
 NEVER_SHIPPED = ("labkit/skeletons.py", "tools/make_golden.py", "tests/grading/*",
-                 "tests/labs/test_lab[0-9][0-9]*", ".ci/*", "grading/release.py",
-                 "grading/leaks.py", "grading/reference_bins.py")
+                 "tests/labs/test_lab[0-9][0-9]*", ".ci/*", "grading/releases/release.py",
+                 "grading/releases/leaks.py", "grading/releases/reference_bins.py")
 # Tests students get: the shared command-line contract (run on the reference binaries) and
 # the unit tests of common/ (which test lab 01's path tracer too: they fail until lab 01 is
 # done, as they should). Every other test needs the solutions (pristine skeletons, skeleton

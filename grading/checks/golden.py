@@ -9,9 +9,9 @@ import pathlib
 
 import numpy as np
 
-from grading import draws, symptoms
-from grading.check_result import CheckResult, image_checked
-from grading.lanes import lanes_not_lab01
+from grading.checks import draws, symptoms
+from grading.checks.check_result import CheckResult, image_checked
+from grading.checks.lanes import lanes_not_lab01
 from labkit.compare import GRADING_ALPHA, compare
 from labkit.harness import GOLDEN, golden, rerun_command, run_lab
 
@@ -24,7 +24,7 @@ def check_golden(binary, scene: str, *, seed: int | None = None, spp: int = GOLD
                  heatmap_dir: pathlib.Path | None = None, launcher=(), threads=None,
                  extra=()) -> CheckResult:
     """Noise-aware comparison with the converged golden image (labkit/compare.py), rendered
-    at a seed drawn from the grading secret (grading/draws.py)."""
+    at a seed drawn from the grading secret (grading/checks/draws.py)."""
     g = golden(scene)
     seed = draws.seed(f"golden-{scene}") if seed is None else seed
     run = run_lab(binary, g.scene, width=g.meta["width"], height=g.meta["height"], spp=spp,

@@ -1,7 +1,7 @@
 """Lab 07's lesson, which speed cannot grade: where its path pool puts neighbouring paths."""
 from __future__ import annotations
 
-from grading.check_result import CheckResult
+from grading.checks.check_result import CheckResult
 from labkit.harness import run_lab
 
 

@@ -16,7 +16,7 @@ import re
 import shutil
 import subprocess
 
-from grading.check_result import CheckResult
+from grading.checks.check_result import CheckResult
 from labkit.harness import ROOT, current_policy, policy, run_lab
 
 RUBRICS = {"openmp"}  # the rubric kinds whose labs are graded for races (lab 03's)

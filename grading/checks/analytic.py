@@ -15,20 +15,11 @@ import tempfile
 
 import numpy as np
 
-from grading import draws, symptoms
-from grading.check_result import CheckResult, image_checked, worst_of
+from grading.checks import draws, symptoms
+from grading.checks.check_result import CheckResult, image_checked, worst_of
+from grading.checks.graded_scenes import INTERIOR, drawn_interior
 from labkit import scenes
 from labkit.harness import run_lab
-
-# The sphere interior both checks below render: albedo, radius, light intensity.
-INTERIOR = dict(albedo=0.6, radius=2.0, intensity=3.0)
-
-
-def drawn_interior() -> dict:
-    """The graded sphere interior's albedo, radius and intensity, drawn from the secret."""
-    return dict(albedo=draws.uniform("interior-albedo", 0.3, 0.8),
-                radius=draws.uniform("interior-radius", 0.5, 4.0),
-                intensity=draws.uniform("interior-intensity", 0.5, 6.0))
 
 
 def render_interior(binary, runs: dict, interior: dict = INTERIOR) -> dict:
@@ -127,7 +118,7 @@ def check_lit_plane(binary) -> CheckResult:
     if not ok:
         # The light stands off the axes, so the image has no symmetry: a flipped or transposed
         # image that matches once turned back means the pixels went to the wrong places, not
-        # the light to the wrong values (grading/symptoms.py).
+        # the light to the wrong values (grading/checks/symptoms.py).
         symptom = black_pixels(image) or symptoms.named(image, want, closed_form=True)
     return CheckResult("analytic lit plane", ok,
                        f"relative error mean {err.mean():.2e}, max {err.max():.2e}"

@@ -24,7 +24,7 @@ from labkit import gpu, registry
 from labkit.harness import ROOT
 
 # The labs graded on their parallel speedup, which a quota below 1.5 cores cannot measure
-# (checks.QUOTA_TOO_SMALL).
+# (speed.QUOTA_TOO_SMALL).
 PARALLEL_LABS = {lab.number for lab in registry.labs() if lab.rubric in ("openmp", "mpi")}
 
 SETUP = """#!/usr/bin/env bash

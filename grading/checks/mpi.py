@@ -1,24 +1,14 @@
-"""Lab 04's ranks: mpirun as the grader starts it, and every distribution of rows."""
+"""Lab 04's ranks: every distribution of rows, and threads within each rank (mpirun as
+the grader, the tools and the tests start it is labkit/mpi.py)."""
 from __future__ import annotations
 
 import math
 import re
 
-from grading.check_result import CheckResult
-from grading.identity_checks import row_ranges
+from grading.checks.check_result import CheckResult
+from grading.checks.identity import row_ranges
 from labkit.harness import run_lab
-
-
-def mpirun(ranks: int, distribution: str | None = None, *env: str) -> list[str]:
-    """The launcher for MPI labs, RT_MPI_DISTRIBUTION set for every rank when `distribution`
-    is given and each NAME=VALUE of `env` too (the sandbox passes none of the grader's
-    environment on). Not -q: it would hide OpenMPI's own error text (MPI_ERR_TRUNCATE, a
-    rank that died), the cause a student needs; a run that succeeds prints no banner."""
-    cmd = ["mpirun", "--oversubscribe", "--bind-to", "none", "-np", str(ranks)]
-    for setting in ([f"RT_MPI_DISTRIBUTION={distribution}"] if distribution else []) + list(env):
-        cmd += ["-x", setting]
-    return cmd
-
+from labkit.mpi import mpirun
 
 DISTRIBUTIONS = ("block", "interleaved", "dynamic")
 

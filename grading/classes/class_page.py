@@ -12,8 +12,8 @@ import pathlib
 import urllib.parse
 
 from grading import report_html, shown
+from grading.classes.verdicts import failure_cause, flagged, provisional_points, waiting
 from grading.speed_numbers import speed_numbers
-from grading.verdicts import failure_cause, flagged, provisional_points, waiting
 
 MOST_NOTE_LINES = 3  # of a row's own notes (a compile error's lines are in its cause and page)
 

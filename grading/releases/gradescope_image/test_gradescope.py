@@ -2,8 +2,9 @@
 
 A Debian base image made with debootstrap from the Debian archive this machine uses (once;
 kept as prt-debian-base:bookworm), the lab-01 bundle built into an image on it
-(grading/gradescope/Dockerfile: setup.sh at build time), and run_autograder run in fresh
-containers with Docker's default seccomp profile and capabilities at 0.5 CPU and 768 MB:
+(grading/releases/gradescope_image/Dockerfile: setup.sh at build time), and run_autograder
+run in fresh containers with Docker's default seccomp profile and capabilities at 0.5 CPU and
+768 MB:
 
     reference (render.cpp, path_tracer.h)           100
     skeleton (as generated)                         at most 10
@@ -25,7 +26,7 @@ import tempfile
 import time
 import zipfile
 
-ROOT = pathlib.Path(__file__).resolve().parents[2]  # make test-gradescope: on the import path
+ROOT = pathlib.Path(__file__).resolve().parents[3]  # make test-gradescope: on the import path
 BASE = "prt-debian-base:bookworm"
 IMAGE = "prt-gradescope-lab01"
 LIMITS = ["--cpus=0.5", "--memory=768m"]  # Gradescope's defaults
@@ -85,7 +86,7 @@ def base_image() -> None:
 
 
 def autograder_image(work: pathlib.Path) -> None:
-    from grading.gradescope import bundle
+    from grading.releases.gradescope import bundle
     zip_path = bundle("01", work / "lab01.zip")
     context = work / "context"
     with zipfile.ZipFile(zip_path) as z:

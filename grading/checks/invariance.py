@@ -9,10 +9,9 @@ import tempfile
 
 import numpy as np
 
-from grading import draws
-from grading.analytic_checks import INTERIOR
-from grading.check_result import CheckResult, image_checked
-from grading.speed_checks import timed_scene
+from grading.checks import draws
+from grading.checks.check_result import CheckResult, image_checked
+from grading.checks.graded_scenes import INTERIOR, timed_scene
 from labkit import scenes
 from labkit.harness import run_lab
 

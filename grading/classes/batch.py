@@ -2,18 +2,19 @@
 grader process (a grader that dies on one submission does not take the class with it), all
 with the same hidden scene; a CSV for the gradebook and an HTML page to read.
 
-    python3 -m grading.batch 01 SUBMISSIONS --out REPORT
+    python3 -m grading.classes.batch 01 SUBMISSIONS --out REPORT
     make grade-batch LAB=01 SUBMISSIONS=DIR REPORT=DIR
 
 SUBMISSIONS may be Gradescope's export of the assignment, unzipped as it comes
 (submission_<id>/ folders and submission_metadata.yml): grades.csv is then keyed by the
 export's submission ids and names each one's submitters. Otherwise SUBMISSIONS/<student>/
-holds the student's hand-in (its files, at the top or in one folder below: grading/handin.py
-finds them); SUBMISSIONS/<student>.zip is a hand-in zip as `make handin` writes it. A hand-in
-is graded from its sources, always: a program in it is never run (grading a built program is
-`python3 -m grading.grade --binary`, course staff's choice on their command line). A zip over
-the intake's limits, or one that cannot be read, is refused in one line, which becomes that
-student's cause; a metadata file that cannot be read costs the names, never the grades.
+holds the student's hand-in (its files, at the top or in one folder below:
+grading/releases/handin.py finds them); SUBMISSIONS/<student>.zip is a hand-in zip as `make
+handin` writes it. A hand-in is graded from its sources, always: a program in it is never run
+(grading a built program is `python3 -m grading.grade --binary`, course staff's choice on their
+command line). A zip over the intake's limits, or one that cannot be read, is refused in one
+line, which becomes that student's cause; a metadata file that cannot be read costs the names,
+never the grades.
 REPORT/<student>/results.json is each student's results.json; REPORT/grades.csv and
 REPORT/report.html sum them up: per student the points, the provisional points apart (a check
 the machine was too busy to measure), the timed seconds, speedup and capacity, and the cause of
@@ -40,10 +41,12 @@ import threading
 import time
 import zipfile
 
-from grading import class_page, hidden, references, shown
+from grading import references, shown
+from grading.checks import hidden
+from grading.classes import class_page
+from grading.classes.verdicts import failure_cause, flagged, provisional_points
 from grading.grade import BUDGET_SECONDS, RUBRICS
 from grading.speed_numbers import speed_numbers
-from grading.verdicts import failure_cause, flagged, provisional_points
 from labkit import gpu, sandbox
 from labkit.harness import ROOT
 
@@ -518,7 +521,7 @@ def main(argv=None) -> int:
                         "its saved secret, and merge them into its grades")
     p.add_argument("--task", type=int, metavar="K",
                    help="grade only the K-th submission (from 0, in name order), with REPORT's "
-                        "saved secret: one task of a Slurm job array (grading/slurm.py)")
+                        "saved secret: one task of a Slurm job array (grading/classes/slurm.py)")
     p.add_argument("--merge", action="store_true",
                    help="grade nothing: write grades.csv and report.html from REPORT's results")
     a = p.parse_args(argv)
@@ -535,7 +538,7 @@ def main(argv=None) -> int:
     # One secret for the batch, saved for regrades: every student gets the same hidden scene.
     env = {**os.environ, "GRADING_SECRET": batch_secret(a.out)}
     # Graders run side by side (one per GPU, a Slurm array's tasks): none of them runs make.
-    # The references are built once, here (a Slurm array's by grading/slurm.py, before it
+    # The references are built once, here (a Slurm array's by grading/classes/slurm.py, before it
     # submits), and never rewritten while a grade runs (grading/references.py).
     extra = ["--no-build", *(["--run-seconds", str(a.run_seconds)] if a.run_seconds else [])]
     if a.task is None and not a.merge and (line := references.build(a.lab)):
@@ -552,7 +555,7 @@ def main(argv=None) -> int:
         found = submissions(a.submissions, unpacked)
         found = by_export(found, submitters)
         rows = {student: previous(a.out, student) for student in found}
-        if a.merge:  # the last job of a class graded through Slurm (grading/slurm.py)
+        if a.merge:  # the last job of a class graded through Slurm (grading/classes/slurm.py)
             write_report(a.out, a.lab, rows, submitters, regrade="make grade-slurm")
             return 0
         if a.task is not None:

@@ -2,8 +2,8 @@
 RUBRICS): the checks, their points, what each needs before it counts and what it takes to
 pass, so that a handout cannot say other numbers than the grader uses.
 
-    python3 -m grading.handout_tables           rewrite the tables in handouts/NN-*.md
-    python3 -m grading.handout_tables --check   exit 1 naming the handouts that differ
+    python3 -m grading.releases.handout_tables           rewrite the tables in handouts/NN-*.md
+    python3 -m grading.releases.handout_tables --check   exit 1 naming the handouts that differ
 
 A handout holds its table between the two marker lines BEGIN and END below; everything
 between them is generated. tests/grading/test_handout_tables.py fails when a handout's table
@@ -17,12 +17,14 @@ import pathlib
 import re
 import sys
 
-from grading import checks, grade, race_checks
+from grading import grade
+from grading.checks import analytic, identity, invariance, mpi, races, speed
+from grading.checks.golden import GOLDEN_TEST_SPP
 from labkit import harness
 from labkit.harness import ROOT
 
 BEGIN = ("<!-- grading table: generated from grading/grade.py's RUBRICS by "
-         "`python3 -m grading.handout_tables`; edit the rubric, not this table -->")
+         "`python3 -m grading.releases.handout_tables`; edit the rubric, not this table -->")
 END = "<!-- end of the generated grading table -->"
 HANDOUTS = ROOT / "handouts"
 
@@ -36,7 +38,7 @@ def closure(fn, name: str, default=None):
 
 def default_bitwise_threads() -> str:
     """The thread counts check_bitwise_equal uses when a rubric names none."""
-    m = re.search(r"for t in \(([\d, ]+)\)", inspect.getsource(checks.check_bitwise_equal))
+    m = re.search(r"for t in \(([\d, ]+)\)", inspect.getsource(identity.check_bitwise_equal))
     counts = [c.strip() for c in m.group(1).split(",")] if m else []
     return f"{', '.join(counts[:-1])} and {counts[-1]} threads" if counts else "several threads"
 
@@ -47,8 +49,8 @@ def parameter(fn, name: str):
 
 def speed_curve(lab: str, item: grade.Item) -> str:
     """How speed points fall short of the bar: the grader's partial-credit curve
-    (checks.speed_credit)."""
-    return (f"all points at the bar, falling linearly to none at {checks.ZERO_CREDIT_AT:g} x "
+    (speed.speed_credit)."""
+    return (f"all points at the bar, falling linearly to none at {speed.ZERO_CREDIT_AT:g} x "
             f"the bar")
 
 
@@ -59,10 +61,10 @@ def passes_when(lab: str, item: grade.Item) -> str:
     ranks = f", under `mpirun -np {launcher[-1]}`" if launcher else ""
     if item.id.startswith("golden-"):
         scene = item.id.removeprefix("golden-")
-        return (f"`{scene}` at {checks.GOLDEN_TEST_SPP} spp{ranks} matches the converged golden "
+        return (f"`{scene}` at {GOLDEN_TEST_SPP} spp{ranks} matches the converged golden "
                 f"image within its noise (per-pixel z-scores; a heatmap where it does not)")
     if item.id == "sphere-interior":
-        bounces = ", ".join(map(str, parameter(checks.check_sphere_interior, "bounces")))
+        bounces = ", ".join(map(str, parameter(analytic.check_sphere_interior, "bounces")))
         return (f"inside a diffuse sphere the radiance has a closed form: matched at "
                 f"{bounces} bounces")
     if item.id == "lit-plane":
@@ -73,7 +75,7 @@ def passes_when(lab: str, item: grade.Item) -> str:
         return ("a scene drawn from a secret when grading matches lab 01's reference: worth "
                 "nothing itself, but the golden images count only when it passes")
     if item.id == "scale":
-        factors = ", ".join(f"{f:g}" for f in checks.SCALE_FACTORS)
+        factors = ", ".join(f"{f:g}" for f in invariance.SCALE_FACTORS)
         return f"the Cornell box scaled by {factors} gives the same image"
     if item.id == "reproducible":
         return "two runs with the same seed give the same bits"
@@ -89,23 +91,23 @@ def passes_when(lab: str, item: grade.Item) -> str:
                 "each, once its Vec3 no longer says \"scalar fallback\" (the skeleton's, "
                 "correct but not SSE, earns none)")
     if item.id == "distributions":
-        ranks = parameter(checks.check_distributions, "ranks")
+        ranks = parameter(mpi.check_distributions, "ranks")
         return (f"with `RT_MPI_DISTRIBUTION=interleaved` rank r of {ranks} renders "
                 f"rows r, r + {ranks}, r + {2 * ranks}, ..., with `dynamic` the rows are not "
                 f"block's fixed bands (as `RT_MPI_REPORT=1` lists them); half the points each")
     if item.id == "races":
-        counts = " and ".join(str(t) for t in race_checks.RACE_THREADS)
+        counts = " and ".join(str(t) for t in races.RACE_THREADS)
         return (f"your sources built for ThreadSanitizer (`make lab03-race`: clang, LLVM's "
                 f"OpenMP and its Archer tool, your files at -O0) report no data race at "
                 f"{counts} threads on a small render: a variable the threads share where each "
                 f"needs its own is found even where every image is right")
     if item.id == "hybrid":
-        threads = parameter(checks.check_hybrid_threads, "threads")
+        threads = parameter(mpi.check_hybrid_threads, "threads")
         return (f"one rank with `--threads {threads}` under `mpirun`: no thread did "
-                f"{checks.HYBRID_SHARED:.0%} of the CPU time (each thread's measured by the "
+                f"{mpi.HYBRID_SHARED:.0%} of the CPU time (each thread's measured by the "
                 f"grader): the rank's rows are shared among its threads")
     if item.id == "parallel-speedup":
-        fraction = parameter(checks.check_parallel_speedup, "fraction")
+        fraction = parameter(speed.check_parallel_speedup, "fraction")
         who = ("`mpirun -np N` (N = the cores), 1 thread a rank" if launcher
                else "every core")
         return (f"on {who}, wall-clock speedup over `lab01-ref` (interleaved, best of rounds) "
@@ -170,7 +172,7 @@ def main(argv=None) -> int:
     if a.check:
         bad = differing()
         if bad:
-            print(f"grading tables out of date (python3 -m grading.handout_tables): "
+            print(f"grading tables out of date (python3 -m grading.releases.handout_tables): "
                   f"{', '.join(bad)}", file=sys.stderr)
             return 1
         return 0

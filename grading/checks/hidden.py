@@ -22,9 +22,9 @@ import tempfile
 
 import numpy as np
 
-from grading import symptoms
-from grading.check_result import CheckResult, image_checked
-from grading.lanes import lanes_not_lab01
+from grading.checks import symptoms
+from grading.checks.check_result import CheckResult, image_checked
+from grading.checks.lanes import lanes_not_lab01
 from labkit import scenes
 from labkit.compare import GRADING_ALPHA, compare
 from labkit.harness import RunPolicy, available_cores, policy, run_lab

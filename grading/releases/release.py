@@ -6,9 +6,9 @@ A release for lab NN holds the skeletons of lab NN and every later lab, the solu
 earlier labs (lab NN builds on them), common/ with the solution regions of lab NN and later
 replaced by their skeleton form (labkit/skeletons.py), the scenes, the golden images, the
 handouts, the public tests, the grader (students run `make grade LAB=NN`, trusted) and the
-reference binaries of lab NN and later, prebuilt (grading/reference_bins.py says why and how).
-It holds no solution source of lab NN or later, no test that is not public, no instructor
-tool and no secret: grading/leaks.py checks the finished folder, and the release is refused
+reference binaries of lab NN and later, prebuilt (grading/releases/reference_bins.py says why
+and how). It holds no solution source of lab NN or later, no test that is not public, no instructor
+tool and no secret: grading/releases/leaks.py checks the finished folder, and the release is refused
 when it finds anything.
 
 The release is written atomically: it is assembled in a hidden folder beside OUT and renamed
@@ -29,8 +29,8 @@ import sys
 import textwrap
 import time
 
-from grading import handin, leaks, reference_bins
-from grading.gradescope import repository_files
+from grading.releases import handin, leaks, reference_bins
+from grading.releases.gradescope import repository_files
 from labkit import registry
 from labkit.harness import ROOT
 
@@ -284,7 +284,7 @@ def make_release(lab: str, out: pathlib.Path, secret: str | None = None) -> path
 def main(argv=None) -> int:
     args = sys.argv[1:] if argv is None else argv
     if len(args) != 2 or not args[1]:
-        print("error: release: usage: python3 -m grading.release NN OUT_DIR "
+        print("error: release: usage: python3 -m grading.releases.release NN OUT_DIR "
               "(make release LAB=NN OUT=DIR)", file=sys.stderr)
         return 2
 
@@ -292,7 +292,7 @@ def main(argv=None) -> int:
         raise KeyboardInterrupt(signal.Signals(signum).name)
     signal.signal(signal.SIGTERM, interrupted)
     try:
-        # The instructor's fixed secret (grading/hidden.py); without one, each grade draws
+        # The instructor's fixed secret (grading/checks/hidden.py); without one, each grade draws
         # its own and there is none to leak.
         out = make_release(args[0], pathlib.Path(args[1]), os.environ.get("GRADING_SECRET"))
     except (ReleaseError, reference_bins.BuildError) as e:

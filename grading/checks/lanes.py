@@ -7,8 +7,8 @@ import tempfile
 
 import numpy as np
 
-from grading import draws, symptoms
-from grading.check_result import LAB01_REFERENCE
+from grading.checks import draws, symptoms
+from grading.checks.check_result import LAB01_REFERENCE
 from labkit import scenes
 from labkit.harness import run_lab
 

@@ -1,4 +1,4 @@
-"""Prebuilt reference binaries for a student release (grading/release.py).
+"""Prebuilt reference binaries for a student release (grading/releases/release.py).
 
 The grader times and checks a student's build against lab01-ref (and lab04-ref in lab 04), and
 students compare their timings with their lab's reference, but a release for lab NN holds no

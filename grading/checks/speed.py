@@ -2,38 +2,17 @@
 credit, and whether a program ran in parallel (CPU time over wall time, thread by thread)."""
 from __future__ import annotations
 
-import contextlib
 import os
 import pathlib
-import tempfile
 import time
 
 import numpy as np
 
-from grading import draws, hidden
-from grading.check_result import LAB01_REFERENCE, CheckResult, image_checked
-from labkit import scenes
+from grading.checks import draws, hidden
+from grading.checks.check_result import LAB01_REFERENCE, CheckResult, image_checked
+from grading.checks.graded_scenes import TIMED_SCENE, timed_scene
 from labkit.compare import compare
 from labkit.harness import golden, run_lab
-
-# The timed renders: a variation of the golden 'cornell' scene drawn from the grading secret
-# (draws.box_variation: the same cost, nobody's stored image), at the golden size, with enough
-# paths that process start-up is a few percent of the time. Its golden data are rendered on the
-# spot by the trusted reference where a timed image is compared with them (check_speedup);
-# labs 03 and 04 compare their timed images with lab 01's bits instead.
-TIMED_SCENE = "cornell"
-
-
-def drawn_timed_scene() -> dict:
-    """The timed scene of this grade: the golden Cornell box varied by the secret."""
-    return draws.box_variation(scenes.load(TIMED_SCENE), "timed")
-
-
-@contextlib.contextmanager
-def timed_scene():
-    """The drawn timed scene in a temporary file (neutral name, removed after): its path."""
-    with tempfile.TemporaryDirectory() as tmp:
-        yield scenes.write_scene(pathlib.Path(tmp) / "scene.json", drawn_timed_scene())
 
 
 def timed_settings(spp: int, scene: pathlib.Path, scale: int = 1) -> dict:
@@ -46,7 +25,7 @@ def timed_settings(spp: int, scene: pathlib.Path, scale: int = 1) -> dict:
 
 def timed_golden(scene: pathlib.Path, reference=LAB01_REFERENCE) -> tuple:
     """(mean, variance, golden_spp) of the drawn timed scene, rendered now by the trusted
-    reference at the golden size (grading/hidden.py's make_golden)."""
+    reference at the golden size (grading/checks/hidden.py's make_golden)."""
     g = golden(TIMED_SCENE)
     made = hidden.make_golden(reference, scene, size=g.meta["width"], bounces=g.meta["bounces"])
     return made.mean, made.variance, made.golden_spp

@@ -70,11 +70,11 @@ def check_part_a(binary, secret: str, reference: pathlib.Path):
     once the Vec3 is no longer the skeleton's scalar fallback (the summary's "device", from
     vec3.h's kVec3Kind): the skeleton is correct, so correctness alone is not the task. Its
     own symptom context: what it identifies is Part A's, never said of Part B's images."""
-    from grading import checks, hidden, symptoms
+    from grading.checks import analytic, check_result, hidden, symptoms
     from labkit.harness import run_lab
-    parts = [("sphere interior", lambda: checks.check_sphere_interior(binary)),
-             ("lit plane", lambda: checks.check_lit_plane(binary)),
-             ("glass pane", lambda: checks.check_glass_slab(binary)),
+    parts = [("sphere interior", lambda: analytic.check_sphere_interior(binary)),
+             ("lit plane", lambda: analytic.check_lit_plane(binary)),
+             ("glass pane", lambda: analytic.check_glass_slab(binary)),
              ("hidden scene", lambda: hidden.check_hidden(binary, reference, secret))]
     said, passed = [], 0
     with symptoms.grading("02", part="a"):  # not Part B's packets: no lane masks here
@@ -82,7 +82,7 @@ def check_part_a(binary, secret: str, reference: pathlib.Path):
             try:
                 result = run()
             except Exception as e:  # a crash, a timeout: that part fails, the others run
-                result = checks.CheckResult(name, False, f"could not run: {e}")
+                result = check_result.CheckResult(name, False, f"could not run: {e}")
             passed += result.passed
             said.append(f"{'PASS' if result.passed else 'FAIL'} {name}"
                         + ("" if result.passed else f": {result.detail}"))
@@ -94,8 +94,8 @@ def check_part_a(binary, secret: str, reference: pathlib.Path):
         said.insert(0, f"not counted: its Vec3 says \"{SCALAR}\" (kVec3Kind in part-a/vec3.h): "
                        f"the skeleton's scalar Vec3 earns none of Part A's points, SSE does")
         passed = 0
-    return checks.CheckResult("Part A", passed == len(parts), "; ".join(said),
-                              credit=passed / len(parts))
+    return check_result.CheckResult("Part A", passed == len(parts), "; ".join(said),
+                                    credit=passed / len(parts))
 
 
 SCALAR = "scalar fallback"  # what the skeleton's kVec3Kind says

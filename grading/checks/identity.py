@@ -4,9 +4,9 @@ from __future__ import annotations
 
 import numpy as np
 
-from grading import draws, symptoms
-from grading.check_result import CheckResult, image_checked
-from grading.speed_checks import timed_scene
+from grading.checks import draws, symptoms
+from grading.checks.check_result import CheckResult, image_checked
+from grading.checks.graded_scenes import timed_scene
 from labkit.harness import run_lab
 
 
