@@ -40,7 +40,7 @@ LIB_SRC    := common/host/scene_loader.cpp common/host/json_with_positions.cpp c
               common/host/progress.cpp common/host/interrupt_cleanup.cpp \
               common/host/scene_centring.cpp common/host/scene_report.cpp \
               common/host/scene_limits.cpp common/host/double_twin.cpp \
-              common/host/t_junctions.cpp
+              common/host/t_junctions.cpp common/host/scene_schema.cpp
 LIB_OBJ    := $(LIB_SRC:%.cpp=$(BUILD)/%.o)
 DRIVER_OBJ := $(BUILD)/common/host/lab_main.o $(BUILD)/common/host/main.o
 COMMON_OBJ := $(LIB_OBJ) $(DRIVER_OBJ)
