@@ -212,15 +212,17 @@ test-labs:
 
 # The quick tier, beside the full make test: the style, the unit tests and the pytest files
 # that run in seconds and build at most lab 01 (the registry, the layout of the kit, the
-# handouts' tables and GPU figures, the image comparison's statistics, the speed credit, the
-# hand-in, lab 01's own tests); not the image-comparison suites of every lab, the grader's
-# sandbox and hostile submissions, the releases or the benchmarks, which make test runs.
+# handouts' tables and GPU figures, DESIGN.md's scene-file table, the image comparison's
+# statistics, the speed credit, the hand-in, lab 01's own tests); not the image-comparison
+# suites of every lab, the grader's sandbox and hostile submissions, the releases or the
+# benchmarks, which make test runs.
 QUICK_TESTS := tests/tools/test_registry.py tests/tools/test_python_layout.py \
                tests/tools/test_gpu_report.py tests/tools/test_gpu_figures.py \
                tests/grading/test_handout_tables.py tests/grading/test_speed_credit.py \
                tests/grading/test_handin.py tests/grading/test_golden_sums.py \
                tests/grading/test_compare.py tests/grading/test_symptoms.py \
-               tests/labs/test_lab01.py tests/labs/test_scene_report.py
+               tests/labs/test_lab01.py tests/labs/test_scene_report.py \
+               tests/tools/test_scene_schema.py
 test-quick:
 	$(if $(wildcard .clang-format),$(MAKE) --no-print-directory lint)
 	$(MAKE) --no-print-directory test-unit
