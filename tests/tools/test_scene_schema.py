@@ -118,3 +118,22 @@ def test_no_binary_is_a_clear_error(monkeypatch):
     finally:
         monkeypatch.undo()
         scene_schema.schema.cache_clear()
+
+
+def test_a_binary_built_before_the_flag_is_rebuilt_first(tmp_path, monkeypatch):
+    stale = tmp_path / scene_schema.BINARY
+    stale.write_text("#!/bin/sh\necho 'error: --scene-schema: unknown option' >&2; exit 2\n")
+    stale.chmod(0o755)
+    fresh = json.dumps(scene_schema.schema())
+
+    def rebuild(*targets):
+        stale.write_text(f"#!/bin/sh\necho '{fresh}'\n")
+        return [tmp_path / t for t in targets]
+    monkeypatch.setattr(scene_schema, "ROOT", tmp_path)
+    monkeypatch.setattr(harness, "build", rebuild)
+    scene_schema.schema.cache_clear()
+    try:
+        assert scene_schema.schema() == json.loads(fresh)
+    finally:
+        monkeypatch.undo()
+        scene_schema.schema.cache_clear()
