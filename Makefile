@@ -40,7 +40,7 @@ LIB_SRC    := common/host/scene_loader.cpp common/host/json_with_positions.cpp c
               common/host/progress.cpp common/host/interrupt_cleanup.cpp \
               common/host/scene_centring.cpp common/host/scene_report.cpp \
               common/host/scene_limits.cpp common/host/double_twin.cpp \
-              common/host/t_junctions.cpp
+              common/host/t_junctions.cpp common/host/scene_schema.cpp
 LIB_OBJ    := $(LIB_SRC:%.cpp=$(BUILD)/%.o)
 DRIVER_OBJ := $(BUILD)/common/host/lab_main.o $(BUILD)/common/host/main.o
 COMMON_OBJ := $(LIB_OBJ) $(DRIVER_OBJ)
@@ -212,15 +212,17 @@ test-labs:
 
 # The quick tier, beside the full make test: the style, the unit tests and the pytest files
 # that run in seconds and build at most lab 01 (the registry, the layout of the kit, the
-# handouts' tables and GPU figures, the image comparison's statistics, the speed credit, the
-# hand-in, lab 01's own tests); not the image-comparison suites of every lab, the grader's
-# sandbox and hostile submissions, the releases or the benchmarks, which make test runs.
+# handouts' tables and GPU figures, DESIGN.md's scene-file table, the image comparison's
+# statistics, the speed credit, the hand-in, lab 01's own tests); not the image-comparison
+# suites of every lab, the grader's sandbox and hostile submissions, the releases or the
+# benchmarks, which make test runs.
 QUICK_TESTS := tests/tools/test_registry.py tests/tools/test_python_layout.py \
                tests/tools/test_gpu_report.py tests/tools/test_gpu_figures.py \
                tests/grading/test_handout_tables.py tests/grading/test_speed_credit.py \
                tests/grading/test_handin.py tests/grading/test_golden_sums.py \
                tests/grading/test_compare.py tests/grading/test_symptoms.py \
-               tests/labs/test_lab01.py tests/labs/test_scene_report.py
+               tests/labs/test_lab01.py tests/labs/test_scene_report.py \
+               tests/tools/test_scene_schema.py
 test-quick:
 	$(if $(wildcard .clang-format),$(MAKE) --no-print-directory lint)
 	$(MAKE) --no-print-directory test-unit

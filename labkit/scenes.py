@@ -7,6 +7,7 @@ import pathlib
 
 import numpy as np
 
+from labkit import scene_schema
 from labkit.harness import SCENES
 
 
@@ -167,20 +168,12 @@ def glass_slab_radiance(scene: dict, bounces: int, angle_deg: float = 0.0) -> fl
     return value
 
 
-# How each list of primitives in a scene file is written: what each field of an entry is (a
-# point, a list of points, a length or a unit direction), so that a move, a rotation or a scale
-# changes it as it should. The C++ kinds declare theirs in common/core/ (primitive_kinds.h).
-PRIMITIVE_FIELDS = {
-    "spheres": {"center": "point", "radius": "length"},
-    "triangles": {"vertices": "points"},
-    "quads": {"vertices": "points"},
-}
-
-
 def _mapped(scene: dict, point, scale: float, direction=None) -> dict:
     """A copy of `scene` with every point mapped by `point`, every length multiplied by `scale`
     (the light's intensity by its square) and, given `direction`, every direction (the camera's
-    up included) mapped by it."""
+    up included) mapped by it. What each primitive list's fields are (a point, a list of
+    points, a length or a unit direction) is the renderer's own declaration of its kinds, read
+    from `--scene-schema` (scene_schema.py)."""
     s = json.loads(json.dumps(scene))
     s["camera"]["position"] = point(s["camera"]["position"])
     s["camera"]["look_at"] = point(s["camera"]["look_at"])
@@ -190,7 +183,7 @@ def _mapped(scene: dict, point, scale: float, direction=None) -> dict:
         s["light"]["position"] = point(s["light"]["position"])
         if scale != 1:
             s["light"]["intensity"] = [c * scale**2 for c in s["light"]["intensity"]]
-    for key, fields in PRIMITIVE_FIELDS.items():
+    for key, fields in scene_schema.primitive_fields().items():
         for prim in s.get(key, []):
             for name, what in fields.items():
                 if what == "point":

@@ -1,8 +1,10 @@
 // How a primitive kind of a few numbers is written in a scene file: a list under its file key
 // ("spheres"), each entry its fields and a "material". The loader, the centring, the scene
 // limits and the report handle every kind declared this way alike (host/scene_loader.cpp,
-// scene_centring.cpp, scene_limits.cpp, scene_report.cpp); triangles and quads, written as
-// lists of vertices, have their own. A kind written as fields declares
+// scene_centring.cpp, scene_limits.cpp, scene_report.cpp), and `--scene-schema` prints its
+// fields' roles (host/scene_schema.cpp), by which labkit/scenes.py moves and scales scenes;
+// triangles and quads, written as lists of vertices, have their own (host/scene_schema.h). A
+// kind written as fields declares
 //   kFileKey                 its list's key in a scene file;
 //   kFields                  its fields (FileField), in order;
 //   from_fields(KindTag<K>{}, values, material)  the primitive of its fields' values (3 numbers

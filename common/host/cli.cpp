@@ -6,6 +6,7 @@
 #include <cstring>
 
 #include <errors.h>
+#include <scene_schema.h>
 
 #ifndef RT_SOURCE_DIR
 #define RT_SOURCE_DIR "."
@@ -19,9 +20,11 @@ static void print_usage(const char* program) {
     std::printf(
         "usage: %s [--scene FILE.json] [--width W] [--height H] [--spp S] [--bounces B]\n"
         "          [--seed N] [--out IMAGE.ppm] [--pfm IMAGE.pfm] [--threads T]\n"
-        "          [--quiet] [--json]\n"
+        "          [--quiet] [--json] [--scene-schema] [--help]\n"
         "Renders a scene with a Monte Carlo path tracer. Defaults: common/scenes/cornell.json,\n"
-        "the scene's own render settings (else 600x600, 512 spp, 4 bounces), seed 0.\n",
+        "the scene's own render settings (else 600x600, 512 spp, 4 bounces), seed 0.\n"
+        "--scene-schema prints the scene file's primitive lists and material types (JSON)\n"
+        "and exits, rendering nothing.\n",
         program);
 }
 
@@ -47,6 +50,9 @@ Options parse_options(int argc, char** argv, const char* program) {
         };
         if (flag == "--help" || flag == "-h") {
             print_usage(program);
+            std::exit(0);
+        } else if (flag == "--scene-schema") {  // exits as --help does, at its place
+            std::printf("%s\n", scene_schema_json().c_str());
             std::exit(0);
         } else if (flag == "--scene") {
             o.scene_path = value();

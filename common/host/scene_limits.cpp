@@ -5,6 +5,7 @@
 #include <cstdio>
 
 #include <scene_centring.h>
+#include <scene_schema.h>
 
 const PrecisionLimits kFloatLimits{"float",           1e9,     "1e9", 1e-9, "1e-9",
                                    8.0 * FLT_EPSILON, "2^-20", false};
@@ -101,8 +102,9 @@ PlacementProblem placement_problem(const Scene& scene, size_t file_triangles,
     const WrittenCoordinates& w = scene.written;
     // Where the i-th triangle of the scene is written: a triangle, or one half of a quad.
     const auto triangle_pointer = [&](size_t i) {
-        return i < file_triangles ? "/triangles/" + std::to_string(i)
-                                  : "/quads/" + std::to_string((i - file_triangles) / 2);
+        return i < file_triangles ? std::string("/") + kTriangleList.key + "/" + std::to_string(i)
+                                  : std::string("/") + kQuadList.key + "/" +
+                                        std::to_string((i - file_triangles) / 2);
     };
     // A triangle's k-th point in the file: a quad's second half is its v0 v2 v3.
     const auto vertex_pointer = [&](size_t i, int k) {

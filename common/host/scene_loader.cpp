@@ -14,6 +14,7 @@
 #include <json_with_positions.h>
 #include <scene_centring.h>
 #include <scene_limits.h>
+#include <scene_schema.h>
 #include <t_junctions.h>
 
 using nlohmann::json;
@@ -354,19 +355,19 @@ void read_fields_kind(const SceneReader& r, const PrimitiveReader& prims, Scene&
 // Triangles, then quads, each checked as the two triangles v0 v1 v2 and v0 v2 v3
 // (classify_quads then makes most of them one primitive).
 void read_triangles(const SceneReader& r, const PrimitiveReader& prims, Scene& scene) {
-    const json& triangles = prims.list("triangles");
+    const json& triangles = prims.list(kTriangleList.key);
     for (size_t i = 0; i < triangles.size(); ++i) {
-        const std::string p = "/triangles/" + std::to_string(i);
+        const std::string p = std::string("/") + kTriangleList.key + "/" + std::to_string(i);
         r.check_keys(triangles[i], p, {"vertices", "material"});
-        const auto v = prims.vertices(triangles[i], p, 3);
+        const auto v = prims.vertices(triangles[i], p, kTriangleList.vertices);
         scene.of<Triangle>().push_back(
             read_triangle(triangles[i], v, 0, 1, 2, prims.material(triangles[i], p), scene));
     }
-    const json& quads = prims.list("quads");
+    const json& quads = prims.list(kQuadList.key);
     for (size_t i = 0; i < quads.size(); ++i) {
-        const std::string p = "/quads/" + std::to_string(i);
+        const std::string p = std::string("/") + kQuadList.key + "/" + std::to_string(i);
         r.check_keys(quads[i], p, {"vertices", "material"});
-        const auto v = prims.vertices(quads[i], p, 4);
+        const auto v = prims.vertices(quads[i], p, kQuadList.vertices);
         const int m = prims.material(quads[i], p);
         scene.of<Triangle>().push_back(read_triangle(quads[i], v, 0, 1, 2, m, scene));
         scene.of<Triangle>().push_back(read_triangle(quads[i], v, 0, 2, 3, m, scene));
@@ -504,7 +505,7 @@ Scene parse_scene(const std::string& text, const std::string& name) {
         r.fail_key(parsed.duplicate_key_pointer, "duplicate key \"" + parsed.duplicate_key + "\"");
     std::vector<const char*> keys = {"camera", "background", "light", "materials"};
     for_each_fields_kind([&](auto kind) { keys.push_back(decltype(kind)::type::kFileKey); });
-    keys.insert(keys.end(), {"triangles", "quads", "render"});
+    keys.insert(keys.end(), {kTriangleList.key, kQuadList.key, "render"});
     r.check_keys(root, "", keys);
 
     Scene scene;
@@ -519,7 +520,8 @@ Scene parse_scene(const std::string& text, const std::string& name) {
         [&](auto kind) { read_fields_kind<typename decltype(kind)::type>(r, prims, scene); });
     read_triangles(r, prims, scene);
     read_render_settings(r, root, scene.render);
-    const size_t file_triangles = root.contains("triangles") ? root["triangles"].size() : 0;
+    const size_t file_triangles =
+        root.contains(kTriangleList.key) ? root[kTriangleList.key].size() : 0;
     check_placement(r, scene, file_triangles);
     classify_quads(scene, file_triangles);
     scene.t_junction_pieces = split_t_junctions(scene);

@@ -10,8 +10,8 @@
 #include "errors.h"
 #include "lab.h"
 
-// Ends MPI once, however the process ends: a normal return, or `--help`, which exits from
-// inside the flag parser.
+// Ends MPI once, however the process ends: a normal return, or `--help` or `--scene-schema`,
+// which exit from inside the flag parser.
 static void finalize_mpi() {
     int finalized = 0;
     MPI_Finalized(&finalized);
@@ -53,7 +53,7 @@ int main(int argc, char** argv) {
     int rank = 0;
     MPI_Comm_rank(MPI_COMM_WORLD, &rank);
     // Rank 0 speaks for everyone; the driver keeps the others quiet, and this keeps `--help`
-    // from printing its usage once per rank.
+    // and `--scene-schema` from printing once per rank.
     if (rank != 0 && !std::freopen("/dev/null", "w", stdout)) return 1;
 
     LabHooks hooks;

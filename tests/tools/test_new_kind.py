@@ -3,8 +3,11 @@ them (tests/tools/new_kind/*.diff), each touch a handful of files and work in ev
 
 Both diffs are applied with `git apply` to one scratch copy of the repository (test_new_lab's);
 then, in the copy:
-- each diff touches at most its number of files, tests included (disk 6, rough metal 4), and
-  `git status` shows those files and nothing else;
+- each diff touches at most its number of files, tests included (disk 4, rough metal 3), none
+  under labkit/ and not DESIGN.md, and `git status` shows those files and nothing else but
+  DESIGN.md, whose table of scene-file lists and types is regenerated from the built
+  renderer's `--scene-schema` (python3 -m labkit.scene_schema --write) and now lists both;
+- labkit/scenes.py, unchanged, moves, turns and scales a disk by its declared fields;
 - the CPU references and the unit tests build (the diffs' own unit tests run there), and the
   references render the Cornell box and the showcase to the bits this checkout's render;
 - a disk renders right in labs 01, 02 and 03: a lit disk seen from above, one bounce, against
@@ -24,13 +27,17 @@ import shutil
 import numpy as np
 import pytest
 
+from labkit import scene_schema
 from labkit.harness import ROOT
 from labkit.pfm import read_pfm
 from labkit.scenes import camera_rays
 from tests.tools.test_new_lab import run, scratch_copy
 
 EXAMPLES = pathlib.Path(__file__).parent / "new_kind"
-MOST_FILES = {"disk.diff": 6, "rough_metal.diff": 4}
+MOST_FILES = {"disk.diff": 4, "rough_metal.diff": 3}
+# What a kind never edits by hand: Python reads its schema from the renderer, and DESIGN.md's
+# table of it is generated.
+NEVER_TOUCHED = ("labkit/", "DESIGN.md")
 LABS = ("lab01-ref", "lab02-ref", "lab03-ref")
 
 
@@ -42,12 +49,14 @@ def touched(diff: pathlib.Path) -> set[str]:
 
 @pytest.fixture(scope="module")
 def copy(tmp_path_factory):
-    """The scratch copy with both examples applied and the CPU references built."""
+    """The scratch copy with both examples applied, the CPU references built and DESIGN.md's
+    generated table rewritten."""
     root = scratch_copy(tmp_path_factory.mktemp("new_kind"))
     for diff in sorted(EXAMPLES.glob("*.diff")):
         run(root, "git", "apply", "--whitespace=error-all", str(diff))
     run(root, "make", f"-j{os.cpu_count() or 1}", *LABS, "build/unit_tests", "CI=true",
         timeout=1800)
+    run(root, "python3", "-m", "labkit.scene_schema", "--write")
     return root
 
 
@@ -68,10 +77,35 @@ def test_each_example_touches_few_files_and_nothing_else_changes(copy):
     for name, most in MOST_FILES.items():
         files = touched(EXAMPLES / name)
         assert 0 < len(files) <= most, f"{name} touches {len(files)} files: {sorted(files)}"
+        assert not [f for f in files if f.startswith(NEVER_TOUCHED)], sorted(files)
         changed |= files
     status = run(copy, "git", "status", "--porcelain", "--untracked-files=all").stdout
-    # What the build writes is ignored; what the examples wrote is all that git sees.
-    assert {line[3:] for line in status.splitlines()} == changed, status
+    # What the build writes is ignored; what the examples wrote, and the regenerated table, is
+    # all that git sees.
+    assert {line[3:] for line in status.splitlines()} == changed | {"DESIGN.md"}, status
+
+
+def test_design_lists_both_kinds_and_changes_only_in_its_generated_table(copy):
+    run(copy, "python3", "-m", "labkit.scene_schema", "--check")
+    text = (copy / "DESIGN.md").read_text()
+    table = scene_schema.current(text)
+    assert "| `disks` | `center`: a point [x, y, z]; `normal`: a direction" in table
+    assert "| `rough_metal` | `albedo`: RGB, each in [0, 1]; `roughness`: a roughness in [0, 1] |" \
+        in table
+    here = (ROOT / "DESIGN.md").read_text()
+    assert text.replace(table, "") == here.replace(scene_schema.current(here), "")
+
+
+def test_scenes_move_a_disk_by_its_declared_fields(copy):
+    """The copy's labkit/scenes.py, untouched, reads the disk's fields from the copy's
+    renderer: a quarter turn about z turns its normal, a scale of 2 doubles its radius."""
+    made = run(copy, "python3", "-c", "import json, numpy as np; from labkit import scenes; "
+               f"s = json.loads({json.dumps(DISK)!r}); "
+               "m = np.array([[0.0, -1, 0], [1, 0, 0], [0, 0, 1]]); "
+               "print(json.dumps(scenes.transformed(s, m, offset=(0, 0, 1), scale=2.0)))")
+    disk = json.loads(made.stdout)["disks"][0]
+    assert np.allclose(disk["center"], [0, 0, 1]) and np.allclose(disk["normal"], [-1, 0, 0])
+    assert disk["radius"] == 2 * DISK["disks"][0]["radius"]
 
 
 def test_the_examples_unit_tests_pass(copy):

@@ -11,6 +11,7 @@
 
 #include "cli.h"
 #include "errors.h"
+#include "scene_schema.h"
 
 namespace {
 
@@ -166,4 +167,22 @@ TEST(Cli, SettingsForAppliesOverridesOnly) {
     EXPECT_EQ(all.spp, 3);
     EXPECT_EQ(all.bounces, 4);
     EXPECT_EQ(all.seed, 5u);
+}
+
+TEST(Cli, SceneSchemaPrintsJsonAndExitsZero) {
+    GTEST_FLAG_SET(death_test_style, "threadsafe");
+    const std::string out = ::testing::TempDir() + "rt-unit-scene-schema.txt";
+    std::remove(out.c_str());
+    EXPECT_EXIT(
+        {
+            if (!std::freopen(out.c_str(), "w", stdout)) std::exit(3);
+            parse({"--spp", "4", "--scene-schema", "--width", "0"});  // read no further
+        },
+        ::testing::ExitedWithCode(0), "");
+    std::ifstream in(out);
+    const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    EXPECT_EQ(text, scene_schema_json() + "\n");
+    std::remove(out.c_str());
+    // A bad flag before it is an error, as before --help.
+    expect_bad({"--width", "0", "--scene-schema"}, "--width");
 }
