@@ -6,6 +6,10 @@
 
 #include <scene_centring.h>
 
+const char* const kDoublePlacesIt =
+    "double places it: the references switch to it by themselves (./lab01-ref), or make "
+    "lab01-ref-double";
+
 const PrecisionLimits kFloatLimits{"float",           1e9,     "1e9", 1e-9, "1e-9",
                                    8.0 * FLT_EPSILON, "2^-20", false};
 const PrecisionLimits kDoubleLimits{"double",          1e30,    "1e30", 1e-30, "1e-30",

@@ -40,6 +40,9 @@ struct PrecisionLimits {
     double min_scene_relative_size() const { return relative_offset; }  // to the scene's extent
 };
 
+// The end of a PrecisionError's line: what to do about it.
+extern const char* const kDoublePlacesIt;
+
 extern const PrecisionLimits kFloatLimits;
 extern const PrecisionLimits kDoubleLimits;
 const PrecisionLimits& build_limits();  // the one this build renders with (real.h)

@@ -8,11 +8,12 @@ references render them in double by themselves (common/host/double_twin.h)."""
 import os
 import subprocess
 
+import numpy as np
 import pytest
 
 from grading import checks
 from grading.renderer_checks import CHECKS
-from labkit import scenes
+from labkit import harness, scenes
 from labkit.harness import ROOT, build, run_lab
 
 
@@ -144,3 +145,35 @@ def test_mixing_double_and_float_objects_fails_to_link(tmp_path):
     assert p.returncode != 0 and "undefined reference to `render(" in p.stderr, \
         p.stdout + p.stderr
     assert not (tmp_path / "lab").exists()
+
+
+def _nan_cornell(tmp_path, intensity):
+    """The Cornell box with white walls of albedo (1, 0, 1), the green wall (0, 1, 0) and the
+    light at `intensity` 0.01 from the green wall: a light sample's product overflowed float
+    and met the zero channel of a path's throughput (0 * inf; 49 NaN values of 768 at 3e38)."""
+    scene = scenes.load("cornell")
+    scene["materials"]["white"]["albedo"] = [1, 0, 1]
+    scene["materials"]["green"]["albedo"] = [0, 1, 0]
+    scene["light"] = {"position": [0.99, 0.5, -0.5], "intensity": [intensity] * 3}
+    return scenes.write_scene(tmp_path / f"bright-{intensity:g}.json", scene)
+
+
+@pytest.mark.parametrize("target", ["lab01-ref", "lab01-ref-double", "lab02-ref", "lab03-ref"])
+def test_no_nan_up_to_the_largest_intensity(target, tmp_path):
+    """Intensities up to float's largest with zero albedo channels, 4 bounces: every CPU lab
+    either renders an image without NaN or, where float's products could overflow, renders
+    in double (the references) or refuses in one line that double places it (lab 02)."""
+    if target == "lab02-ref" and not harness.cpu_has_avx2():
+        pytest.skip("this CPU has no AVX2/FMA")
+    binary = build(target)[0]
+    for intensity in (1e30, 3e38, 3.4e38):
+        run = run_lab(binary, _nan_cornell(tmp_path, intensity), width=16, height=16, spp=4,
+                      bounces=4, seed=1, check=False)
+        if run.returncode != 0:
+            lines = run.stderr.strip().splitlines()
+            assert run.returncode == 2 and len(lines) == 1, (intensity, run.stderr)
+            assert "double places it" in lines[0], lines[0]
+            continue
+        assert run.image is not None, intensity
+        assert not np.isnan(run.image).any(), \
+            f"{target} at intensity {intensity:g}: {int(np.isnan(run.image).sum())} NaN values"

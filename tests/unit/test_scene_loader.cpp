@@ -7,6 +7,7 @@
 // "line L, column C" from the marker's place, then removes it before parsing.
 #include <gtest/gtest.h>
 
+#include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
@@ -15,6 +16,7 @@
 #include <vector>
 
 #include "errors.h"
+#include "json_with_positions.h"
 #include "scene_centring.h"
 #include "scene_loader.h"
 
@@ -607,12 +609,105 @@ TEST(SceneLoaderErrors, ArrayOfFourWhereThreeExpected) {
 }
 
 // A coordinate is judged once the scene is centred (test_scene_limits.cpp); any other number
-// must be within the type's range as written.
-TEST(SceneLoaderErrors, NumberTooLargeForFloat) {
-    expect_error(scene_with(kGoodSphere,
-                            "  \"light\": { \"position\": [0, 1, 0], "
-                            "\"intensity\": [1, @1e39, 1] },\n"),
-                 {"float range"});
+// beyond float's range, which double holds, is a PrecisionError in the float build (a
+// reference renders it in double) and loads in the double build.
+TEST(SceneLoaderErrors, NumberBeyondFloatsRangeIsForDouble) {
+    const Marked m = unmark(scene_with(kGoodSphere,
+                                       "  \"light\": { \"position\": [0, 1, 0], "
+                                       "\"intensity\": [1, @1e39, 1] },\n"));
+    if (std::string(kPrecisionName) == "double") {
+        EXPECT_EQ(parse_scene(m.text, kName).light.intensity.y, real(1e39));
+        return;
+    }
+    try {
+        parse_scene(m.text, kName);
+        ADD_FAILURE() << "an intensity of 1e39 loaded in float";
+    } catch (const PrecisionError& e) {
+        const std::string message = e.what();
+        EXPECT_NE(message.find(m.position), std::string::npos) << message;
+        EXPECT_NE(message.find("1e+39 is beyond float's range"), std::string::npos) << message;
+        EXPECT_NE(message.find("double places it"), std::string::npos) << message;
+    }
+}
+
+// A value out of its field's range as written is refused in every build with the same
+// message, even where float rounds it into the range (1 + 1e-9 rounds to 1, 5 + 1e-7 to 5).
+TEST(SceneLoaderErrors, RangesAreJudgedOnTheWrittenNumber) {
+    const auto material = [](const std::string& fields) {
+        return "{\n"
+               "  \"camera\": { \"position\": [0, 0, 5], \"look_at\": [0, 0, 0] },\n"
+               "  \"materials\": { \"m\": { " +
+               fields +
+               " } },\n"
+               "  \"spheres\": [ { \"center\": [0, 0, 0], \"radius\": 1, \"material\": \"m\" } ]\n"
+               "}\n";
+    };
+    expect_error(material("\"type\": \"diffuse\", \"albedo\": @[0.5, 1.000000001, 0.5]"),
+                 {"/materials/m/albedo", "in [0, 1]"});
+    expect_error(material("\"type\": \"diffuse\", \"albedo\": @[0.5, -1e-50, 0.5]"),
+                 {"/materials/m/albedo", ">= 0"});
+    expect_error(material("\"type\": \"glass\", \"ior\": @5.0000001"),
+                 {"/materials/m/ior", "an index of refraction in [1, 5]"});
+    expect_error(material("\"type\": \"glass\", \"ior\": @0.99999999999"),
+                 {"/materials/m/ior", "in [1, 5]"});
+    expect_error(material("\"type\": \"diffuse\", \"albedo\": @[0.5, 1e39, 0.5]"),
+                 {"in [0, 1]"});  // out of its own range first: not a precision matter
+    expect_error(scene_with(kGoodSphere, "  \"background\": @[0, -1e-40, 0],\n"),
+                 {"/background", ">= 0"});
+    // Within the range as written: loads in both builds, at the value as written.
+    EXPECT_EQ(parse_scene(material("\"type\": \"glass\", \"ior\": 5"), kName).materials[0].ior,
+              real(5));
+}
+
+// A field of view of 179.99999999 degrees lies in (0, 180) as written: double renders it;
+// float rounds it to 180, so the float build sends it to double with a message that says so.
+TEST(SceneLoaderErrors, FieldOfViewThatFloatRoundsOutOfItsRange) {
+    const Marked m = unmark(
+        "{\n"
+        "  \"camera\": { \"position\": [0, 0, 5], \"look_at\": [0, 0, 0], \"vfov\": @179.99999999 },\n"
+        "  \"materials\": { \"w\": { \"type\": \"diffuse\", \"albedo\": [0.5, 0.5, 0.5] } },\n"
+        "  \"spheres\": [ { \"center\": [0, 0, 0], \"radius\": 1, \"material\": \"w\" } ]\n"
+        "}\n");
+    if (std::string(kPrecisionName) == "double") {
+        EXPECT_LT(parse_scene(m.text, kName).camera.vfov_degrees, 180.0);
+        return;
+    }
+    try {
+        parse_scene(m.text, kName);
+        ADD_FAILURE() << "a field of view float rounds to 180 loaded in float";
+    } catch (const PrecisionError& e) {
+        const std::string message = e.what();
+        EXPECT_NE(message.find(m.position), std::string::npos) << message;
+        EXPECT_NE(message.find("179.99999999 rounds to 180 in float"), std::string::npos)
+            << message;
+    }
+    // 180 itself and beyond are out of the range as written, in every build.
+    expect_error(
+        "{\n"
+        "  \"camera\": { \"position\": [0, 0, 5], \"look_at\": [0, 0, 0], \"vfov\": @180.0000001 },\n"
+        "  \"materials\": { \"w\": { \"type\": \"diffuse\", \"albedo\": [0.5, 0.5, 0.5] } }\n"
+        "}\n",
+        {"expected a field of view in degrees, in (0, 180)"});
+}
+
+// Nesting deeper than any scene file needs is refused before parsing, at the bracket that
+// goes past the limit, at once (100,000 brackets took 23 s and 3 GB before).
+TEST(SceneLoaderErrors, DeepNestingIsRefusedAtOnce) {
+    std::string text = "{\"camera\": " + std::string(kMaxJsonDepth - 1, '[');
+    const size_t column = text.size() + 1;  // the bracket one past the limit
+    text += std::string(100000, '[') + std::string(100000 + kMaxJsonDepth - 1, ']') + "}";
+    const auto start = std::chrono::steady_clock::now();
+    const std::string message = error_of(text);
+    const double seconds =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    EXPECT_LT(seconds, 0.5);
+    EXPECT_NE(message.find("line 1, column " + std::to_string(column) + ": nesting deeper than 32"),
+              std::string::npos)
+        << message;
+    // Brackets inside strings are text, not nesting: this is refused for its key, not its depth.
+    const std::string in_string = "{\"camera\": {\"name\": \"" + std::string(100, '[') + "\\\"" +
+                                  std::string(100, '{') + "\"}}";
+    EXPECT_NE(error_of(in_string).find("unknown key \"name\""), std::string::npos);
 }
 
 TEST(SceneLoaderErrors, QuadWithThreeVertices) {
