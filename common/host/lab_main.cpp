@@ -76,6 +76,8 @@ static int run(int argc, char** argv, const LabHooks& hooks, bool& setup_reporte
                      precision.c_str());
         const std::string warning = scale_warning(use);
         if (!warning.empty()) std::fprintf(stderr, "%s\n", warning.c_str());
+        const std::string lines = lines_left_out(use);
+        if (!lines.empty()) std::fprintf(stderr, "%s\n", lines.c_str());
     }
 
     // Open the outputs before rendering: a bad path fails in a millisecond, not after the

@@ -68,6 +68,10 @@ double largest(const WrittenPoint& p) {
     return std::fmax(std::fabs(p.x), std::fmax(std::fabs(p.y), std::fabs(p.z)));
 }
 
+double distance(const WrittenPoint& a, const WrittenPoint& b) {
+    return std::hypot(a.x - b.x, a.y - b.y, a.z - b.z);
+}
+
 // Calls f(KindTag<K>{}, pointer, written, i) for every entry i of every kind K written as fields
 // (file_fields.h), in AllPrimitives' order: pointer is where the file writes it ("/spheres/0").
 template <class F>
@@ -95,6 +99,18 @@ double fields_extent(const WrittenFields<K>& written, size_t i, const Centred& c
 }
 
 }  // namespace
+
+bool on_a_line(const WrittenPoint (&v)[3]) {
+    const double e1[3] = {v[1].x - v[0].x, v[1].y - v[0].y, v[1].z - v[0].z};
+    const double e2[3] = {v[2].x - v[0].x, v[2].y - v[0].y, v[2].z - v[0].z};
+    const double twice_area =
+        std::hypot(e1[1] * e2[2] - e1[2] * e2[1], e1[2] * e2[0] - e1[0] * e2[2],
+                   e1[0] * e2[1] - e1[1] * e2[0]);
+    const double longest =
+        std::fmax(distance(v[0], v[1]), std::fmax(distance(v[1], v[2]), distance(v[2], v[0])));
+    const double coordinates = std::fmax(largest(v[0]), std::fmax(largest(v[1]), largest(v[2])));
+    return !(twice_area > 8.0 * DBL_EPSILON * coordinates * longest);
+}
 
 PlacementProblem placement_problem(const Scene& scene, size_t file_triangles,
                                    const PrecisionLimits& limits) {
@@ -140,7 +156,13 @@ PlacementProblem placement_problem(const Scene& scene, size_t file_triangles,
         });
     });
     if (!first.empty()) return first;
+    // A triangle on a line is left out by the loader (on_a_line): no limit judges it.
+    const auto line = [&](size_t i) {
+        const WrittenPoint* v = &w.triangle_vertices[3 * i];
+        return on_a_line({v[0], v[1], v[2]});
+    };
     for (size_t i = 0; i < w.triangle_vertices.size(); ++i) {
+        if (line(i / 3)) continue;
         const PlacementProblem problem =
             coordinate(w.triangle_vertices[i], vertex_pointer(i / 3, static_cast<int>(i % 3)));
         if (!problem.empty()) return problem;
@@ -164,8 +186,8 @@ PlacementProblem placement_problem(const Scene& scene, size_t file_triangles,
         extent =
             std::fmax(extent, fields_extent<typename decltype(kind)::type>(written, i, centred));
     });
-    for (const WrittenPoint& v : w.triangle_vertices)
-        extent = std::fmax(extent, largest(centred(v)));
+    for (size_t i = 0; i < w.triangle_vertices.size(); ++i)
+        if (!line(i / 3)) extent = std::fmax(extent, largest(centred(w.triangle_vertices[i])));
 
     // Each length against the type's range, its own entry's extent and the scene's.
     for_each_fields_entry(w, [&](auto kind, const std::string& p, const auto& written, size_t i) {
@@ -191,13 +213,9 @@ PlacementProblem placement_problem(const Scene& scene, size_t file_triangles,
         const WrittenPoint v[3] = {centred(w.triangle_vertices[3 * i]),
                                    centred(w.triangle_vertices[3 * i + 1]),
                                    centred(w.triangle_vertices[3 * i + 2])};
-        // The differences of the written points, which centring leaves as they were.
+        // The written points, whose differences centring leaves as they were.
         const WrittenPoint* raw = &w.triangle_vertices[3 * i];
-        const double r1[3] = {raw[1].x - raw[0].x, raw[1].y - raw[0].y, raw[1].z - raw[0].z};
-        const double r2[3] = {raw[2].x - raw[0].x, raw[2].y - raw[0].y, raw[2].z - raw[0].z};
-        if (r1[1] * r2[2] == r1[2] * r2[1] && r1[2] * r2[0] == r1[0] * r2[2] &&
-            r1[0] * r2[1] == r1[1] * r2[0])
-            continue;  // no area as written: nothing to show, kept and never hit
+        if (line(i)) continue;
         const auto edge = [&](int a, int b) {
             return std::hypot(raw[a].x - raw[b].x, raw[a].y - raw[b].y, raw[a].z - raw[b].z);
         };

@@ -18,8 +18,13 @@
 //    floor of half-size 1e4 rendered the floor 10% too dark). Details down to 64 offsets
 //    render with a warning (scene_report.h).
 //  - A triangle with an area as written must keep one when its centred vertices are rounded
-//    to the type (else its normal is zero and it is never hit). One that has no area as
-//    written is kept: it has nothing to show.
+//    to the type (else its normal is zero and it is never hit).
+//  - A triangle whose written points lie on a line, to within the rounding of the file's
+//    numbers to double (on_a_line), has no area at any precision: the loader leaves it out in
+//    every build and the driver says so in one line; it is judged by no other limit.
+//    (Rounded to float, a triangle nearly collinear as written either collapsed, and the
+//    references switched to double while lab 02 refused it, or kept a sliver of area with a
+//    normal made of rounding; neither is the file's intent.)
 #pragma once
 
 #include <string>
@@ -42,6 +47,12 @@ struct PrecisionLimits {
 
 // The end of a PrecisionError's line: what to do about it.
 extern const char* const kDoublePlacesIt;
+
+// Whether a triangle's points, as the file writes them, lie on a line to within the rounding
+// of the file's decimals to double: its height over its longest edge is at most 8 ulps of its
+// largest |coordinate| (each written coordinate is off by up to half an ulp, which moves the
+// height by about 3 ulps; the cross product's own rounding adds about as much).
+bool on_a_line(const WrittenPoint (&v)[3]);
 
 extern const PrecisionLimits kFloatLimits;
 extern const PrecisionLimits kDoubleLimits;

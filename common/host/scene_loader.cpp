@@ -502,6 +502,11 @@ void classify_quads(Scene& scene, size_t file_triangles) {
         for (int k = 0; k < 4; ++k) v[k] = moved_to_centre(written[6 * i + corner[k]], centre);
         axis[i] = axis_rect_axis(v);
         kind[i] = axis[i] >= 0 ? kRect : (is_planar_convex_quad(v) ? kQuad : kTriangles);
+        // Three points on a line as written: two triangles, of which the line is left out,
+        // whatever rounding to `real` made of the corner (drop_line_triangles).
+        if (on_a_line({written[6 * i], written[6 * i + 1], written[6 * i + 2]}) ||
+            on_a_line({written[6 * i + 3], written[6 * i + 4], written[6 * i + 5]}))
+            kind[i] = kTriangles;
         rendered[i] = {v[0], v[1], v[2], v[3]};
         if (kind[i] != kRect) add_edges(v, 4);  // two triangles: their outline is the quad's
     }
@@ -546,6 +551,34 @@ void classify_quads(Scene& scene, size_t file_triangles) {
     }
 }
 
+// The triangles whose written points lie on a line (scene_limits.h, on_a_line), which the
+// loader leaves out in every build alike: counts them and names the first as the file writes
+// it. A quad with such a half becomes two triangles (classify_quads), so every one of them
+// is left out by drop_line_triangles.
+void count_line_triangles(Scene& scene, size_t file_triangles) {
+    const std::vector<WrittenPoint>& all = scene.written.triangle_vertices;
+    for (size_t i = 0; 3 * i < all.size(); ++i) {
+        if (!on_a_line({all[3 * i], all[3 * i + 1], all[3 * i + 2]})) continue;
+        if (++scene.line_triangles == 1)
+            scene.first_line_triangle = i < file_triangles
+                                            ? "/triangles/" + std::to_string(i)
+                                            : "/quads/" + std::to_string((i - file_triangles) / 2);
+    }
+}
+
+void drop_line_triangles(Scene& scene) {
+    std::vector<Triangle> kept;
+    std::vector<WrittenPoint> kept_points;
+    const std::vector<WrittenPoint>& all = scene.written.triangle_vertices;
+    for (size_t i = 0; i < scene.of<Triangle>().size(); ++i) {
+        if (on_a_line({all[3 * i], all[3 * i + 1], all[3 * i + 2]})) continue;
+        kept.push_back(scene.of<Triangle>()[i]);
+        kept_points.insert(kept_points.end(), all.begin() + 3 * i, all.begin() + 3 * i + 3);
+    }
+    scene.of<Triangle>() = std::move(kept);
+    scene.written.triangle_vertices = std::move(kept_points);
+}
+
 }  // namespace
 
 Scene parse_scene(const std::string& text, const std::string& name) {
@@ -573,7 +606,9 @@ Scene parse_scene(const std::string& text, const std::string& name) {
     read_render_settings(r, root, scene.render);
     const size_t file_triangles = root.contains("triangles") ? root["triangles"].size() : 0;
     check_placement(r, scene, file_triangles);
+    count_line_triangles(scene, file_triangles);
     classify_quads(scene, file_triangles);
+    if (scene.line_triangles > 0) drop_line_triangles(scene);
     scene.t_junction_pieces = split_t_junctions(scene);
     return scene;
 }

@@ -21,6 +21,8 @@ struct SceneUse {
     bool background = false;  // a background that is not black
     double smallest = 0;  // the smallest radius or longest edge (0: no primitive)
     double extent = 0;  // the largest |coordinate| of any primitive, after centring
+    int line_triangles = 0;  // triangles of the file left out: their points lie on a line
+    std::string first_line_triangle;  // where the first is written ("/triangles/3")
 
     template <class K>
     int primitives_of() const {
@@ -40,4 +42,5 @@ constexpr double kResolvedDetail = 64.0 * kRelativeOffset;
 SceneUse scene_use(const Scene& scene);
 std::string describe(const SceneUse& use);  // one line
 std::string scale_warning(const SceneUse& use);  // one line with what to do, or ""
+std::string lines_left_out(const SceneUse& use);  // one line saying so, or ""
 std::string to_json(const SceneUse& use);  // an object for --json
