@@ -3,6 +3,8 @@
 #include <cfloat>
 #include <cmath>
 #include <cstdio>
+#include <string>
+#include <vector>
 
 #include <scene_centring.h>
 
@@ -10,10 +12,10 @@ const char* const kDoublePlacesIt =
     "double places it: the references switch to it by themselves (./lab01-ref), or make "
     "lab01-ref-double";
 
-const PrecisionLimits kFloatLimits{"float",           1e9,     "1e9", 1e-9, "1e-9",
-                                   8.0 * FLT_EPSILON, "2^-20", false};
-const PrecisionLimits kDoubleLimits{"double",          1e30,    "1e30", 1e-30, "1e-30",
-                                    8.0 * DBL_EPSILON, "2^-49", true};
+const PrecisionLimits kFloatLimits{"float", 1e9,   "1e9",   1e-9,    "1e-9",  8.0 * FLT_EPSILON,
+                                   "2^-20", false, "2^-13", FLT_MAX, "3.4e38"};
+const PrecisionLimits kDoubleLimits{"double", 1e30, "1e30",  1e-30,   "1e-30",  8.0 * DBL_EPSILON,
+                                    "2^-49",  true, "2^-42", DBL_MAX, "1.8e308"};
 
 const PrecisionLimits& build_limits() {
 #if defined(RT_DOUBLE)
@@ -45,12 +47,13 @@ std::string size_problem(const char* what, double size, double extent,
     return "";
 }
 
-std::string scene_scale_problem(const char* what, double size, double scene_extent,
+std::string scene_scale_problem(const char* what, double size, double reach,
                                 const PrecisionLimits& limits) {
-    if (!(size < limits.min_scene_relative_size() * scene_extent)) return "";
+    if (!(size < limits.min_scene_relative_size() * reach)) return "";
     return std::string(what) + " of " + format_number(size) + " is below " +
-           limits.relative_offset_text + " of the scene's extent (" + format_number(scene_extent) +
-           " from its centre), finer than " + limits.name + " arithmetic places it there";
+           limits.scene_relative_text + " of the scene's reach (" + format_number(reach) +
+           " from its centre, camera and light included), finer than " + limits.name +
+           " arithmetic places it there";
 }
 
 // Whether a triangle with an area as written loses it when its points are rounded to T: the
@@ -188,6 +191,13 @@ PlacementProblem placement_problem(const Scene& scene, size_t file_triangles,
     });
     for (size_t i = 0; i < w.triangle_vertices.size(); ++i)
         if (!line(i / 3)) extent = std::fmax(extent, largest(centred(w.triangle_vertices[i])));
+    // The scene's reach: the extent, or the distance of the camera or the light from the
+    // centre, where a ray's first offset is sized (ray.h: it grows with t).
+    const WrittenPoint origin{0.0, 0.0, 0.0};
+    double reach = extent;
+    if (scene.camera.written)
+        reach = std::fmax(reach, distance(centred(scene.camera.written_position), origin));
+    if (scene.has_light) reach = std::fmax(reach, distance(centred(w.light_position), origin));
 
     // Each length against the type's range, its own entry's extent and the scene's.
     for_each_fields_entry(w, [&](auto kind, const std::string& p, const auto& written, size_t i) {
@@ -203,7 +213,7 @@ PlacementProblem placement_problem(const Scene& scene, size_t file_triangles,
                             limits.max_coordinate_text + ", too large for the renderer's " +
                             limits.name + " arithmetic: scale the scene down";
                 if (found.empty()) found = size_problem(what.c_str(), size, own_extent, limits);
-                if (found.empty()) found = scene_scale_problem(what.c_str(), size, extent, limits);
+                if (found.empty()) found = scene_scale_problem(what.c_str(), size, reach, limits);
                 if (!found.empty()) first = {p + "/" + field.key, found};
             }
         });
@@ -223,7 +233,7 @@ PlacementProblem placement_problem(const Scene& scene, size_t file_triangles,
         const double own_extent = std::fmax(largest(v[0]), std::fmax(largest(v[1]), largest(v[2])));
         const char* what = "a triangle with a longest edge";
         std::string problem = size_problem(what, longest, own_extent, limits);
-        if (problem.empty()) problem = scene_scale_problem(what, longest, extent, limits);
+        if (problem.empty()) problem = scene_scale_problem(what, longest, reach, limits);
         if (problem.empty() && (limits.is_double ? collapses<double>(v) : collapses<float>(v)))
             problem = std::string(
                           "the triangle collapses to a line when its vertices are "
@@ -232,4 +242,82 @@ PlacementProblem placement_problem(const Scene& scene, size_t file_triangles,
         if (!problem.empty()) return {triangle_pointer(i) + "/vertices", problem};
     }
     return {};
+}
+
+PlacementProblem render_problem(const Scene& scene, int image_height, int bounces,
+                                const PrecisionLimits& limits) {
+    // The view: the angle one pixel spans at the image's centre, 2 tan(vfov / 2) / height.
+    const double pixel_angle =
+        2.0 * std::tan(double(scene.camera.vfov_degrees) * 0.5 * 3.14159265358979323846 / 180.0) /
+        image_height;
+    if (pixel_angle < limits.min_pixel_angle())
+        return {"/camera/vfov", "a field of view of " + format_number(scene.camera.vfov_degrees) +
+                                    " degrees over " + std::to_string(image_height) +
+                                    " pixels spans " + format_number(pixel_angle) +
+                                    " rad a pixel, finer than " + limits.name +
+                                    " ray directions resolve (256 ulps, " +
+                                    format_number(limits.min_pixel_angle()) +
+                                    " rad): widen the view, or render more pixels"};
+    if (!scene.has_light) return {};
+    const double intensity =
+        std::fmax(double(scene.light.intensity.x),
+                  std::fmax(double(scene.light.intensity.y), double(scene.light.intensity.z)));
+    if (!(intensity > 0.0)) return {};
+    // The light's distance to the nearest primitive's bounding box, from the file's points
+    // once centred; at least one ray offset of the scene's reach.
+    const WrittenPoint c = centring_centre(scene);
+    const WrittenCoordinates& w = scene.written;
+    const WrittenPoint light{w.light_position.x - c.x, w.light_position.y - c.y,
+                             w.light_position.z - c.z};
+    double nearest = INFINITY, reach = 0.0;
+    const auto box = [&](const WrittenPoint* points, int n, double margin) {
+        double lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
+        for (int k = 0; k < n; ++k) {
+            const double p[3] = {points[k].x - c.x, points[k].y - c.y, points[k].z - c.z};
+            for (int axis = 0; axis < 3; ++axis) {
+                lo[axis] = std::fmin(lo[axis], p[axis] - margin);
+                hi[axis] = std::fmax(hi[axis], p[axis] + margin);
+                reach = std::fmax(reach, std::fmax(std::fabs(lo[axis]), std::fabs(hi[axis])));
+            }
+        }
+        const double l[3] = {light.x, light.y, light.z};
+        double d2 = 0.0;
+        for (int axis = 0; axis < 3; ++axis) {
+            const double out = std::fmax(lo[axis] - l[axis], std::fmax(0.0, l[axis] - hi[axis]));
+            d2 += out * out;
+        }
+        nearest = std::fmin(nearest, std::sqrt(d2));
+    };
+    for_each_fields_entry(w, [&](auto kind, const std::string&, const auto& written, size_t i) {
+        using K = typename decltype(kind)::type;
+        double margin = 0.0;
+        std::vector<WrittenPoint> points;
+        for_each_field<K>([&](const FileField& field, int at) {
+            if (field.role == FieldRole::Point) points.push_back(written.point(i, at));
+            if (field.role == FieldRole::Length)
+                margin = std::fmax(margin, written.values[i * field_values<K>() + at]);
+        });
+        box(points.data(), static_cast<int>(points.size()), margin);
+    });
+    for (size_t i = 0; 3 * i < w.triangle_vertices.size(); ++i)
+        box(&w.triangle_vertices[3 * i], 3, 0.0);
+    for (size_t i = 0; 4 * i < w.quad_vertices.size(); ++i) box(&w.quad_vertices[4 * i], 4, 0.0);
+    for (size_t i = 0; 4 * i < w.rect_vertices.size(); ++i) box(&w.rect_vertices[4 * i], 4, 0.0);
+    if (!std::isfinite(nearest)) return {};  // nothing to light
+    reach = std::fmax(reach, distance(light, WrittenPoint{0.0, 0.0, 0.0}));
+    if (scene.camera.written) {
+        const WrittenPoint& p = scene.camera.written_position;
+        reach = std::fmax(reach, distance({p.x - c.x, p.y - c.y, p.z - c.z}, {0.0, 0.0, 0.0}));
+    }
+    const double d = std::fmax(nearest, limits.relative_offset * reach);
+    const double background =
+        std::fmax(double(scene.background.x),
+                  std::fmax(double(scene.background.y), double(scene.background.z)));
+    const double brightest = bounces * (intensity / (3.14159265358979323846 * d * d)) + background;
+    if (brightest <= limits.max_value) return {};
+    return {"/light/intensity",
+            "a light of intensity " + format_number(intensity) + " as near as " + format_number(d) +
+                " to a surface gives a path of " + std::to_string(bounces) + " bounces up to " +
+                format_number(brightest) + ", beyond " + limits.name + "'s range (" +
+                limits.max_value_text + "): dim the light or move it away"};
 }

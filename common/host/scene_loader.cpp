@@ -613,6 +613,20 @@ Scene parse_scene(const std::string& text, const std::string& name) {
     return scene;
 }
 
+void check_render_limits(Scene& scene, int image_height, int bounces) {
+    const PlacementProblem in_float = render_problem(scene, image_height, bounces, kFloatLimits);
+    if (!in_float.empty() && scene.float_refusal.empty())
+        scene.float_refusal = in_float.pointer + ": " + in_float.message;
+    if (!build_limits().is_double && in_float.empty()) return;
+    const PlacementProblem in_double = render_problem(scene, image_height, bounces, kDoubleLimits);
+    const auto where = [&](const PlacementProblem& p) {
+        return scene.name + ": " + p.pointer + ": ";
+    };
+    if (!in_double.empty()) throw InputError(where(in_double) + in_double.message);
+    if (!build_limits().is_double)
+        throw PrecisionError(where(in_float) + in_float.message + "; " + kDoublePlacesIt);
+}
+
 Scene load_scene(const std::string& path) {
     std::ifstream in(path, std::ios::binary);
     if (!in) throw InputError(path + ": cannot open scene file: " + std::strerror(errno));

@@ -105,14 +105,6 @@ std::string describe(const SceneUse& use) {
     return line;
 }
 
-std::string scale_warning(const SceneUse& use) {
-    if (use.smallest <= 0 || use.smallest >= use.extent * kResolvedDetail) return "";
-    return "warning: the scene's smallest detail (" + number(use.smallest) + ") is below 1/" +
-           number(1.0 / kResolvedDetail) + " of its extent (" + number(use.extent) +
-           "): rays that cross the scene leave surfaces by offsets close to that size, so it "
-           "will render with visible error; make the detail larger or the scene smaller";
-}
-
 std::string lines_left_out(const SceneUse& use) {
     if (use.line_triangles == 0) return "";
     return "note: " + plural(use.line_triangles, "triangle", "triangles") +
@@ -141,6 +133,5 @@ std::string to_json(const SceneUse& use) {
            material_keys + "], \"light\": " + (use.light ? "true" : "false") +
            ", \"background\": " + (use.background ? "true" : "false") +
            ", \"smallest\": " + number(use.smallest) + ", \"extent\": " + number(use.extent) +
-           ", \"warning\": " + (scale_warning(use).empty() ? "false" : "true") +
            ", \"lines_left_out\": " + std::to_string(use.line_triangles) + "}";
 }

@@ -105,17 +105,19 @@ def test_a_piped_scene_only_double_places_is_refused_in_one_line(lab01_ref, tmp_
 
 def test_a_mixed_scale_scene_is_rendered_right_by_the_reference(lab01_ref, tmp_path):
     """A sphere of radius 1e-4 on a floor of half-size 1e4, lit from the side: float cannot
-    place the sphere, so lab01-ref renders it in double, and its image is the float image of
-    the same view on a floor of half-size 1 (one bounce: the floor out of view adds nothing)
-    to rounding: the same mean, every shadow pixel dark. With ray offsets of 2^-20 of the
-    scene's size in double too, the shadow rays started above the sphere and 97 of the 192
-    shadow pixels were lit."""
+    place the sphere, so lab01-ref renders it in double, and its image is the image of the
+    same view on a floor of half-size 1 (one bounce: the floor out of view adds nothing) to
+    rounding: the same mean, every shadow pixel dark. (That view renders in double too: its
+    light, 1e4 radii from the sphere, counts in the scene's reach.) With ray offsets of 2^-20
+    of the scene's size in double too, the shadow rays started above the sphere and 97 of the
+    192 shadow pixels were lit."""
     settings = dict(width=64, height=64, spp=64, bounces=1, seed=5)
     far = scenes.write_scene(tmp_path / "mixed.json", scenes.mixed_scale(1e4))
     near = scenes.write_scene(tmp_path / "near.json", scenes.mixed_scale(1.0))
     mixed = run_lab(lab01_ref, far, **settings)
     plain = run_lab(lab01_ref, near, **settings)
-    assert mixed.json["precision"] == "double" and plain.json["precision"] == "float"
+    assert mixed.json["precision"] == "double" and plain.json["precision"] == "double"
+    assert "reach (1e+04" in mixed.json["precision_reason"]
     assert "/spheres/0/radius" in mixed.json["precision_reason"]
     assert abs(mixed.image.mean() / plain.image.mean() - 1) < 1e-3
     luminance, want = mixed.image.mean(axis=2), plain.image.mean(axis=2)
@@ -200,3 +202,106 @@ def test_a_triangle_on_a_line_is_left_out_alike_everywhere(tmp_path):
         assert with_line.json["scene_uses"]["lines_left_out"] == 1, target
         assert with_line.json["precision"] == ("double" if "double" in target else "float")
         assert (with_line.image == run_lab(binary, plain_path, **settings).image).all(), target
+
+
+# ---- where the switch sits: each ratio swept across its limit (common/host/scene_limits.h) --
+# Below a limit, lab01-ref renders in double and a student's float build refuses in one line;
+# just above it, lab01-ref's float image is its double image's, by the criterion of the scale
+# check (grading/invariance_checks.py: same seed, mean within 1%, at most 2% of pixel values
+# off by more than 5%).
+
+OFFSET = 2.0**-20  # float's ray offset, relative to the distance scale (common/core/ray.h)
+SWEEP = dict(width=24, height=24, spp=16, seed=5)
+
+
+def _switched(scene_path, lab01_ref, pointer, bounces=1):
+    run = run_lab(lab01_ref, scene_path, bounces=bounces, **SWEEP, check=False)
+    assert run.returncode == 0 and np.isfinite(run.image).all(), run.stderr
+    assert run.json["precision"] == "double", run.json
+    assert pointer in run.json["precision_reason"], run.json["precision_reason"]
+    p = subprocess.run([str(build("lab01")[0]), "--quiet", "--scene", str(scene_path),
+                        "--width", "24", "--height", "24", "--spp", "1", "--bounces",
+                        str(bounces)], capture_output=True, text=True)
+    lines = p.stderr.strip().splitlines()
+    assert p.returncode == 2 and len(lines) == 1, p.stderr
+    assert pointer in lines[0] and "double places it" in lines[0], lines[0]
+
+
+def _float_is_right(scene_path, lab01_ref, lab01_ref_double, bounces=1):
+    # check=False: run_lab's sanity bound (1e9) is for ordinary scenes, not for a light near
+    # float's range; the run must still succeed with a finite image.
+    single = run_lab(lab01_ref, scene_path, bounces=bounces, **SWEEP, check=False)
+    double = run_lab(lab01_ref_double, scene_path, bounces=bounces, **SWEEP, check=False)
+    assert single.returncode == 0 and double.returncode == 0, single.stderr + double.stderr
+    assert single.json["precision"] == "float", single.json
+    assert np.isfinite(single.image).all()
+    a, b = single.image.astype(np.float64), double.image.astype(np.float64)
+    mean_err = abs(a.mean() / b.mean() - 1)
+    bad = float((~(np.abs(a - b) / (np.abs(b) + 1e-3) <= 0.05)).mean())
+    assert mean_err <= 0.01 and bad <= 0.02, \
+        f"float against double: mean off by {mean_err:.2%}, {bad:.2%} of values off by > 5%"
+
+
+def test_a_detail_switches_below_128_offsets_of_the_scene(lab01_ref, lab01_ref_double,
+                                                           tmp_path):
+    """A sphere of radius k ray offsets on a floor of half-size 1e4 (float's image was wrong at
+    k = 1.1 .. 64, docs/precision.md): at k = 100 the reference renders in double, at 160
+    float renders it right."""
+    for k in (100, 160):
+        r = k * OFFSET * 1e4
+        scene = scenes.mixed_scale(1e4, r)
+        scene["light"] = {"position": [5 * r, 10 * r, 0], "intensity": [r * r] * 3}
+        path = scenes.write_scene(tmp_path / f"mixed-{k}.json", scene)
+        if k < 128:
+            _switched(path, lab01_ref, "/spheres/0/radius")
+        else:
+            _float_is_right(path, lab01_ref, lab01_ref_double)
+
+
+def test_the_cameras_distance_counts(lab01_ref, lab01_ref_double, tmp_path):
+    """A sphere of radius 0.2 on a floor of half-size 1 seen from D away, the view narrowed to
+    frame the floor: its first hits leave surfaces by offsets that grow with D, so the limit is
+    128 offsets of D (D = 1638). At D = 2000 the reference renders in double, at 1300 float
+    renders it right."""
+    for distance in (2000, 1300):
+        scene = scenes.mixed_scale(1.0, 0.2)
+        look_at = np.array([0, 0.2, 0])
+        away = np.array([0, 0.5, 1.0]) / np.linalg.norm([0, 0.5, 1.0])
+        scene["camera"] = {"position": list(look_at + away * distance),
+                           "look_at": list(look_at),
+                           "vfov": float(np.degrees(2 * np.arctan(1.0 / distance)))}
+        path = scenes.write_scene(tmp_path / f"far-{distance}.json", scene)
+        if distance > 1638:
+            _switched(path, lab01_ref, "/spheres/0/radius")
+        else:
+            _float_is_right(path, lab01_ref, lab01_ref_double)
+
+
+def test_a_narrow_view_switches_below_256_ulps_a_pixel(lab01_ref, lab01_ref_double, tmp_path):
+    """The Cornell box through a view whose 24 pixels span u ulps of a unit direction each
+    (2^-23 rad), aimed at the corner of the floor and the back wall: at u = 200 the reference
+    renders in double, at 320 float renders it right."""
+    for ulps in (200, 320):
+        scene = scenes.load("cornell")
+        scene["camera"]["look_at"] = [0.3, 0.0, -1.0]
+        scene["camera"]["vfov"] = float(np.degrees(2 * np.arctan(12 * ulps * 2.0**-23)))
+        path = scenes.write_scene(tmp_path / f"view-{ulps}.json", scene)
+        if ulps < 256:
+            _switched(path, lab01_ref, "/camera/vfov", bounces=2)
+        else:
+            _float_is_right(path, lab01_ref, lab01_ref_double, bounces=2)
+
+
+def test_a_light_whose_paths_leave_floats_range_switches(lab01_ref, lab01_ref_double,
+                                                         tmp_path):
+    """A light 0.01 from the Cornell box's green wall gives a falloff up to 1/(pi 1e-4); at
+    2 bounces an intensity past 5.35e34 could carry a path past float's largest value: at 6e34
+    the reference renders in double, at 4e34 float renders it right."""
+    for intensity in (6e34, 4e34):
+        scene = scenes.load("cornell")
+        scene["light"] = {"position": [0.99, 0.5, -0.5], "intensity": [intensity] * 3}
+        path = scenes.write_scene(tmp_path / f"bright-{intensity:g}.json", scene)
+        if intensity > 5.35e34:
+            _switched(path, lab01_ref, "/light/intensity", bounces=2)
+        else:
+            _float_is_right(path, lab01_ref, lab01_ref_double, bounces=2)

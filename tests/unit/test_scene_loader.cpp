@@ -208,7 +208,7 @@ TEST(SceneLoader, EverythingAsWritten) {
     "steel": { "type": "mirror",  "albedo": [0.9, 0.8, 0.7] }
   },
   "spheres":   [ { "center": [0.5, 0.2, -0.25], "radius": 0.2, "material": "steel" },
-                 { "center": [1, 1, 1], "radius": 3e-4, "material": "glass" } ],
+                 { "center": [1, 1, 1], "radius": 3e-3, "material": "glass" } ],
   "triangles": [ { "vertices": [[0,0,0], [1,0,0], [1,0,-1]], "material": "white" } ],
   "quads":     [ { "vertices": [[0,0,0], [0,1,0], [0,1,-1.5], [0,0,-1]], "material": "glass" } ],
   "render":    { "width": 320, "height": 240, "spp": 16, "bounces": 7, "seed": 99 }
@@ -235,7 +235,7 @@ TEST(SceneLoader, EverythingAsWritten) {
     ASSERT_EQ(s.of<Sphere>().size(), 2u);
     EXPECT_EQ(s.material_names[s.of<Sphere>()[0].material], "steel");
     EXPECT_EQ(s.material_names[s.of<Sphere>()[1].material], "glass");
-    EXPECT_FLOAT_EQ(s.of<Sphere>()[1].radius, 3e-4f);
+    EXPECT_FLOAT_EQ(s.of<Sphere>()[1].radius, 3e-3f);
     // One triangle, and a quad that is planar but no rectangle, and shares an edge with the
     // triangle: a convex quad.
     ASSERT_EQ(s.of<Triangle>().size(), 1u);
@@ -254,9 +254,10 @@ TEST(SceneLoader, EverythingAsWritten) {
 namespace {
 
 // A scene of the given quads (JSON arrays of four points) and triangles, all white.
-std::string scene_of(const std::vector<std::string>& quads,
-                     const std::vector<std::string>& triangles = {}) {
-    std::string text = R"({"camera": {"position": [0.5, 0.5, 3], "look_at": [0.5, 0.5, 0]},
+std::string scene_of(
+    const std::vector<std::string>& quads, const std::vector<std::string>& triangles = {},
+    const std::string& camera = R"("position": [0.5, 0.5, 3], "look_at": [0.5, 0.5, 0])") {
+    std::string text = R"({"camera": {)" + camera + R"(},
         "materials": {"white": {"type": "diffuse", "albedo": [0.5, 0.5, 0.5]}}, "quads": [)";
     for (size_t i = 0; i < quads.size(); ++i)
         text +=
@@ -349,7 +350,12 @@ TEST(SceneLoader, KindsDoNotDependOnWhereTheSceneIs) {
             }
             moved.push_back(out + "]");
         }
-        const Scene s = parse_scene(scene_of(moved), kName);
+        char camera[160];  // moved with the quads: the camera's distance counts in the limits
+        std::snprintf(camera, sizeof camera,
+                      R"("position": [%.17g, %.17g, %.17g], "look_at": [%.17g, %.17g, %.17g])",
+                      0.5 + shift, 0.5 - shift, 3 + 0.5 * shift, 0.5 + shift, 0.5 - shift,
+                      0.5 * shift);
+        const Scene s = parse_scene(scene_of(moved, {}, camera), kName);
         EXPECT_EQ(s.of<AxisRect>().size(), here.rects) << shift;
         EXPECT_EQ(s.of<ConvexQuad>().size(), here.quads) << shift;
         EXPECT_EQ(s.of<Triangle>().size(), here.triangles) << shift;
