@@ -7,6 +7,7 @@ float build says "float". The double build accepts the wider scenes double can h
 references render them in double by themselves (common/host/double_twin.h)."""
 import os
 import subprocess
+import time
 
 import numpy as np
 import pytest
@@ -305,3 +306,42 @@ def test_a_light_whose_paths_leave_floats_range_switches(lab01_ref, lab01_ref_do
             _switched(path, lab01_ref, "/light/intensity", bounces=2)
         else:
             _float_is_right(path, lab01_ref, lab01_ref_double, bounces=2)
+
+
+def test_numbers_are_judged_as_written(lab01_ref, lab01_ref_double, tmp_path):
+    """A range is checked on the number the file writes, in every build with the same message
+    (float rounds an albedo of 1 + 1e-9 to 1); a number only float cannot hold (an intensity
+    of 1e39) renders in double in the reference and is refused in one line by a student's
+    float build; nesting past any scene's is refused at once, at its line and column."""
+    def student(path):
+        p = subprocess.run([str(build("lab01")[0]), "--quiet", "--scene", str(path), "--width",
+                            "4", "--height", "4", "--spp", "1"], capture_output=True, text=True)
+        return p.returncode, p.stderr.strip().splitlines()
+
+    over = scenes.load("cornell")
+    over["materials"]["white"]["albedo"] = [0.5, 1.000000001, 0.5]
+    over_path = scenes.write_scene(tmp_path / "over.json", over)
+    messages = set()
+    for binary in (lab01_ref, lab01_ref_double):
+        run = run_lab(binary, over_path, width=4, height=4, spp=1, check=False)
+        lines = run.stderr.strip().splitlines()
+        assert run.returncode == 2 and len(lines) == 1 and "in [0, 1]" in lines[0], run.stderr
+        messages.add(lines[0])
+    assert len(messages) == 1, messages
+
+    bright = scenes.load("cornell")
+    bright["light"]["intensity"] = [1e39, 1, 1]
+    bright_path = scenes.write_scene(tmp_path / "bright.json", bright)
+    run = run_lab(lab01_ref, bright_path, width=4, height=4, spp=1, check=False)
+    assert run.returncode == 0 and run.json["precision"] == "double", run.stderr
+    assert "/light/intensity/0: 1e+39 is beyond float's range" in run.json["precision_reason"]
+    status, lines = student(bright_path)
+    assert status == 2 and len(lines) == 1 and "double places it" in lines[0], lines
+
+    deep = tmp_path / "deep.json"
+    deep.write_text('{"camera":\n' + "[" * 100000 + "]" * 100000 + "}")
+    start = time.monotonic()
+    status, lines = student(deep)
+    assert time.monotonic() - start < 2
+    assert status == 2 and len(lines) == 1 and "line 2, column 32: nesting deeper than 32" \
+        in lines[0], lines
