@@ -6,6 +6,7 @@ float build says "float". The double build accepts the wider scenes double can h
 (common/host/scene_limits.h); the students' float build refuses them in one line, and the
 references render them in double by themselves (common/host/double_twin.h)."""
 import os
+import shutil
 import subprocess
 import time
 
@@ -161,17 +162,25 @@ def _nan_cornell(tmp_path, intensity):
     return scenes.write_scene(tmp_path / f"bright-{intensity:g}.json", scene)
 
 
-@pytest.mark.parametrize("target", ["lab01-ref", "lab01-ref-double", "lab02-ref", "lab03-ref"])
-def test_no_nan_up_to_the_largest_intensity(target, tmp_path):
+@pytest.mark.parametrize("target", ["lab01-ref", "lab01-ref-double", "lab02-ref", "lab03-ref",
+                                    "lab04-ref"])
+def test_no_nan_up_to_the_largest_intensity(target, tmp_path, monkeypatch):
     """Intensities up to float's largest with zero albedo channels, 4 bounces: every CPU lab
     either renders an image without NaN or, where float's products could overflow, renders
-    in double (the references) or refuses in one line that double places it (lab 02)."""
-    if target == "lab02-ref" and not harness.cpu_has_avx2():
+    in double (the references) or refuses in one line that double places it (labs 02, 04)."""
+    if target in ("lab02-ref", "lab04-ref") and not harness.cpu_has_avx2():
         pytest.skip("this CPU has no AVX2/FMA")
+    launcher = ()
+    if target == "lab04-ref":  # two ranks, as root where CI runs (test_lab04.py)
+        if shutil.which("mpirun") is None:
+            pytest.skip("no mpirun here")
+        monkeypatch.setenv("OMPI_ALLOW_RUN_AS_ROOT", "1")
+        monkeypatch.setenv("OMPI_ALLOW_RUN_AS_ROOT_CONFIRM", "1")
+        launcher = ("mpirun", "-q", "--oversubscribe", "--bind-to", "none", "-np", "2")
     binary = build(target)[0]
     for intensity in (1e30, 3e38, 3.4e38):
         run = run_lab(binary, _nan_cornell(tmp_path, intensity), width=16, height=16, spp=4,
-                      bounces=4, seed=1, check=False)
+                      bounces=4, seed=1, check=False, launcher=launcher)
         if run.returncode != 0:
             lines = run.stderr.strip().splitlines()
             assert run.returncode == 2 and len(lines) == 1, (intensity, run.stderr)
