@@ -16,15 +16,14 @@
 //    its primitives' extent, or the camera's or the light's distance from its centre where
 //    larger (the first hit's offset grows with the distance the ray travelled, ray.h). A ray
 //    that crossed the scene leaves a surface by an offset of 2^-20 of that distance, so a
-//    detail near it is not placed, or not lit, where it is: a sphere of radius k offsets on a
-//    floor of half-size 1e4 rendered 24, 20, 15, 9, 6 of 576 pixels more than 10% off the
-//    double image at k = 1.1, 2, 4, 16, 64, and 2, 1, 0 at k = 128, 512, 1024 (boundary
-//    pixels of the shadow, within their noise); a camera far from a small scene likewise.
-//    Below the limit the references render in double; nothing between it and a warning.
+//    detail within a few dozen offsets of it is not placed, or not lit, where it is (a small
+//    sphere on a large floor, a small scene seen from far away). The limit sits where float
+//    was measured right, with a margin (DESIGN.md section 5, docs/precision.md); below it the
+//    references render in double, and no warning is left between the limit and that.
 //  - A view whose pixels span at least 256 ulps of a unit direction (2^-15 rad in float,
 //    2^-44 in double): the camera's rays are rounded to the type, and a narrower view repeats
-//    the same ray across neighbouring pixels (float at 1e-5 degrees). Judged with the image's
-//    height, once the settings are known (render_problem).
+//    the same ray across neighbouring pixels. Judged with the image's height, once the
+//    settings are known (render_problem).
 //  - A light whose brightest path stays within the type's range: its intensity times the
 //    largest falloff 1/(pi d^2) it gives (d from the light to the nearest primitive's
 //    bounding box, at least one ray offset of the scene's reach) times the bounces (each adds
