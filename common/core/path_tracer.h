@@ -196,8 +196,8 @@ RT_HD inline bool sample_light(const SceneView& scene, Vec3 position, Vec3 origi
     shadow.ray = {origin, wi};
     shadow.t_max = distance - dot(origin - position, wi);
     // The light's term saturates at the type's largest value: an intensity near it times a
-    // falloff above 1 overflows to inf, which a zero channel of the throughput or albedo turns
-    // into NaN (0 * inf). albedo * intensity is finite (albedo <= 1), the falloff is finite
+    // falloff above 1 overflows to inf, which a zero channel of the path's throughput turns
+    // into NaN (0 * inf). albedo * intensity is finite (albedo <= 1) and the falloff is finite
     // (tested above), so the product is a number or +inf, never NaN; the throughput it meets
     // next is at most 1. Below the largest value the bits are those of the plain product.
     const Vec3 radiance = albedo * scene.light.intensity * (cos_theta / (kPi * distance2));
