@@ -195,7 +195,14 @@ RT_HD inline bool sample_light(const SceneView& scene, Vec3 position, Vec3 origi
     if (!in_front) return false;
     shadow.ray = {origin, wi};
     shadow.t_max = distance - dot(origin - position, wi);
-    shadow.radiance = albedo * scene.light.intensity * (cos_theta / (kPi * distance2));
+    // The light's term saturates at the type's largest value: an intensity near it times a
+    // falloff above 1 overflows to inf, which a zero channel of the path's throughput turns
+    // into NaN (0 * inf). albedo * intensity is finite (albedo <= 1) and the falloff is finite
+    // (tested above), so the product is a number or +inf, never NaN; the throughput it meets
+    // next is at most 1. Below the largest value the bits are those of the plain product.
+    const Vec3 radiance = albedo * scene.light.intensity * (cos_theta / (kPi * distance2));
+    shadow.radiance = {min_float(radiance.x, kRealMax), min_float(radiance.y, kRealMax),
+                       min_float(radiance.z, kRealMax)};
     return true;
     // SKELETON
     //> // TODO(lab01): the light sample. From `position`: the direction wi and distance d to

@@ -246,6 +246,26 @@ private:
     std::vector<std::string> path_;  // pointer tokens of the open containers (not the root)
 };
 
+// The offset of the first bracket that opens a container deeper than kMaxJsonDepth, or npos.
+// Read before parsing, in one pass: the recorder keeps every value's JSON pointer, whose
+// length grows with the depth, so time and memory grew as the depth squared (DESIGN.md,
+// section 5). Brackets inside strings do not count.
+size_t too_deep(const std::string& text) {
+    size_t depth = 0;
+    for (size_t i = 0; i < text.size(); ++i) {
+        const char c = text[i];
+        if (c == '"') {
+            for (++i; i < text.size() && text[i] != '"'; ++i)
+                if (text[i] == '\\') ++i;
+        } else if (c == '[' || c == '{') {
+            if (++depth > kMaxJsonDepth) return i;
+        } else if ((c == ']' || c == '}') && depth > 0) {
+            --depth;
+        }
+    }
+    return std::string::npos;
+}
+
 }  // namespace
 
 std::string pointer_token(const std::string& key) {
@@ -255,6 +275,10 @@ std::string pointer_token(const std::string& key) {
 }
 
 JsonWithPositions parse_json_with_positions(const std::string& text, const std::string& name) {
+    if (const size_t at = too_deep(text); at != std::string::npos)
+        throw InputError(name + ":" + line_column(text, at) + ": nesting deeper than " +
+                         std::to_string(kMaxJsonDepth) +
+                         " levels of brackets (a scene file needs 5 at most)");
     JsonWithPositions parsed;
     size_t consumed = 0;
     PositionRecorder recorder(parsed.root, text, &consumed);

@@ -16,7 +16,12 @@ struct JsonWithPositions {
     std::string duplicate_key;          // that key, unescaped
 };
 
-// Parses `text`; a syntax error throws InputError "<name>:line L, column C: invalid JSON: ...".
+// The deepest nesting of arrays and objects a file may have: a scene file needs 5 (the root,
+// "quads", a quad, its "vertices", a point); anything deeper is refused before parsing.
+constexpr size_t kMaxJsonDepth = 32;
+
+// Parses `text`; a syntax error throws InputError "<name>:line L, column C: invalid JSON: ...",
+// nesting deeper than kMaxJsonDepth one naming the bracket that goes past it.
 JsonWithPositions parse_json_with_positions(const std::string& text, const std::string& name);
 
 // "line L, column C" (both from 1) of an offset into `text`.

@@ -35,13 +35,23 @@ static std::string json_escape(const std::string& s) {
     return out;
 }
 
-// The scene, centred on its geometry: where a scene sits in the world does not change its
-// image. One that float cannot place goes to the double build where this binary carries one
-// (a reference): this process becomes it, with the same command line. The double build reads
-// the scene again, so a scene this process drained (a pipe, /dev/stdin) is refused instead.
-static Scene load_centred(const Options& options, char** argv) {
+struct Loaded {
+    Scene scene;
+    RenderSettings settings;
+};
+
+// The scene, centred on its geometry (where a scene sits in the world does not change its
+// image), and the settings it renders with. One that float cannot place, or cannot render
+// with those settings (a view too narrow, a light too bright: check_render_limits), goes to
+// the double build where this binary carries one (a reference): this process becomes it,
+// with the same command line. The double build reads the scene again, so a scene this
+// process drained (a pipe, /dev/stdin) is refused instead.
+static Loaded load_centred(const Options& options, char** argv) {
     try {
-        return centre_scene(load_scene(options.scene_path));
+        Scene scene = centre_scene(load_scene(options.scene_path));
+        const RenderSettings settings = settings_for(scene, options);
+        check_render_limits(scene, settings.height, settings.bounces);
+        return {std::move(scene), settings};
     } catch (const PrecisionError&) {
         if (!has_double_twin()) throw;
         struct stat st {};
@@ -65,17 +75,18 @@ static std::string precision_reason(const Scene& scene) {
 // `setup_reported` tells lab_main whether hooks.setup_done has been called already.
 static int run(int argc, char** argv, const LabHooks& hooks, bool& setup_reported) {
     const Options options = parse_options(argc, argv, argv[0]);
-    const Scene scene = load_centred(options, argv);
+    const Loaded loaded = load_centred(options, argv);
+    const Scene& scene = loaded.scene;
+    const RenderSettings& settings = loaded.settings;
     const std::string precision = precision_reason(scene);
-    const RenderSettings settings = settings_for(scene, options);
-    // What the scene uses, and a detail too small for its extent, before the render starts
-    // (not with --quiet, which the grader and the tests use; --json carries it too).
+    // What the scene uses before the render starts, and the triangles left out (not with
+    // --quiet, which the grader and the tests use; --json carries it too).
     const SceneUse use = scene_use(scene);
     if (hooks.writes_output && !options.quiet) {
         std::fprintf(stderr, "%s; in %s: %s\n", describe(use).c_str(), kPrecisionName,
                      precision.c_str());
-        const std::string warning = scale_warning(use);
-        if (!warning.empty()) std::fprintf(stderr, "%s\n", warning.c_str());
+        const std::string lines = lines_left_out(use);
+        if (!lines.empty()) std::fprintf(stderr, "%s\n", lines.c_str());
     }
 
     // Open the outputs before rendering: a bad path fails in a millisecond, not after the

@@ -107,6 +107,10 @@ struct Scene {
     // why it was needed (lab_main.cpp).
     std::string float_refusal;
     int t_junction_pieces = 0;  // primitives added by splitting at T-junctions (t_junctions.h)
+    // Triangles of the file whose points lie on a line (scene_limits.h, on_a_line): left out
+    // in every build; how many, and where the first is written ("/triangles/3").
+    int line_triangles = 0;
+    std::string first_line_triangle;
 
     template <class K>
     std::vector<K>& of() {

@@ -4,6 +4,8 @@
 #include <cmath>
 #include <limits>
 
+#include <scene_limits.h>
+
 namespace {
 
 struct BoundsD {
@@ -134,7 +136,9 @@ void centre_of_bounds(const Scene& scene, double centre[3]) {
         }
     });
     for (size_t i = 0; i < scene.of<Triangle>().size(); ++i) {
-        for (int k = 0; k < 3; ++k) box.add(points.vertex(i, k));
+        const WrittenPoint v[3] = {points.vertex(i, 0), points.vertex(i, 1), points.vertex(i, 2)};
+        if (on_a_line(v)) continue;  // left out by the loader: the centre is the same without it
+        for (const WrittenPoint& p : v) box.add(p);
     }
     for (size_t i = 0; i < scene.of<ConvexQuad>().size(); ++i) {
         for (int k = 0; k < 4; ++k) box.add(points.quad_vertex(i, k));

@@ -2,6 +2,8 @@
 
 #include <array>
 #include <cerrno>
+#include <cfloat>
+#include <charconv>
 #include <cmath>
 #include <cstring>
 #include <fstream>
@@ -20,6 +22,14 @@
 using nlohmann::json;
 
 namespace {
+
+// The shortest decimal that reads back as x: a number as the file wrote it (179.99999999, not
+// 180 or 179.99999999000001).
+std::string shortest(double x) {
+    char text[40];
+    const std::to_chars_result end = std::to_chars(text, text + sizeof text, x);
+    return std::string(text, end.ptr);
+}
 
 // Walks the DOM with knowledge of where each value sits in the text.
 class SceneReader {
@@ -72,40 +82,74 @@ public:
         return obj.at(key);
     }
 
-    // The number as the file writes it (a double), within the range `real` holds; a
-    // coordinate, any finite double (scene_limits.h judges it once the scene is centred).
+    // Every range is judged on the number as the file writes it (a double), alike in both
+    // builds: float would accept an albedo of 1 + 1e-9 (it rounds to 1) that double refuses.
+    // What float alone cannot hold (a number beyond its range, or one it rounds out of its
+    // field's range) is noted here, the first of it, and made a PrecisionError in the float
+    // build once the whole file has been read (check_placement): a reference renders it in
+    // double, and an error later in the file is still reported as an input error.
+    mutable PlacementProblem float_problem;
+
+    void note_float_problem(const std::string& pointer, const std::string& what) const {
+        if (float_problem.empty()) float_problem = {pointer, what};
+    }
+
+    // The number as the file writes it: any finite double. A coordinate or a length is judged
+    // once the scene is centred (scene_limits.h); any other number must be within float's
+    // range for the float build.
     double written_number(const json& v, const std::string& pointer,
                           bool coordinate = false) const {
         if (!v.is_number()) fail(pointer, "expected a number, found " + type_of(v));
         const double d = v.get<double>();
-        if (!std::isfinite(d) || (!coordinate && std::fabs(d) > kRealMax))
-            fail(pointer,
-                 std::string("expected a finite number within ") + kPrecisionName + " range");
+        if (!std::isfinite(d)) fail(pointer, "expected a finite number");
+        if (!coordinate && std::fabs(d) > FLT_MAX)
+            note_float_problem(pointer, shortest(d) + " is beyond float's range (3.4e38)");
         return d;
     }
 
-    real number(const json& v, const std::string& pointer) const {
-        return static_cast<real>(written_number(v, pointer));
+    std::array<double, 3> written_vec3(const json& v, const std::string& pointer) const {
+        if (!v.is_array() || v.size() != 3)
+            fail(pointer, "expected an array of 3 numbers, found " + type_of(v));
+        return {written_number(v[0], pointer + "/0"), written_number(v[1], pointer + "/1"),
+                written_number(v[2], pointer + "/2")};
+    }
+
+    static Vec3 rounded(const std::array<double, 3>& w) {
+        return {static_cast<real>(w[0]), static_cast<real>(w[1]), static_cast<real>(w[2])};
     }
 
     Vec3 vec3(const json& v, const std::string& pointer) const {
-        if (!v.is_array() || v.size() != 3)
-            fail(pointer, "expected an array of 3 numbers, found " + type_of(v));
-        return {number(v[0], pointer + "/0"), number(v[1], pointer + "/1"),
-                number(v[2], pointer + "/2")};
+        return rounded(written_vec3(v, pointer));
     }
 
     Vec3 non_negative_vec3(const json& v, const std::string& pointer) const {
-        const Vec3 r = vec3(v, pointer);
-        if (r.x < 0 || r.y < 0 || r.z < 0) fail(pointer, "expected components >= 0");
-        return r;
+        const std::array<double, 3> w = written_vec3(v, pointer);
+        if (w[0] < 0 || w[1] < 0 || w[2] < 0) fail(pointer, "expected components >= 0");
+        return rounded(w);
     }
 
     Vec3 albedo(const json& v, const std::string& pointer) const {
-        const Vec3 r = non_negative_vec3(v, pointer);
-        if (r.x > 1 || r.y > 1 || r.z > 1)
+        const std::array<double, 3> w = written_vec3(v, pointer);
+        if (w[0] < 0 || w[1] < 0 || w[2] < 0) fail(pointer, "expected components >= 0");
+        if (w[0] > 1 || w[1] > 1 || w[2] > 1)
             fail(pointer, "expected an albedo with components in [0, 1] (energy conservation)");
-        return r;
+        return rounded(w);
+    }
+
+    // A number within (lo, hi), or [lo, hi] when `closed`, as written; refused with `what`
+    // otherwise. One that float rounds out of the range is noted for the float build.
+    real ranged(const json& v, const std::string& pointer, double lo, double hi, bool closed,
+                const std::string& what) const {
+        const double d = written_number(v, pointer);
+        const auto within = [&](double x) {
+            return closed ? x >= lo && x <= hi : x > lo && x < hi;
+        };
+        if (!within(d)) fail(pointer, what);
+        const double in_float = static_cast<float>(d);
+        if (!within(in_float))
+            note_float_problem(pointer, shortest(d) + " rounds to " + shortest(in_float) +
+                                            " in float, outside the range");
+        return static_cast<real>(d);
     }
 
     long long integer(const json& v, const std::string& pointer, long long lo, long long hi) const {
@@ -176,30 +220,37 @@ void read_camera(const SceneReader& r, const json& root, Scene& scene) {
     camera.position =
         read_position(r, r.require(cam, "/camera", "position"), "/camera/position", from);
     camera.look_at = read_position(r, r.require(cam, "/camera", "look_at"), "/camera/look_at", to);
-    if (cam.contains("up")) camera.up = r.vec3(cam["up"], "/camera/up");
-    if (cam.contains("vfov")) {
-        camera.vfov_degrees = r.number(cam["vfov"], "/camera/vfov");
-        if (!(camera.vfov_degrees > 0.0f && camera.vfov_degrees < 180.0f))
-            r.fail("/camera/vfov", "expected a field of view in degrees, in (0, 180)");
+    std::array<double, 3> written_up = {0.0, 1.0, 0.0};
+    if (cam.contains("up")) {
+        written_up = r.written_vec3(cam["up"], "/camera/up");
+        camera.up = SceneReader::rounded(written_up);
     }
+    if (cam.contains("vfov"))
+        camera.vfov_degrees = r.ranged(cam["vfov"], "/camera/vfov", 0.0, 180.0, false,
+                                       "expected a field of view in degrees, in (0, 180)");
     const double forward[3] = {to.x - from.x, to.y - from.y, to.z - from.z};
     if (forward[0] == 0.0 && forward[1] == 0.0 && forward[2] == 0.0)
         r.fail("/camera/look_at",
                "expected a point different from the camera position (as doubles, they are "
                "equal)");
-    // Parallel or not, on unit vectors: a cross product of raw ones can underflow.
+    // Parallel or not, on unit vectors: a cross product of raw ones can underflow. Judged on
+    // the up vector as written; one that only float rounds to zero or parallel is noted.
     const double f_length = std::hypot(forward[0], forward[1], forward[2]);
-    const double up[3] = {camera.up.x, camera.up.y, camera.up.z};
-    const double up_length = std::hypot(up[0], up[1], up[2]);
-    double f[3], u[3];
-    for (int axis = 0; axis < 3; ++axis) {
-        f[axis] = forward[axis] / f_length;
-        u[axis] = up[axis] / up_length;
-    }
-    const double right[3] = {f[1] * u[2] - f[2] * u[1], f[2] * u[0] - f[0] * u[2],
-                             f[0] * u[1] - f[1] * u[0]};
-    if (!(up_length > 0.0) || std::hypot(right[0], right[1], right[2]) < 1e-30)
+    const auto usable = [&](double ux, double uy, double uz) {
+        const double up_length = std::hypot(ux, uy, uz);
+        double f[3];
+        for (int axis = 0; axis < 3; ++axis) f[axis] = forward[axis] / f_length;
+        const double u[3] = {ux / up_length, uy / up_length, uz / up_length};
+        const double right[3] = {f[1] * u[2] - f[2] * u[1], f[2] * u[0] - f[0] * u[2],
+                                 f[0] * u[1] - f[1] * u[0]};
+        return up_length > 0.0 && std::hypot(right[0], right[1], right[2]) >= 1e-30;
+    };
+    if (!usable(written_up[0], written_up[1], written_up[2]))
         r.fail("/camera/up", "expected an up vector not parallel to the viewing direction");
+    if (!usable(static_cast<float>(written_up[0]), static_cast<float>(written_up[1]),
+                static_cast<float>(written_up[2])))
+        r.note_float_problem("/camera/up",
+                             "the up vector rounds to one parallel to the view (or zero) in float");
 }
 
 void read_light(const SceneReader& r, const json& root, Scene& scene) {
@@ -235,13 +286,11 @@ Material read_material(const SceneReader& r, const json& m, const std::string& p
         if (K::kAlbedo) mat.albedo = r.albedo(r.require(m, p, "albedo"), p + "/albedo");
         if (K::kNumber.key) {
             const std::string at = p + "/" + K::kNumber.key;
-            const real value = r.number(r.require(m, p, K::kNumber.key), at);
-            if (!(value >= K::kNumber.lo && value <= K::kNumber.hi)) {
-                std::ostringstream range;  // [1, 5]
-                range << '[' << K::kNumber.lo << ", " << K::kNumber.hi << ']';
-                r.fail(at, std::string("expected ") + K::kNumber.what + " in " + range.str());
-            }
-            mat.*K::kNumber.field = value;
+            std::ostringstream range;  // [1, 5]
+            range << '[' << K::kNumber.lo << ", " << K::kNumber.hi << ']';
+            mat.*K::kNumber.field =
+                r.ranged(r.require(m, p, K::kNumber.key), at, K::kNumber.lo, K::kNumber.hi, true,
+                         std::string("expected ") + K::kNumber.what + " in " + range.str());
         }
     });
     if (!known)
@@ -393,17 +442,20 @@ void read_render_settings(const SceneReader& r, const json& root, RenderSettings
 // its double build (double_twin.h). Why float cannot place a scene is kept for the double
 // build's report.
 void check_placement(const SceneReader& r, Scene& scene, size_t file_triangles) {
-    const PlacementProblem in_float = placement_problem(scene, file_triangles, kFloatLimits);
+    const PlacementProblem in_float = !r.float_problem.empty()
+                                          ? r.float_problem
+                                          : placement_problem(scene, file_triangles, kFloatLimits);
     if (!in_float.empty()) scene.float_refusal = in_float.pointer + ": " + in_float.message;
-    const PlacementProblem own = build_limits().is_double
-                                     ? placement_problem(scene, file_triangles, kDoubleLimits)
-                                     : in_float;
-    if (own.empty()) return;
-    if (!build_limits().is_double &&
-        placement_problem(scene, file_triangles, kDoubleLimits).empty())
-        r.fail_precision(own.pointer, own.message +
-                                          "; double places it: the references switch to it by "
-                                          "themselves (./lab01-ref), or make lab01-ref-double");
+    if (!build_limits().is_double && in_float.empty()) return;
+    const PlacementProblem in_double = placement_problem(scene, file_triangles, kDoubleLimits);
+    if (in_double.empty()) {
+        if (!build_limits().is_double)
+            r.fail_precision(in_float.pointer, in_float.message + "; " + kDoublePlacesIt);
+        return;
+    }
+    // Neither places it: the float build names float's own limit where it has one.
+    const PlacementProblem& own =
+        build_limits().is_double || !r.float_problem.empty() ? in_double : in_float;
     r.fail(own.pointer, own.message);
 }
 
@@ -451,6 +503,11 @@ void classify_quads(Scene& scene, size_t file_triangles) {
         for (int k = 0; k < 4; ++k) v[k] = moved_to_centre(written[6 * i + corner[k]], centre);
         axis[i] = axis_rect_axis(v);
         kind[i] = axis[i] >= 0 ? kRect : (is_planar_convex_quad(v) ? kQuad : kTriangles);
+        // Three points on a line as written: two triangles, of which the line is left out,
+        // whatever rounding to `real` made of the corner (drop_line_triangles).
+        if (on_a_line({written[6 * i], written[6 * i + 1], written[6 * i + 2]}) ||
+            on_a_line({written[6 * i + 3], written[6 * i + 4], written[6 * i + 5]}))
+            kind[i] = kTriangles;
         rendered[i] = {v[0], v[1], v[2], v[3]};
         if (kind[i] != kRect) add_edges(v, 4);  // two triangles: their outline is the quad's
     }
@@ -495,6 +552,34 @@ void classify_quads(Scene& scene, size_t file_triangles) {
     }
 }
 
+// The triangles whose written points lie on a line (scene_limits.h, on_a_line), which the
+// loader leaves out in every build alike: counts them and names the first as the file writes
+// it. A quad with such a half becomes two triangles (classify_quads), so every one of them
+// is left out by drop_line_triangles.
+void count_line_triangles(Scene& scene, size_t file_triangles) {
+    const std::vector<WrittenPoint>& all = scene.written.triangle_vertices;
+    for (size_t i = 0; 3 * i < all.size(); ++i) {
+        if (!on_a_line({all[3 * i], all[3 * i + 1], all[3 * i + 2]})) continue;
+        if (++scene.line_triangles == 1)
+            scene.first_line_triangle = i < file_triangles
+                                            ? "/triangles/" + std::to_string(i)
+                                            : "/quads/" + std::to_string((i - file_triangles) / 2);
+    }
+}
+
+void drop_line_triangles(Scene& scene) {
+    std::vector<Triangle> kept;
+    std::vector<WrittenPoint> kept_points;
+    const std::vector<WrittenPoint>& all = scene.written.triangle_vertices;
+    for (size_t i = 0; i < scene.of<Triangle>().size(); ++i) {
+        if (on_a_line({all[3 * i], all[3 * i + 1], all[3 * i + 2]})) continue;
+        kept.push_back(scene.of<Triangle>()[i]);
+        kept_points.insert(kept_points.end(), all.begin() + 3 * i, all.begin() + 3 * i + 3);
+    }
+    scene.of<Triangle>() = std::move(kept);
+    scene.written.triangle_vertices = std::move(kept_points);
+}
+
 }  // namespace
 
 Scene parse_scene(const std::string& text, const std::string& name) {
@@ -523,9 +608,25 @@ Scene parse_scene(const std::string& text, const std::string& name) {
     const size_t file_triangles =
         root.contains(kTriangleList.key) ? root[kTriangleList.key].size() : 0;
     check_placement(r, scene, file_triangles);
+    count_line_triangles(scene, file_triangles);
     classify_quads(scene, file_triangles);
+    if (scene.line_triangles > 0) drop_line_triangles(scene);
     scene.t_junction_pieces = split_t_junctions(scene);
     return scene;
+}
+
+void check_render_limits(Scene& scene, int image_height, int bounces) {
+    const PlacementProblem in_float = render_problem(scene, image_height, bounces, kFloatLimits);
+    if (!in_float.empty() && scene.float_refusal.empty())
+        scene.float_refusal = in_float.pointer + ": " + in_float.message;
+    if (!build_limits().is_double && in_float.empty()) return;
+    const PlacementProblem in_double = render_problem(scene, image_height, bounces, kDoubleLimits);
+    const auto where = [&](const PlacementProblem& p) {
+        return scene.name + ": " + p.pointer + ": ";
+    };
+    if (!in_double.empty()) throw InputError(where(in_double) + in_double.message);
+    if (!build_limits().is_double)
+        throw PrecisionError(where(in_float) + in_float.message + "; " + kDoublePlacesIt);
 }
 
 Scene load_scene(const std::string& path) {

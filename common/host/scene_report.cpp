@@ -54,6 +54,8 @@ double detail_size(const K& primitive) {
 SceneUse scene_use(const Scene& scene) {
     SceneUse use;
     use.split_pieces = scene.t_junction_pieces;
+    use.line_triangles = scene.line_triangles;
+    use.first_line_triangle = scene.first_line_triangle;
     for (const Material& m : scene.materials) ++use.materials[static_cast<int>(m.type)];
     use.light = scene.has_light;
     use.background = !is_black(scene.background);
@@ -103,12 +105,12 @@ std::string describe(const SceneUse& use) {
     return line;
 }
 
-std::string scale_warning(const SceneUse& use) {
-    if (use.smallest <= 0 || use.smallest >= use.extent * kResolvedDetail) return "";
-    return "warning: the scene's smallest detail (" + number(use.smallest) + ") is below 1/" +
-           number(1.0 / kResolvedDetail) + " of its extent (" + number(use.extent) +
-           "): rays that cross the scene leave surfaces by offsets close to that size, so it "
-           "will render with visible error; make the detail larger or the scene smaller";
+std::string lines_left_out(const SceneUse& use) {
+    if (use.line_triangles == 0) return "";
+    return "note: " + plural(use.line_triangles, "triangle", "triangles") +
+           " of the file left out, " + (use.line_triangles == 1 ? "its" : "their") +
+           " points on a line (no area at any precision; the first: " + use.first_line_triangle +
+           ")";
 }
 
 std::string to_json(const SceneUse& use) {
@@ -131,5 +133,5 @@ std::string to_json(const SceneUse& use) {
            material_keys + "], \"light\": " + (use.light ? "true" : "false") +
            ", \"background\": " + (use.background ? "true" : "false") +
            ", \"smallest\": " + number(use.smallest) + ", \"extent\": " + number(use.extent) +
-           ", \"warning\": " + (scale_warning(use).empty() ? "false" : "true") + "}";
+           ", \"lines_left_out\": " + std::to_string(use.line_triangles) + "}";
 }

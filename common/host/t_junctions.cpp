@@ -204,6 +204,12 @@ std::vector<Piece> fan(const Piece& piece, const PointIndex& index, const Writte
         const int next = (k + 1) % piece.corners;
         boundary.push_back({piece.rendered[k], piece.written[k], false});
         for (const OnEdge& on : points_on_edge(index, piece.rendered[k], piece.rendered[next])) {
+            // A sliver's own corner can lie within the tolerance of its opposite edge: splitting
+            // there made slivers like it, pass after pass, until memory ran out.
+            bool own = false;
+            for (int c = 0; c < piece.corners; ++c)
+                own = own || same(on.point.rendered, piece.rendered[c]);
+            if (own) continue;
             boundary.push_back(on.point);
             split = true;
         }

@@ -1,7 +1,7 @@
 """What a lab binary says about the scene it renders (common/host/scene_report.h): one line of
-what the scene uses, a warning with what to do when a detail is too small for the scene's
-extent (and the render still goes on), the same in --json, and nothing on stderr with
---quiet."""
+what the scene uses and the precision it renders in, and why (a detail too small for the
+scene's reach is no warning: the reference renders it in double), the same in --json, and
+nothing on stderr with --quiet."""
 import copy
 import json
 import subprocess
@@ -43,12 +43,12 @@ def test_the_scene_is_described(tmp_path):
     assert "warning" not in p.stderr
 
 
-def test_a_detail_too_small_for_the_room_is_warned_of_and_rendered(tmp_path):
+def test_a_detail_too_small_for_the_room_is_rendered_in_double(tmp_path):
     p = render(tiny_bead_in_a_huge_room(), tmp_path)
     assert p.returncode == 0, p.stderr
-    warnings = [line for line in p.stderr.splitlines() if line.startswith("warning: ")]
-    assert len(warnings) == 1, p.stderr
-    assert "make the detail larger or the scene smaller" in warnings[0]
+    lines = p.stderr.splitlines()
+    assert len(lines) == 1 and "in double: float cannot place /spheres/0/radius" in lines[0], \
+        p.stderr
     assert (tmp_path / "out.ppm").exists()
 
 
@@ -56,8 +56,7 @@ def test_json_says_the_same_and_quiet_says_nothing(tmp_path):
     p = render(tiny_bead_in_a_huge_room(), tmp_path, "--json", "--quiet")
     assert p.returncode == 0 and p.stderr == "", p.stderr
     uses = json.loads(p.stdout)["scene_uses"]
-    assert uses["spheres"] == 1 and uses["triangles"] == 0 and uses["warning"] is True
+    assert uses["spheres"] == 1 and uses["triangles"] == 0 and uses["lines_left_out"] == 0
     assert uses["quads"] == 0 and uses["rects"] == 5, uses
     assert uses["smallest"] == 0.01 and uses["extent"] >= 5000, uses
-    p = render(CORNELL, tmp_path, "--json", "--quiet")
-    assert json.loads(p.stdout)["scene_uses"]["warning"] is False
+    assert json.loads(p.stdout)["precision"] == "double"

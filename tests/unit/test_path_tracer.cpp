@@ -184,6 +184,24 @@ TEST(PathTracer, LightBehindTheSurfaceGivesNothing) {
     expect_exact(direct_light_from(v, {0, 0, 0}, {1, 0, 0}, Vec3(0.8f)), Vec3(0.0f));
 }
 
+// A light at the type's largest intensity just above a floor of albedo (1, 0, 1): the light's
+// term saturates at kRealMax instead of overflowing to inf, so a throughput with a zero
+// channel where the term has a full one gives 0, not 0 * inf = NaN.
+TEST(PathTracer, TheLightTermSaturatesAtTheLargestValue) {
+    TestScene ts;
+    const Vec3 albedo(1.0f, 0.0f, 1.0f);
+    ts.floor(ts.material(material_type<Diffuse>, albedo));
+    ts.light({0, real(0.01), 0}, Vec3(kRealMax));
+    const Vec3 lit = direct_light_from(ts.view(), {0, 0, 0}, {0, 1, 0}, albedo);
+    EXPECT_EQ(lit.x, kRealMax);
+    EXPECT_EQ(lit.y, real(0));
+    EXPECT_EQ(lit.z, kRealMax);
+    const Vec3 weighted = Vec3(0.0f, 1.0f, 0.5f) * lit;  // a throughput after a green wall
+    EXPECT_EQ(weighted.x, real(0));
+    EXPECT_EQ(weighted.y, real(0));
+    EXPECT_TRUE(std::isfinite(weighted.z));
+}
+
 TEST(PathTracer, OccludersCastShadowsGlassIncluded) {
     const Vec3 p(0.2f, 0.0f, 0.1f), light(0.2f, 3.0f, 0.1f);
     for (MaterialType type :

@@ -5,9 +5,12 @@
 // where the scene sits does not matter.
 #include <gtest/gtest.h>
 
+#include <cmath>
+#include <cstdio>
 #include <string>
 
 #include "errors.h"
+#include "scene_limits.h"
 #include "scene_loader.h"
 
 namespace {
@@ -52,12 +55,16 @@ void expect_refused(const std::string& text, const std::vector<std::string>& wor
 }  // namespace
 
 TEST(SceneLimits, AcceptsTheRangeTheRendererHandles) {
-    EXPECT_EQ(refusal(scene(sphere("[0, 0, 0]", "1e-9"))), "");
+    // The camera counts in the scene's reach (scene_limits.h): a tiny scene is seen from near.
+    EXPECT_EQ(refusal(scene(sphere("[0, 0, 0]", "1e-9"), "[0, 0, 5e-9]")), "");
     EXPECT_EQ(refusal(scene(sphere("[0, -1e9, 0]", "1e9"))), "");  // a floor of radius 1e9
-    EXPECT_EQ(refusal(scene(sphere("[2e4, -1.4e4, 6e3]", "2"))), "");  // moved 1e4 radii
+    EXPECT_EQ(refusal(scene(sphere("[2e4, -1.4e4, 6e3]", "2"), "[2e4, -1.4e4, 6005]",
+                            "[2e4, -1.4e4, 6e3]")),
+              "");  // moved 1e4 radii, with its camera
     EXPECT_EQ(refusal(scene(triangle("[-1e9, 0, -1e9]", "[-1e9, 0, 1e9]", "[1e9, 0, 0]"))), "");
-    EXPECT_EQ(refusal(scene(triangle("[0, 0, 0]", "[1e-9, 0, 0]", "[0, 1e-9, 0]"))), "");
-    // Zero area as written: nothing to show, kept (and never hit).
+    EXPECT_EQ(refusal(scene(triangle("[0, 0, 0]", "[1e-9, 0, 0]", "[0, 1e-9, 0]"), "[0, 0, 5e-9]")),
+              "");
+    // On a line as written: nothing to show, left out by the loader, judged by no limit.
     EXPECT_EQ(refusal(scene(triangle("[0, 0, 0]", "[1, 1, 1]", "[2, 2, 2]"))), "");
     EXPECT_EQ(refusal(scene(triangle("[0, 0, 0]", "[0, 0, 0]", "[0, 0, 0]"))), "");
 }
@@ -98,7 +105,7 @@ TEST(SceneLimits, RefusesPrimitivesTooSmallForTheirPlaceInTheScene) {
                    {"/spheres/0/radius", "too small for float precision", "scene's centre"});
     EXPECT_EQ(refusal(scene(sphere("[1e5, 0, 0]", "0.1"), "[1e5, 0, 5]", "[1e5, 0, 0]")), "");
     expect_refused(scene(triangle("[1e6, 0, 0]", "[1e6, 1, 0]", "[1e6, 0, 1]") + ",\n" +
-                         sphere("[0, 0, 0]", "3")),
+                         sphere("[0, 0, 0]", "1000")),
                    {"/triangles/0/vertices", "too small for float precision"});
 }
 
@@ -108,4 +115,53 @@ TEST(SceneLimits, RefusesPrimitivesTooSmallForTheirPlaceInTheScene) {
 TEST(SceneLimits, RefusesTrianglesThatCollapseInFloat) {
     expect_refused(scene(triangle("[0, 0, 0]", "[1e7, 1e7, 0]", "[9e6, 9000000.1, 0]")),
                    {"/triangles/0/vertices", "collapses", "rounded to float"});
+}
+
+// What depends on the image's settings (render_problem): a view whose pixels span fewer than
+// 256 ulps of a unit direction, and a light whose brightest path leaves the type's range.
+TEST(SceneLimits, ANarrowViewAndABrightLightNeedTheirType) {
+    const auto view = [](double vfov) {
+        char camera[160];
+        std::snprintf(camera, sizeof camera,
+                      "{\n  \"camera\": { \"position\": [0, 0, 5], \"look_at\": [0, 0, 0], "
+                      "\"vfov\": %.17g },\n",
+                      vfov);
+        return parse_scene(std::string(camera) +
+                               "  \"materials\": { \"m\": { \"type\": \"diffuse\", \"albedo\": "
+                               "[0.5, 0.5, 0.5] } },\n" +
+                               sphere("[0, 0, 0]", "1") + "\n}\n",
+                           "view.json");
+    };
+    // 24 pixels spanning 2 tan(vfov / 2): the limit is 256 * 2^-23 rad a pixel in float.
+    const double limit = 2 * std::atan(12 * 256 * std::ldexp(1.0, -23)) * 180 / M_PI;
+    EXPECT_TRUE(render_problem(view(limit * 1.01), 24, 4, kFloatLimits).empty());
+    const PlacementProblem narrow = render_problem(view(limit * 0.99), 24, 4, kFloatLimits);
+    EXPECT_EQ(narrow.pointer, "/camera/vfov");
+    EXPECT_NE(narrow.message.find("finer than float ray directions resolve"), std::string::npos)
+        << narrow.message;
+    EXPECT_TRUE(render_problem(view(limit * 0.99), 24, 4, kDoubleLimits).empty());
+    EXPECT_FALSE(render_problem(view(1e-12), 24, 4, kDoubleLimits).empty());
+    EXPECT_TRUE(render_problem(view(limit * 0.99), 12, 4, kFloatLimits).empty());  // wider pixels
+
+    // A light 0.01 from a sphere: falloff up to 1 / (pi 1e-4); with 4 bounces, an intensity
+    // of 2.67e34 reaches float's largest value.
+    const auto light = [](double intensity) {
+        char text[200];
+        std::snprintf(text, sizeof text,
+                      "  \"light\": { \"position\": [1.01, 0, 0], \"intensity\": [1, %.17g, 1] "
+                      "},\n",
+                      intensity);
+        return parse_scene(scene(text + sphere("[0, 0, 0]", "1")), "light.json");
+    };
+    EXPECT_TRUE(render_problem(light(2.6e34), 24, 4, kFloatLimits).empty());
+    const PlacementProblem bright = render_problem(light(2.7e34), 24, 4, kFloatLimits);
+    EXPECT_EQ(bright.pointer, "/light/intensity");
+    EXPECT_NE(bright.message.find("beyond float's range"), std::string::npos) << bright.message;
+    EXPECT_TRUE(render_problem(light(2.7e34), 24, 4, kDoubleLimits).empty());
+    EXPECT_TRUE(render_problem(light(2.7e34), 24, 3, kFloatLimits).empty());  // fewer bounces
+    // In the float build a PrecisionError (a reference switches); in double it renders.
+    Scene bright_scene = light(3e38);
+    if (std::string(kPrecisionName) == "float")
+        EXPECT_THROW(check_render_limits(bright_scene, 24, 4), PrecisionError);
+    else EXPECT_NO_THROW(check_render_limits(bright_scene, 24, 4));
 }

@@ -7,6 +7,7 @@
 // "line L, column C" from the marker's place, then removes it before parsing.
 #include <gtest/gtest.h>
 
+#include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
@@ -15,6 +16,7 @@
 #include <vector>
 
 #include "errors.h"
+#include "json_with_positions.h"
 #include "scene_centring.h"
 #include "scene_loader.h"
 
@@ -206,7 +208,7 @@ TEST(SceneLoader, EverythingAsWritten) {
     "steel": { "type": "mirror",  "albedo": [0.9, 0.8, 0.7] }
   },
   "spheres":   [ { "center": [0.5, 0.2, -0.25], "radius": 0.2, "material": "steel" },
-                 { "center": [1, 1, 1], "radius": 3e-4, "material": "glass" } ],
+                 { "center": [1, 1, 1], "radius": 3e-3, "material": "glass" } ],
   "triangles": [ { "vertices": [[0,0,0], [1,0,0], [1,0,-1]], "material": "white" } ],
   "quads":     [ { "vertices": [[0,0,0], [0,1,0], [0,1,-1.5], [0,0,-1]], "material": "glass" } ],
   "render":    { "width": 320, "height": 240, "spp": 16, "bounces": 7, "seed": 99 }
@@ -233,7 +235,7 @@ TEST(SceneLoader, EverythingAsWritten) {
     ASSERT_EQ(s.of<Sphere>().size(), 2u);
     EXPECT_EQ(s.material_names[s.of<Sphere>()[0].material], "steel");
     EXPECT_EQ(s.material_names[s.of<Sphere>()[1].material], "glass");
-    EXPECT_FLOAT_EQ(s.of<Sphere>()[1].radius, 3e-4f);
+    EXPECT_FLOAT_EQ(s.of<Sphere>()[1].radius, 3e-3f);
     // One triangle, and a quad that is planar but no rectangle, and shares an edge with the
     // triangle: a convex quad.
     ASSERT_EQ(s.of<Triangle>().size(), 1u);
@@ -252,9 +254,10 @@ TEST(SceneLoader, EverythingAsWritten) {
 namespace {
 
 // A scene of the given quads (JSON arrays of four points) and triangles, all white.
-std::string scene_of(const std::vector<std::string>& quads,
-                     const std::vector<std::string>& triangles = {}) {
-    std::string text = R"({"camera": {"position": [0.5, 0.5, 3], "look_at": [0.5, 0.5, 0]},
+std::string scene_of(
+    const std::vector<std::string>& quads, const std::vector<std::string>& triangles = {},
+    const std::string& camera = R"("position": [0.5, 0.5, 3], "look_at": [0.5, 0.5, 0])") {
+    std::string text = R"({"camera": {)" + camera + R"(},
         "materials": {"white": {"type": "diffuse", "albedo": [0.5, 0.5, 0.5]}}, "quads": [)";
     for (size_t i = 0; i < quads.size(); ++i)
         text +=
@@ -289,7 +292,7 @@ TEST(SceneLoader, EachQuadBecomesTheKindItIs) {
     EXPECT_TRUE(is(one("[[0,0,0], [1,0,0], [1,1,0.01], [0,1,0]]"), 2, 0, 0));  // not planar
     EXPECT_TRUE(is(one("[[0,0,0], [1,0,0], [0.2,0.2,0], [0,1,0]]"), 2, 0, 0));  // not convex
     EXPECT_TRUE(is(one("[[0,0,0], [1,1,0], [1,0,0], [0,1,0]]"), 2, 0, 0));      // a bow tie
-    EXPECT_TRUE(is(one("[[0,0,0], [1,0,0], [2,0,0], [3,0,0]]"), 2, 0, 0));      // no area
+    EXPECT_TRUE(is(one("[[0,0,0], [1,0,0], [2,0,0], [3,0,0]]"), 0, 0, 0));  // a line: left out
     // Two halves of a split quad keep the file's order: (v0 v1 v2), (v0 v2 v3).
     const Scene s = parse_scene(scene_of({"[[0,0,0], [1,0,0], [1,1,0.01], [0,1,0]]"}), kName);
     EXPECT_EQ(s.of<Triangle>()[1].v0.x, 0.0f);
@@ -347,7 +350,12 @@ TEST(SceneLoader, KindsDoNotDependOnWhereTheSceneIs) {
             }
             moved.push_back(out + "]");
         }
-        const Scene s = parse_scene(scene_of(moved), kName);
+        char camera[160];  // moved with the quads: the camera's distance counts in the limits
+        std::snprintf(camera, sizeof camera,
+                      R"("position": [%.17g, %.17g, %.17g], "look_at": [%.17g, %.17g, %.17g])",
+                      0.5 + shift, 0.5 - shift, 3 + 0.5 * shift, 0.5 + shift, 0.5 - shift,
+                      0.5 * shift);
+        const Scene s = parse_scene(scene_of(moved, {}, camera), kName);
         EXPECT_EQ(s.of<AxisRect>().size(), here.rects) << shift;
         EXPECT_EQ(s.of<ConvexQuad>().size(), here.quads) << shift;
         EXPECT_EQ(s.of<Triangle>().size(), here.triangles) << shift;
@@ -607,12 +615,105 @@ TEST(SceneLoaderErrors, ArrayOfFourWhereThreeExpected) {
 }
 
 // A coordinate is judged once the scene is centred (test_scene_limits.cpp); any other number
-// must be within the type's range as written.
-TEST(SceneLoaderErrors, NumberTooLargeForFloat) {
-    expect_error(scene_with(kGoodSphere,
-                            "  \"light\": { \"position\": [0, 1, 0], "
-                            "\"intensity\": [1, @1e39, 1] },\n"),
-                 {"float range"});
+// beyond float's range, which double holds, is a PrecisionError in the float build (a
+// reference renders it in double) and loads in the double build.
+TEST(SceneLoaderErrors, NumberBeyondFloatsRangeIsForDouble) {
+    const Marked m = unmark(scene_with(kGoodSphere,
+                                       "  \"light\": { \"position\": [0, 1, 0], "
+                                       "\"intensity\": [1, @1e39, 1] },\n"));
+    if (std::string(kPrecisionName) == "double") {
+        EXPECT_EQ(parse_scene(m.text, kName).light.intensity.y, real(1e39));
+        return;
+    }
+    try {
+        parse_scene(m.text, kName);
+        ADD_FAILURE() << "an intensity of 1e39 loaded in float";
+    } catch (const PrecisionError& e) {
+        const std::string message = e.what();
+        EXPECT_NE(message.find(m.position), std::string::npos) << message;
+        EXPECT_NE(message.find("1e+39 is beyond float's range"), std::string::npos) << message;
+        EXPECT_NE(message.find("double places it"), std::string::npos) << message;
+    }
+}
+
+// A value out of its field's range as written is refused in every build with the same
+// message, even where float rounds it into the range (1 + 1e-9 rounds to 1, 5 + 1e-7 to 5).
+TEST(SceneLoaderErrors, RangesAreJudgedOnTheWrittenNumber) {
+    const auto material = [](const std::string& fields) {
+        return "{\n"
+               "  \"camera\": { \"position\": [0, 0, 5], \"look_at\": [0, 0, 0] },\n"
+               "  \"materials\": { \"m\": { " +
+               fields +
+               " } },\n"
+               "  \"spheres\": [ { \"center\": [0, 0, 0], \"radius\": 1, \"material\": \"m\" } ]\n"
+               "}\n";
+    };
+    expect_error(material("\"type\": \"diffuse\", \"albedo\": @[0.5, 1.000000001, 0.5]"),
+                 {"/materials/m/albedo", "in [0, 1]"});
+    expect_error(material("\"type\": \"diffuse\", \"albedo\": @[0.5, -1e-50, 0.5]"),
+                 {"/materials/m/albedo", ">= 0"});
+    expect_error(material("\"type\": \"glass\", \"ior\": @5.0000001"),
+                 {"/materials/m/ior", "an index of refraction in [1, 5]"});
+    expect_error(material("\"type\": \"glass\", \"ior\": @0.99999999999"),
+                 {"/materials/m/ior", "in [1, 5]"});
+    expect_error(material("\"type\": \"diffuse\", \"albedo\": @[0.5, 1e39, 0.5]"),
+                 {"in [0, 1]"});  // out of its own range first: not a precision matter
+    expect_error(scene_with(kGoodSphere, "  \"background\": @[0, -1e-40, 0],\n"),
+                 {"/background", ">= 0"});
+    // Within the range as written: loads in both builds, at the value as written.
+    EXPECT_EQ(parse_scene(material("\"type\": \"glass\", \"ior\": 5"), kName).materials[0].ior,
+              real(5));
+}
+
+// A field of view of 179.99999999 degrees lies in (0, 180) as written: double renders it;
+// float rounds it to 180, so the float build sends it to double with a message that says so.
+TEST(SceneLoaderErrors, FieldOfViewThatFloatRoundsOutOfItsRange) {
+    const Marked m = unmark(
+        "{\n"
+        "  \"camera\": { \"position\": [0, 0, 5], \"look_at\": [0, 0, 0], \"vfov\": @179.99999999 },\n"
+        "  \"materials\": { \"w\": { \"type\": \"diffuse\", \"albedo\": [0.5, 0.5, 0.5] } },\n"
+        "  \"spheres\": [ { \"center\": [0, 0, 0], \"radius\": 1, \"material\": \"w\" } ]\n"
+        "}\n");
+    if (std::string(kPrecisionName) == "double") {
+        EXPECT_LT(parse_scene(m.text, kName).camera.vfov_degrees, 180.0);
+        return;
+    }
+    try {
+        parse_scene(m.text, kName);
+        ADD_FAILURE() << "a field of view float rounds to 180 loaded in float";
+    } catch (const PrecisionError& e) {
+        const std::string message = e.what();
+        EXPECT_NE(message.find(m.position), std::string::npos) << message;
+        EXPECT_NE(message.find("179.99999999 rounds to 180 in float"), std::string::npos)
+            << message;
+    }
+    // 180 itself and beyond are out of the range as written, in every build.
+    expect_error(
+        "{\n"
+        "  \"camera\": { \"position\": [0, 0, 5], \"look_at\": [0, 0, 0], \"vfov\": @180.0000001 },\n"
+        "  \"materials\": { \"w\": { \"type\": \"diffuse\", \"albedo\": [0.5, 0.5, 0.5] } }\n"
+        "}\n",
+        {"expected a field of view in degrees, in (0, 180)"});
+}
+
+// Nesting deeper than any scene file needs is refused before parsing, at the bracket that
+// goes past the limit, at once (the parser took time and memory as the depth squared).
+TEST(SceneLoaderErrors, DeepNestingIsRefusedAtOnce) {
+    std::string text = "{\"camera\": " + std::string(kMaxJsonDepth - 1, '[');
+    const size_t column = text.size() + 1;  // the bracket one past the limit
+    text += std::string(100000, '[') + std::string(100000 + kMaxJsonDepth - 1, ']') + "}";
+    const auto start = std::chrono::steady_clock::now();
+    const std::string message = error_of(text);
+    const double seconds =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    EXPECT_LT(seconds, 0.5);
+    EXPECT_NE(message.find("line 1, column " + std::to_string(column) + ": nesting deeper than 32"),
+              std::string::npos)
+        << message;
+    // Brackets inside strings are text, not nesting: this is refused for its key, not its depth.
+    const std::string in_string = "{\"camera\": {\"name\": \"" + std::string(100, '[') + "\\\"" +
+                                  std::string(100, '{') + "\"}}";
+    EXPECT_NE(error_of(in_string).find("unknown key \"name\""), std::string::npos);
 }
 
 TEST(SceneLoaderErrors, QuadWithThreeVertices) {

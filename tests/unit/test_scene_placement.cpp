@@ -136,3 +136,46 @@ TEST(ScenePlacement, OnlyWhatDoublePlacesIsAPrecisionError) {
         EXPECT_NE(std::string(e.what()).find("/spheres/0/radius"), std::string::npos) << e.what();
     }
 }
+
+// A triangle whose written points lie on a line, exactly or to within the rounding of the
+// file's decimals, has no area at any precision: left out alike in float and double (this
+// file is compiled into both), counted, the first named; a thin triangle with an area is kept.
+// Nearly collinear as written, a triangle used to collapse in float (a switch to double, a
+// refusal in lab 02) or keep a sliver of area made of rounding.
+TEST(ScenePlacement, TrianglesOnALineAreLeftOutInEveryPrecision) {
+    const auto scene = [](const std::string& triangles, const std::string& quads) {
+        return parse_scene(
+            "{\"camera\": {\"position\": [0, 1, 3], \"look_at\": [0, 0, 0]},\n"
+            "\"materials\": {\"w\": {\"type\": \"diffuse\", \"albedo\": [0.5, 0.5, 0.5]}},\n"
+            "\"spheres\": [{\"center\": [0, 0, 0], \"radius\": 1, \"material\": \"w\"}],\n"
+            "\"triangles\": [" +
+                triangles + "],\n\"quads\": [" + quads + "]}",
+            "lines.json");
+    };
+    const auto triangle = [](const std::string& points) {
+        return "{\"vertices\": " + points + ", \"material\": \"w\"}";
+    };
+    for (const char* line : {
+             "[[0.1, 0.2, 0.3], [0.2, 0.4, 0.6], [0.3, 0.6, 0.9]]",  // not exactly, in double
+             "[[0, 0, 0], [0.1, 0.3, 0.7], [0.3, 0.9, 2.1]]",
+             "[[0.1, 0.7, 0.3], [1.1, 1.7, 1.3], [3.7, 4.3, 3.9]]",
+             "[[1000000.1, 0.2, 0.3], [1000000.2, 0.4, 0.6], [1000000.3, 0.6, 0.9]]",
+             "[[0, 0, 0], [1, 1, 1], [2, 2, 2]]",  // exactly
+         }) {
+        const Scene s =
+            scene(triangle("[[-1, 0, -1], [1, 0, -1], [0, 0, 1]]") + ", " + triangle(line), "");
+        EXPECT_EQ(s.of<Triangle>().size(), 1u) << line;
+        EXPECT_EQ(s.line_triangles, 1) << line;
+        EXPECT_EQ(s.first_line_triangle, "/triangles/1") << line;
+    }
+    // Thin, with an area far above the rounding: kept.
+    const Scene thin = scene(triangle("[[0, 0, 0], [1, 0, 0], [0.5, 1e-9, 0]]"), "");
+    EXPECT_EQ(thin.of<Triangle>().size(), 1u);
+    EXPECT_EQ(thin.line_triangles, 0);
+    // A quad with three points on a line: its other half is kept, as a triangle.
+    const Scene quad = scene("", triangle("[[0, 0, 0], [0.5, 0, 0], [1, 0, 0], [0.5, 0, -1]]"));
+    EXPECT_EQ(quad.of<Triangle>().size(), 1u);
+    EXPECT_EQ(quad.of<ConvexQuad>().size() + quad.of<AxisRect>().size(), 0u);
+    EXPECT_EQ(quad.line_triangles, 1);
+    EXPECT_EQ(quad.first_line_triangle, "/quads/0");
+}

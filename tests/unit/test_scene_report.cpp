@@ -1,5 +1,5 @@
-// What the driver tells about a scene (scene_report.h): the counts by kind, and the warning for
-// a detail too small for the scene's extent, which must appear exactly past the threshold.
+// What the driver tells about a scene (scene_report.h): the counts by kind, the sizes, and the
+// note on triangles of the file left out because their points lie on a line.
 #include <gtest/gtest.h>
 
 #include "scene_loader.h"
@@ -43,7 +43,7 @@ TEST(SceneReport, CountsWhatTheSceneUses) {
     EXPECT_NE(line.find("scene: 1 sphere, 1 triangle;"), std::string::npos) << line;
     EXPECT_NE(line.find("1 diffuse, 1 glass"), std::string::npos) << line;
     EXPECT_NE(line.find("1 : 8"), std::string::npos) << line;
-    EXPECT_EQ(scale_warning(use), "");
+    EXPECT_EQ(lines_left_out(use), "");
 }
 
 // Quads and rectangles are counted by kind, and their edges are sizes; kinds the scene does
@@ -81,23 +81,23 @@ TEST(SceneReport, SaysHowManyPrimitivesSplittingAdded) {
         << line;
 }
 
-// The warning starts where a detail spans fewer than 2^14 of the scene's extent.
-TEST(SceneReport, WarnsOfADetailBelowTheResolvedSize) {
-    const double wall = 1000.0;
-    const double limit = wall * kResolvedDetail;  // about 0.061
-    EXPECT_EQ(scale_warning(scene_use(scene_with(limit * 1.5, wall))), "");
-    const std::string warning = scale_warning(scene_use(scene_with(limit * 0.5, wall)));
-    ASSERT_FALSE(warning.empty());
-    EXPECT_EQ(warning.rfind("warning: ", 0), 0u) << warning;
-    EXPECT_NE(warning.find("make the detail larger or the scene smaller"), std::string::npos);
-    EXPECT_NE(to_json(scene_use(scene_with(limit * 0.5, wall))).find("\"warning\": true"),
-              std::string::npos);
+// Triangles left out for lying on a line: one note line naming the first, and --json's count.
+TEST(SceneReport, SaysWhichTrianglesOnALineWereLeftOut) {
+    Scene s = scene_with(0.25, 2.0);
+    EXPECT_NE(to_json(scene_use(s)).find("\"lines_left_out\": 0"), std::string::npos);
+    s.line_triangles = 2;
+    s.first_line_triangle = "/quads/4";
+    const std::string note = lines_left_out(scene_use(s));
+    EXPECT_EQ(note,
+              "note: 2 triangles of the file left out, their points on a line (no area at any "
+              "precision; the first: /quads/4)");
+    EXPECT_NE(to_json(scene_use(s)).find("\"lines_left_out\": 2"), std::string::npos);
 }
 
 TEST(SceneReport, AnEmptySceneHasNoSizes) {
     Scene s;
     const SceneUse use = scene_use(s);
     EXPECT_EQ(use.smallest, 0.0);
-    EXPECT_EQ(scale_warning(use), "");
+    EXPECT_EQ(lines_left_out(use), "");
     EXPECT_EQ(describe(use).find("sizes"), std::string::npos);
 }

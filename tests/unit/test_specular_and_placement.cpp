@@ -228,8 +228,8 @@ TEST(WrittenCoordinates, RefusalsGiveTheTrueReasonAtAnyScale) {
 }
 
 #if !defined(RT_DOUBLE)
-// A detail below 2^-20 of the centred scene's extent is refused in float, naming the double
-// build; at 2^-17 it loads (the report warns of it).
+// A detail below 2^-13 of the centred scene's reach (128 ray offsets) is refused in float,
+// naming the double build; at 2^-12 it loads.
 TEST(WrittenCoordinates, MixedScalesBeyondFloatAreRefused) {
     const auto scene = [](double radius) {
         char text[512];
@@ -246,6 +246,7 @@ TEST(WrittenCoordinates, MixedScalesBeyondFloatAreRefused) {
     EXPECT_NE(message.find("/spheres/0/radius"), std::string::npos) << message;
     EXPECT_NE(message.find("double places it"), std::string::npos) << message;
     EXPECT_NE(message.find("lab01-ref"), std::string::npos) << message;
-    EXPECT_NO_THROW(parse_scene(scene(1e4 / (1 << 17)), "fine.json"));
+    EXPECT_NO_THROW(parse_scene(scene(1e4 / (1 << 12)), "fine.json"));
+    EXPECT_THROW(parse_scene(scene(1e4 / (1 << 14)), "near.json"), PrecisionError);
 }
 #endif

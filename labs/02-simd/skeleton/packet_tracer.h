@@ -575,8 +575,13 @@ inline MaskOf<F> sample_light(const SceneView& scene, const Vec3xN<F>& position,
     if (none(lit)) return lit;
     shadow.ray = {origin, wi};
     shadow.t_max = distance - dot(origin - position, wi);
-    shadow.radiance =
+    // Saturated at float's largest value, as in the scalar code (no inf to meet a zero
+    // channel); min(a, b) is min_float(a, b) lane by lane.
+    const Vec3xN<F> radiance =
         albedo * Vec3xN<F>(scene.light.intensity) * (cos_theta / (F(kPi) * distance2));
+    const F largest(FLT_MAX);
+    shadow.radiance = {min(radiance.x, largest), min(radiance.y, largest),
+                       min(radiance.z, largest)};
     return lit;
 }
 
