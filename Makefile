@@ -135,7 +135,7 @@ $(DOUBLE_BUILD)/%.o: %.cpp
 # ---- labs -------------------------------------------------------------------------------
 # lab01 builds labs/01-serial/skeleton, lab01-ref builds labs/01-serial/solution. Each
 # folder comes first on the include path of its own objects, so the skeleton's copy of a
-# shared header (lab 01's path_tracer.h) stands in for common/'s.
+# shared header (lab 01's path_steps.h) stands in for common/'s.
 define cpu_lab
 $(BUILD)/labs/$(2)/skeleton/%.o: LAB_INCLUDES = -Ilabs/$(2)/skeleton
 $(BUILD)/labs/$(2)/solution/%.o: LAB_INCLUDES = -Ilabs/$(2)/solution

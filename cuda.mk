@@ -14,7 +14,7 @@
 # common/cuda/ (error checks, device memory, timers, the scene upload, the reference
 # megakernel), and for the wavefront labs common/wavefront/ (queues, pool layouts, kernels,
 # stage loop, renderer). A file students write (labs/NN/skeleton/) stands in for the shared
-# file of the same name, as lab 01's path_tracer.h does (DESIGN.md, section 1).
+# file of the same name, as lab 01's path_steps.h does (DESIGN.md, section 1).
 #
 # Architectures: the GPUs present (nvidia-smi's compute capability), or, where there is none
 # (a student's machine building for `make run-gpu`), machine code for sm_75 (Turing), sm_80

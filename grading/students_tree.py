@@ -1,7 +1,7 @@
 """The tree a submission is compiled in: exactly what a student of the lab holds, never more.
 
 In the course repository (and in the Gradescope bundle, which is that repository) the shared
-files students write, such as lab 01's common/core/path_tracer.h, are the solutions: a
+files students write, such as lab 01's common/core/path_steps.h, are the solutions: a
 hand-in that leaves its copy out would be built against the solution, and the objects in
 build/ are the references'. So a submission is compiled in a students' tree made for its lab:
 

@@ -13,7 +13,7 @@ the "//>" lines (keeping their indentation). Comment lines that start with "//!"
 instructors only (how the file becomes a skeleton, where its solution lives): the skeleton
 drops them too. A lab's solution/ files become skeleton/ files of
 the same name; the shared files a lab lists as `shared` in labs/labs.toml (code the lab's
-students write but later labs reuse, such as common/core/path_tracer.h) become skeleton/
+students write but later labs reuse, such as common/core/path_steps.h) become skeleton/
 files too; the
 lab's build puts skeleton/ first on the include path, so there they stand in for the shared
 file.

@@ -21,7 +21,7 @@ def lab_sources(lab: str, source_dir: str = "solution") -> dict[str, str]:
 
 def build_sources(variant_lab: str, workdir: pathlib.Path, sources: dict[str, str],
                   make_args=(), target: str = "variant") -> pathlib.Path:
-    """Write `sources` (bare file names: render.cpp, path_tracer.h, ray.h...) into a folder and
+    """Write `sources` (bare file names: render.cpp, path_steps.h, ray.h...) into a folder and
     build them as the Makefile builds `variant_lab` (a lab folder name, or 02-simd-a for lab 02
     Part A); `make_args` override Makefile variables (e.g. OPT, BUILD); `target` is
     cuda-variant for a CUDA lab. Returns the binary."""

@@ -2,7 +2,7 @@
 // closest-hit and shadow loops visit every kind in turn; a scene without triangles still pays
 // for the triangle loop's setup (the ray's shear) and, on a GPU, for the registers of every
 // test compiled in. A renderer instantiated for the kinds its scene has carries only their
-// loops (`if constexpr` in path_tracer.h), with the same arithmetic for every primitive it
+// loops (`if constexpr` in path_steps.h), with the same arithmetic for every primitive it
 // does test, so the same bits.
 //
 // A set names its kinds (Kinds<Sphere, AxisRect>, kinds.h), drawn from AllPrimitives
@@ -13,7 +13,7 @@
 #include <primitive_kinds.h>
 #include <scene_view.h>
 
-// What a Hit names (path_tracer.h): nothing, or a primitive of one kind, numbered by its
+// What a Hit names (path_state.h): nothing, or a primitive of one kind, numbered by its
 // position in AllPrimitives from 1 (primitive_kind<Sphere> is 1).
 enum class PrimitiveKind : int { None = 0 };
 

@@ -35,7 +35,7 @@ struct MaterialNumber {
 //   kReportKey     its --json key;
 //   kAlbedo        whether its entry has an "albedo" (in [0, 1] per channel);
 //   kNumber        the one number more its entry has, if any (MaterialNumber);
-// and, but for Diffuse (the kind that samples the light: path_tracer.h's bounce step), a hook
+// and, but for Diffuse (the kind that samples the light: path_steps.h's bounce step), a hook
 //   scatter(K{}, material, SpecularHit, rng, bounce, throughput, next)
 // that continues the path: the next ray and the throughput's weight (below).
 struct Diffuse {  // Lambertian: albedo / pi
@@ -135,7 +135,7 @@ RT_HD inline Vec3 refract(Vec3 d, Vec3 n, real eta, real cos_t) {
     return normalize(d * eta + n * (eta * cos_i - cos_t));
 }
 
-// What a kind's scatter hook reads of a specular hit (path_tracer.h's bounce step fills it in).
+// What a kind's scatter hook reads of a specular hit (path_steps.h's bounce step fills it in).
 struct SpecularHit {
     Vec3 incoming;  // the ray's unit direction
     Vec3 facing;  // the unit geometric normal on the ray's side

@@ -1,5 +1,5 @@
 // The primitive kinds: declared here once, as one list. Its order is the order in which the
-// closest-hit and shadow loops visit the kinds (path_tracer.h) and so the order in which equal
+// closest-hit and shadow loops visit the kinds (path_steps.h) and so the order in which equal
 // distances are decided; a kind's position numbers it in a Hit and a packed hit. The scene's
 // arrays, their upload, the sets a renderer is compiled for and the report's counters follow
 // the list (DESIGN.md §6, "Only what the scene uses").
@@ -8,7 +8,7 @@
 //   kName, kReportKey  what the scene report calls one, and its --json key;
 //   kShearsRay         whether its test takes the ray's RayShear (triangle.h), which the loops
 //                      build once per ray for every kind that does;
-// and these functions of it (its hooks), which the loops of path_tracer.h call by kind (with
+// and these functions of it (its hooks), which the loops of path_steps.h call by kind (with
 // the shear after the ray where kShearsRay, as `intersect(ray, shear, k, t_max)`):
 //   intersect<kConverged>(ray, k, t_max)  the distance in (0, t_max), else t_max;
 //   occludes<kConverged>(ray, k, t_max)   whether it lies on the ray before t_max;

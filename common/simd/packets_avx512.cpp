@@ -9,7 +9,7 @@
 #include <vector>
 
 // Pixel after pixel, each one's samples in packets traced from camera to end
-// (packet_tracer.h, as lab 02's students write it).
+// (packet_tracer.h, with the intersection tests lab 02's students write: packet_hits.h).
 void render_pixels_avx512(const SceneView& scene, const Camera& camera,
                           const RenderSettings& settings, long first_pixel, int pixel_count,
                           Vec3* out) {

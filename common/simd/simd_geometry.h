@@ -146,7 +146,7 @@ inline Float8 intersect_rects8(const BroadcastRay& r, const RectPacket& p, Float
     return select(hit, t, t_max);
 }
 
-// closest_hit (path_tracer.h) over every packet: 8 primitives per test, then the nearest lane;
+// closest_hit (path_steps.h) over every packet: 8 primitives per test, then the nearest lane;
 // the convex quads, and any kind after the rectangles in AllPrimitives (one added to the list),
 // one by one with their scalar hooks (primitive_kinds.h), in the scalar loops' order. Primitives: the kinds compiled in
 // (geometry_set.h); the loops of kinds the scene lacks cost a comparison, and are kept.
@@ -197,7 +197,7 @@ inline Hit closest_hit(const SimdSceneView& scene, const Ray& ray) {
     return hit;
 }
 
-// occluded (path_tracer.h): stops at the first packet with a hit.
+// occluded (path_steps.h): stops at the first packet with a hit.
 template <class Primitives = AnyGeometry>
 inline bool occluded(const SimdSceneView& scene, const Ray& ray, float t_max) {
     const BroadcastRay r(ray);

@@ -74,7 +74,7 @@ def shipped(path: str, lab: str, folders: dict[str, str]) -> bool:
 
 def skeleton_form(lab: str, folders: dict[str, str]) -> set[str]:
     """Shared files whose solution regions belong to lab `lab` or later: they ship as their
-    skeleton (common/core/path_tracer.h is lab 01's, so only a lab-01 release ships it so)."""
+    skeleton (common/core/path_steps.h is lab 01's, so only a lab-01 release ships it so)."""
     return {path for number, name in folders.items() if number >= lab
             for path in leaks.skeletons.SHARED_SOURCES.get(name, [])}
 

@@ -18,6 +18,9 @@ ifneq ($(filter x86_64% i686% i386%,$(shell $(CXX) -dumpmachine)),)
 # -march=native on an AVX2 machine; what lets another machine build it at all).
 # Part B's objects see lab 02's SIMD library (common/simd/) on the include path.
 $(BUILD)/$(LAB02)/%.o: LAB_INCLUDES = -Icommon/simd
+# The skeleton's objects see skeleton/ first: its packet_hits.h (the student's intersection
+# tests) stands in for common/simd/packet_hits.h, which packet_tracer.h includes.
+$(BUILD)/$(LAB02)/skeleton/%.o: LAB_INCLUDES = -I$(LAB02)/skeleton -Icommon/simd
 $(BUILD)/$(LAB02)/skeleton/render_avx2.o $(BUILD)/$(LAB02)/solution/render_avx2.o \
 $(BUILD)/$(LAB02)/render_prims.o: CXXFLAGS += $(SIMD_AVX2_FLAGS)
 

@@ -19,7 +19,7 @@ def normal(quad):
 
 @pytest.mark.parametrize("angle", [0.0, 45.0])
 def test_each_pane_face_points_out_of_the_glass(angle):
-    """The core takes a glass triangle's medium to lie behind its front face (path_tracer.h:
+    """The core takes a glass triangle's medium to lie behind its front face (path_steps.h:
     `entering = dot(incoming, normal) < 0`), so each face's normal must point away from the
     other face."""
     scene = scenes.glass_slab(ior=1.5, albedo=0.8, intensity=4.0, angle_deg=angle)

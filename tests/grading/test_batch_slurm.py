@@ -122,10 +122,10 @@ def test_a_class_graded_as_a_job_array(tmp_path, slurm):
     base.chmod(0o755)
     (subs / "ada").mkdir(parents=True)
     shutil.copy(ROOT / "labs/01-serial/solution/render.cpp", subs / "ada")
-    shutil.copy(ROOT / "common/core/path_tracer.h", subs / "ada")
+    shutil.copy(ROOT / "common/core/path_steps.h", subs / "ada")
     (subs / "bob").mkdir()
     (subs / "bob" / "render.cpp").write_text("int broken( {\n")
-    (subs / "bob" / "path_tracer.h").write_text("")
+    (subs / "bob" / "path_steps.h").write_text("")
     p = subprocess.run(["make", "-s", "-C", str(ROOT), "grade-slurm", "LAB=01",
                         f"SUBMISSIONS={subs}", f"REPORT={report}"], capture_output=True,
                        text=True, env=slurm, timeout=120)

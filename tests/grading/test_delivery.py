@@ -29,7 +29,7 @@ def test_batch_grades_each_student_into_csv_and_html(tmp_path):
     subs = tmp_path / "submissions"
     for student in ("alice", "bob", "carol"):
         (subs / student).mkdir(parents=True)
-    for name in ("render.cpp", "path_tracer.h"):               # correct sources
+    for name in ("render.cpp", "path_steps.h"):               # correct sources
         shutil.copy2(ROOT / "labs/01-serial/solution" / name if name == "render.cpp"
                      else ROOT / "common/core" / name, subs / "alice" / name)
     sub.exec_reference(subs / "bob")          # a program only: never run, nothing to build
@@ -50,8 +50,8 @@ def test_batch_grades_each_student_into_csv_and_html(tmp_path):
 
 def test_gradescope_bundle_grades_a_submission(tmp_path, request):
     """The zip, unpacked where Gradescope unpacks it, grades lab 01's solution handed in as a
-    student's render.cpp and path_tracer.h: 100 points in /autograder/results/results.json.
-    The render.cpp alone is built against the skeleton's path_tracer.h (the students' tree),
+    student's render.cpp and path_steps.h: 100 points in /autograder/results/results.json.
+    The render.cpp alone is built against the skeleton's path_steps.h (the students' tree),
     as a student's own would be, and scores what the skeleton scores."""
     from grading.releases.gradescope import bundle
     # Gradescope's /autograder is open to all; pytest's tmp_path is not (0700 above it), and
@@ -86,8 +86,8 @@ def test_gradescope_bundle_grades_a_submission(tmp_path, request):
 
     alone = run_autograder()
     assert alone["score"] <= 10, json.dumps(alone, indent=1)[:3000]
-    assert "not handed in, the skeleton's copy used: path_tracer.h" in alone["output"]
-    shutil.copy(ROOT / "common" / "core" / "path_tracer.h", root / "submission")
+    assert "not handed in, the skeleton's copy used: path_steps.h" in alone["output"]
+    shutil.copy(ROOT / "common" / "core" / "path_steps.h", root / "submission")
     results = run_autograder()
     assert results["score"] == 100, json.dumps(results, indent=1)[:3000]
 

@@ -10,7 +10,7 @@ from labkit.harness import ROOT, build
 from labkit.variants import build_variant
 from tests.grading import submissions as sub
 
-PATH_TRACER = (ROOT / "common" / "core" / "path_tracer.h").read_text()
+PATH_STEPS = (ROOT / "common" / "core" / "path_steps.h").read_text()
 LOOP_END = "path.alive = path.bounce < max_bounces;"
 BRDF_PI = "(cos_theta / (kPi * distance2))"
 # mistake -> (the edit to the shared path tracer, words the sphere interior must say)
@@ -30,9 +30,9 @@ def output_of(results: dict, check: str) -> str:
 @pytest.mark.parametrize("mistake", sorted(SOURCE_MISTAKES))
 def test_a_source_mistake_is_identified(mistake, tmp_path):
     (old, new), words = SOURCE_MISTAKES[mistake]
-    assert PATH_TRACER.count(old) == 1, f"the path tracer no longer holds {old!r}"
+    assert PATH_STEPS.count(old) == 1, f"the path tracer no longer holds {old!r}"
     binary = build_variant("01-serial", tmp_path,
-                           {"path_tracer.h": PATH_TRACER.replace(old, new)})
+                           {"path_steps.h": PATH_STEPS.replace(old, new)})
     results = grade("01", binary, tmp_path, trusted=True)
     interior = output_of(results, "sphere-interior")
     assert words in interior, describe(results)

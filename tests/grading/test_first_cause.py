@@ -94,14 +94,14 @@ def test_a_wrong_lane_mask_in_lab02_is_named_by_its_kind_before_the_statistics(t
     write."""
     if not cpu_has_avx2():
         pytest.skip("this CPU has no AVX2/FMA: lab 02's Part B cannot run")
-    source = (ROOT / "common/simd/packet_tracer.h").read_text()
+    source = (ROOT / "common/simd/packet_hits.h").read_text()
     mutations = {"return select(crosses & inside, t, t_max);": "return select(inside, t, t_max);",
                  "inside = and_not(candidates, any_negative & any_positive);":
                      "inside = and_not(candidates, any_negative);"}
     for old, new in mutations.items():
         assert source.count(old) == 1, old
         source = source.replace(old, new)
-    mutant = build_variant("02-simd", tmp_path, {"packet_tracer.h": source})
+    mutant = build_variant("02-simd", tmp_path, {"packet_hits.h": source})
     with draws.secret("lanes"), symptoms.grading("02"), policy(UNTRUSTED), rerun_as("./lab02"):
         result = check_golden(mutant, "showcase")
     assert not result.passed

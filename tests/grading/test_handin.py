@@ -32,7 +32,7 @@ def test_the_zip_holds_exactly_the_lab_files(tmp_path, lab):
 
 
 def test_lab02_hands_in_part_a_in_its_folder():
-    assert handin.handin_files("02") == ["packet_tracer.h", "render.cpp", "render_avx2.cpp",
+    assert handin.handin_files("02") == ["packet_hits.h", "render.cpp", "render_avx2.cpp",
                                          "part-a/vec3.h"]
 
 
@@ -53,7 +53,7 @@ def test_a_missing_file_is_named(tmp_path):
     (tmp_path / "sub" / "inner").mkdir(parents=True)
     (tmp_path / "sub" / "inner" / "render.cpp").write_text("// mine\n")
     files, missing = students_tree.collect(tmp_path / "sub", "01-serial")
-    assert files == {"render.cpp": b"// mine\n"} and missing == ["path_tracer.h"]
+    assert files == {"render.cpp": b"// mine\n"} and missing == ["path_steps.h"]
 
 
 def test_the_grader_refuses_an_empty_hand_in_in_one_line(tmp_path):
@@ -66,7 +66,7 @@ def test_the_grader_refuses_an_empty_hand_in_in_one_line(tmp_path):
     assert p.returncode != 0, p.stdout + p.stderr
     assert p.stderr.strip().splitlines() == \
         ["error: the hand-in was refused: no file of lab 01 was handed in: "
-         "expected path_tracer.h, render.cpp"]
+         "expected path_steps.h, render.cpp"]
     r = json.loads(results.read_text())
     assert r["score"] == 0 and "no file of lab 01 was handed in" in r["output"]
 

@@ -71,13 +71,13 @@ def test_a_grade_writes_a_page_with_the_images(lab01_ref, tmp_path):
 
 
 def skipping(kind: str) -> dict:
-    """path_tracer.h whose closest-hit loop never finds a primitive of one kind."""
+    """path_steps.h whose closest-hit loop never finds a primitive of one kind."""
     from labkit.harness import ROOT as root
-    text = (root / "common" / "core" / "path_tracer.h").read_text()
+    text = (root / "common" / "core" / "path_steps.h").read_text()
     keep = "if (t < hit.t) hit = {t, primitive_kind<K>, i};"
     assert text.count(keep) == 1, keep
     skip = f"if (t < hit.t && !has_kind<Kinds<{kind}>, K>) hit = {{t, primitive_kind<K>, i}};"
-    return {"path_tracer.h": text.replace(keep, skip, 1)}
+    return {"path_steps.h": text.replace(keep, skip, 1)}
 
 
 def test_the_hidden_scene_holds_every_kind_of_the_lists(lab01_ref, tmp_path):

@@ -304,8 +304,8 @@ def grade_sources(lab: str, folder: pathlib.Path, tmp_path: pathlib.Path) -> dic
 
 
 def test_a_missing_shared_file_is_the_skeletons_not_the_solution(tmp_path):
-    """Lab 01's render.cpp done, its path_tracer.h left out: in the course repository the
-    shared path_tracer.h is the solution; a student's tree has the skeleton's, and so does the
+    """Lab 01's render.cpp done, its path_steps.h left out: in the course repository the
+    shared path_steps.h is the solution; a student's tree has the skeleton's, and so does the
     grader's build. At most what the skeleton earns."""
     folder = handin(tmp_path / "in", {"render.cpp": solution_text("01-serial", "render.cpp")})
     results = grade_sources("01", folder, tmp_path)
@@ -327,16 +327,16 @@ def test_a_link_is_refused_in_one_line(tmp_path, target):
     """A link to the solution would hand it in; one into /proc would read the grader's
     environment (and its secret) as root. Either is refused before anything is read."""
     folder = handin(tmp_path / "in", {"render.cpp": solution_text("01-serial", "render.cpp")})
-    linked = (ROOT / "common" / "core" / "path_tracer.h" if target == "solution"
+    linked = (ROOT / "common" / "core" / "path_steps.h" if target == "solution"
               else pathlib.Path("/proc/self/environ"))
-    (folder / "path_tracer.h").symlink_to(linked)
+    (folder / "path_steps.h").symlink_to(linked)
     out = tmp_path / "results.json"
     p = subprocess.run([sys.executable, "-m", "grading.grade", "01", "--sources", str(folder),
                         "--results", str(out)], cwd=ROOT, capture_output=True, text=True,
                        timeout=300, env={**os.environ, "GRADING_SECRET": "leak-me-4711"})
     results = json.loads(out.read_text())
     assert p.returncode == 1 and results["score"] == 0, describe(results)
-    assert "path_tracer.h is a symbolic link" in results["output"], results["output"]
+    assert "path_steps.h is a symbolic link" in results["output"], results["output"]
     assert "\n" not in results["output"] and "leak-me-4711" not in out.read_text()
 
 
@@ -345,7 +345,7 @@ def test_no_expected_file_is_one_line_naming_them(tmp_path):
     from grading.grade import build_lab
     binary, errors = build_lab("01", folder, trusted=False)
     assert binary is None and "\n" not in errors, errors
-    assert "expected path_tracer.h, render.cpp" in errors, errors
+    assert "expected path_steps.h, render.cpp" in errors, errors
 
 
 def test_a_nested_checkout_is_found_and_the_reference_scores_100(tmp_path):
@@ -353,7 +353,7 @@ def test_a_nested_checkout_is_found_and_the_reference_scores_100(tmp_path):
     the expected files is taken, not a stray copy higher up."""
     folder = handin(tmp_path / "in", {
         "lab01/labs/01-serial/skeleton/render.cpp": solution_text("01-serial", "render.cpp"),
-        "lab01/labs/01-serial/skeleton/path_tracer.h": solution_text("01-serial", "path_tracer.h"),
+        "lab01/labs/01-serial/skeleton/path_steps.h": solution_text("01-serial", "path_steps.h"),
         "lab01/common/core/vec3.h": (ROOT / "common" / "core" / "vec3.h").read_text()})
     results = grade_sources("01", folder, tmp_path)
     assert results["score"] == 100, describe(results)
@@ -379,7 +379,7 @@ def test_build_folders_are_removed(tmp_path):
                     "--results", str(tmp_path / "r.json")], cwd=ROOT, capture_output=True,
                    timeout=300, env={**os.environ, "TMPDIR": str(tmp)})
     good = handin(tmp_path / "good", {"render.cpp": solution_text("01-serial", "render.cpp"),
-                                      "path_tracer.h": solution_text("01-serial", "path_tracer.h")})
+                                      "path_steps.h": solution_text("01-serial", "path_steps.h")})
     subprocess.run([sys.executable, "-m", "grading.grade", "01", "--sources", str(good),
                     "--results", str(tmp_path / "r2.json"), "--budget-seconds", "0"], cwd=ROOT,
                    capture_output=True, timeout=300, env={**os.environ, "TMPDIR": str(tmp)})
@@ -597,7 +597,7 @@ def test_the_reference_objects_are_out_of_the_compilers_reach(tmp_path):
             folder = handin(tmp_path / f"{target.name}-{len(spelling)}", {
                 "render.cpp": f'__asm__(".section .rodata\\n{spelling} \\"{target}\\"\\n.text");\n'
                               + solution_text("01-serial", "render.cpp"),
-                "path_tracer.h": solution_text("01-serial", "path_tracer.h")})
+                "path_steps.h": solution_text("01-serial", "path_steps.h")})
             binary, errors = build_lab("01", folder, trusted=False)
             assert binary is None, errors
             if spelling == ".incbin":
@@ -629,7 +629,7 @@ def test_a_file_name_that_is_shell_code_is_refused_in_one_line(tmp_path):
     run what follows it. Names outside [A-Za-z0-9_.+-] are refused before anything is built."""
     name = "x.cpp;echo INJECTED-BUILD-STEP;.cpp"
     folder = handin(tmp_path / "in", {"render.cpp": solution_text("01-serial", "render.cpp"),
-                                      "path_tracer.h": solution_text("01-serial", "path_tracer.h"),
+                                      "path_steps.h": solution_text("01-serial", "path_steps.h"),
                                       name: "int unused;\n"})
     out = tmp_path / "results.json"
     p = subprocess.run([sys.executable, "-m", "grading.grade", "01", "--sources", str(folder),

@@ -112,7 +112,7 @@ def test_a_hand_in_running_a_copy_of_itself_scores_nothing(mode, tmp_path):
     from tests.grading.test_hostile import handin, solution_text
     folder = handin(tmp_path / "in", {
         "render.cpp": solution_text("01-serial", "render.cpp"),
-        "path_tracer.h": solution_text("01-serial", "path_tracer.h"),
+        "path_steps.h": solution_text("01-serial", "path_steps.h"),
         "copy.cpp": RUNS_A_COPY})
     binary, errors = build_lab("01", folder, trusted=False)
     assert binary is not None, errors

@@ -132,9 +132,9 @@ def test_lab01_release_layout(pristine01):
     release01 = pristine01
     assert not any((release01 / "labs" / name / "solution").exists() for name in FOLDERS.values())
     assert all((release01 / "labs" / name / "skeleton").is_dir() for name in FOLDERS.values())
-    # lab 01 writes common/core/path_tracer.h's regions: the release has its skeleton form
-    skeleton = (ROOT / "labs/01-serial/skeleton/path_tracer.h").read_text()
-    assert (release01 / "common/core/path_tracer.h").read_text() == skeleton.split("\n", 1)[1]
+    # lab 01 writes common/core/path_steps.h's regions: the release has its skeleton form
+    skeleton = (ROOT / "labs/01-serial/skeleton/path_steps.h").read_text()
+    assert (release01 / "common/core/path_steps.h").read_text() == skeleton.split("\n", 1)[1]
     assert sorted(p.name for p in (release01 / "reference-bin").iterdir()) == sorted(
         [
             "lab01-ref",
@@ -160,8 +160,8 @@ def test_lab03_release_layout(pristine03):
     release03 = pristine03
     for lab, name in FOLDERS.items():
         assert (release03 / "labs" / name / "solution").is_dir() == (lab < "03"), name
-    assert (release03 / "common/core/path_tracer.h").read_bytes() == \
-        (ROOT / "common/core/path_tracer.h").read_bytes()
+    assert (release03 / "common/core/path_steps.h").read_bytes() == \
+        (ROOT / "common/core/path_steps.h").read_bytes()
     assert not (release03 / "reference-bin" / "lab01-ref").exists()
 
 

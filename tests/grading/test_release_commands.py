@@ -240,7 +240,7 @@ def test_release_is_a_repository_with_one_commit(finished):
 
 
 def test_unit_tests_build_against_the_students_copies(finished):
-    """In labs whose students write a shared file (lab 01's path_tracer.h), the unit tests
+    """In labs whose students write a shared file (lab 01's path_steps.h), the unit tests
     compile with the student's folder first on the include path, as the lab binary does."""
     lab, release = finished
     p = run(release, "make -n -B -s build/unit_tests")

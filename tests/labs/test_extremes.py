@@ -3,7 +3,7 @@ the scene loader accepts: each renders as its plain version does, within the noi
 refused at load with one line that says what to do (common/host/scene_limits.h).
 
 What makes it hold (common/core): light measured from the surface point, not from the offset
-ray origin (path_tracer.h's sample_light); ray offsets that grow with the primitive's own
+ray origin (path_steps.h's sample_light); ray offsets that grow with the primitive's own
 coordinates, not only with the hit point's (ray.h); triangle normals computed in double
 (triangle.h). Lab 02 runs the same checks on its references (test_lab02.py).
 

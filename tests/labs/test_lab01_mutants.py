@@ -32,11 +32,11 @@ CHECKS = {
 # name: (file under common/core or the solution dir, original text, mutated text, checks that
 # must catch it)
 MUTANTS = {
-    "no cosine in NEE": ("path_tracer.h", "(cos_theta / (kPi * distance2))",
+    "no cosine in NEE": ("path_steps.h", "(cos_theta / (kPi * distance2))",
                          "(1.0f / (kPi * distance2))", ["plane", "cornell"]),
-    "BRDF without 1/pi": ("path_tracer.h", "(cos_theta / (kPi * distance2))",
+    "BRDF without 1/pi": ("path_steps.h", "(cos_theta / (kPi * distance2))",
                           "(cos_theta / distance2)", ["interior", "plane", "cornell"]),
-    "light falls off as 1/d": ("path_tracer.h", "(cos_theta / (kPi * distance2))",
+    "light falls off as 1/d": ("path_steps.h", "(cos_theta / (kPi * distance2))",
                                "(cos_theta / (kPi * distance))", ["interior", "plane"]),
     "shadow rays ignore spheres": (
         "sphere.h", "return intersect_sphere<kConverged>(ray, s, t_max) < t_max;",
@@ -46,7 +46,7 @@ MUTANTS = {
         "return false && intersect_triangle<kConverged>(ray, shear, tri, t_max) < t_max;",
         ["showcase"]),
     "every rectangle hit names rectangle 0": (
-        "path_tracer.h", "hit = {t, primitive_kind<K>, i};",
+        "path_steps.h", "hit = {t, primitive_kind<K>, i};",
         "hit = {t, primitive_kind<K>, has_kind<Kinds<AxisRect>, K> ? 0 : i};",
         ["cornell", "showcase"]),
     "rectangle: inside test of one axis reversed": (
@@ -54,21 +54,21 @@ MUTANTS = {
         "(from_edge(r.lo_u - o_u, d_u) >= 0.0f) & (from_edge(r.hi_u - o_u, d_u) <= 0.0f)",
         "(from_edge(r.lo_u - o_u, d_u) <= 0.0f) & (from_edge(r.hi_u - o_u, d_u) >= 0.0f)",
         ["cornell", "showcase"]),
-    "no pixel jitter": ("path_tracer.h",
+    "no pixel jitter": ("path_steps.h",
                         "camera.ray_through(x + real(rng.at(kDimPixelX)), "
                         "y + real(rng.at(kDimPixelY)))",
                         "camera.ray_through(x + 0.5f, y + 0.5f)", ["cornell"]),
-    "every sample reuses sample 0": ("path_tracer.h", "SampleStream rng(settings.seed, pixel, s)",
+    "every sample reuses sample 0": ("path_steps.h", "SampleStream rng(settings.seed, pixel, s)",
                                      "SampleStream rng(settings.seed, pixel, 0)", ["cornell"]),
-    "one bounce too few": ("path_tracer.h", "path.alive = path.bounce < max_bounces;",
+    "one bounce too few": ("path_steps.h", "path.alive = path.bounce < max_bounces;",
                            "path.alive = path.bounce + 1 < max_bounces;",
                            ["interior", "cornell"]),
-    "throughput ignores albedo": ("path_tracer.h",
+    "throughput ignores albedo": ("path_steps.h",
                                   "path.throughput *= material.albedo;\n"
                                   "            path.ray = {above, sample_cosine",
                                   "path.ray = {above, sample_cosine",
                                   ["interior", "cornell"]),
-    "NEE from the offset point": ("path_tracer.h",
+    "NEE from the offset point": ("path_steps.h",
                                   "const Vec3 to_light = scene.light.position - position;",
                                   "const Vec3 to_light = scene.light.position - origin;",
                                   # A translated scene no longer shows it (the driver renders

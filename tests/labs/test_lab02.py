@@ -102,7 +102,7 @@ def lab02_prims():
 
 @pytest.fixture(scope="module")
 def lab02_pristine_skeleton(tmp_path_factory):
-    """Part B's skeleton exactly as generated (skeleton/render*.cpp, packet_tracer.h)."""
+    """Part B's skeleton exactly as generated (skeleton/render*.cpp, packet_hits.h)."""
     if not cpu_has_avx2():
         pytest.skip("this CPU has no AVX2/FMA")
     return build_pristine_skeleton("02-simd", tmp_path_factory.mktemp("lab02-skeleton"))

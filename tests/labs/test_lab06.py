@@ -159,11 +159,11 @@ def test_skeleton_in_sync():
     the queue's reserve and the stage loop are what students write."""
     from labkit.variants import pristine_skeleton_sources
     expected = pristine_skeleton_sources(LAB)
-    assert set(expected) == {"path_queue.cuh", "render.cu", "stage_loop.cuh"}
+    assert set(expected) == {"queue_reserve.cuh", "render.cu", "stage_loop.cuh"}
     for name, text in expected.items():
         assert (ROOT / "labs" / LAB / "skeleton" / name).read_text() == text, name
     reserve = (
-        expected["path_queue.cuh"]
+        expected["queue_reserve.cuh"]
         .split("int reserve(int* size, bool wants) {")[1]
         .split("\n}\n")[0]
     )
@@ -290,8 +290,8 @@ def test_waves_and_bands_do_not_change_the_image(gpu, lab06_ref):
 
 
 def reserve_replaced(body: str) -> str:
-    """common/wavefront/path_queue.cuh with the reserve's solution replaced by `body`."""
-    text = (ROOT / "common" / "wavefront" / "path_queue.cuh").read_text()
+    """common/wavefront/queue_reserve.cuh with the reserve's solution replaced by `body`."""
+    text = (ROOT / "common" / "wavefront" / "queue_reserve.cuh").read_text()
     start = text.index("    // BEGIN SOLUTION")
     end = text.index("    // END SOLUTION") + len("    // END SOLUTION")
     return text[:start] + body + text[end:]
@@ -306,7 +306,7 @@ def test_a_reserve_of_one_atomic_per_thread_gives_the_same_image(gpu, lab06_ref,
     binary = cuda_variant(LAB, tmp_path, {
         "render.cu": (ROOT / "labs" / LAB / "solution" / "render.cu").read_text(),
         "stage_loop.cuh": (ROOT / "common" / "wavefront" / "stage_loop.cuh").read_text(),
-        "path_queue.cuh": reserve_replaced("    return wants ? atomicAdd(size, 1) : -1;")})
+        "queue_reserve.cuh": reserve_replaced("    return wants ? atomicAdd(size, 1) : -1;")})
     settings = dict(width=96, height=64, spp=16, seed=5)
     mine = run_lab(binary, **settings).image
     assert np.array_equal(mine, run_lab(lab06_ref, **settings).image)

@@ -204,7 +204,7 @@ def first_entry_with(old: str, new: str) -> str:
     (first_entry_with('ships = ["lab01-ref"]', 'ships = ["lab01"]'), "ships only"),
     (first_entry_with('rubric = "serial"', 'rubric = "gpu"'), "gpu rubric"),
     (first_entry_with('folder = "01-serial"', 'folder = "1-serial"'), "two digits"),
-    (first_entry_with('handin = ["path_tracer.h", "render.cpp"]\n', ""), "needs handin"),
+    (first_entry_with('handin = ["path_steps.h", "render.cpp"]\n', ""), "needs handin"),
     (first_entry_with('number = "01"', 'number = "01"\ncolour = "red"'), "unknown field"),
     (first_entry_with("timed_spp = 7936\n", ""), "timed_spp"),
     ("[[lab]\n", "not TOML"),
@@ -281,6 +281,6 @@ def test_the_cuda_check_fails_where_a_lab_mk_disagrees(tmp_path):
     assert cuda_disagreements(root) == []
     toml = root / "labs" / "labs.toml"
     toml.write_text(toml.read_text().replace(
-        'shared = ["common/wavefront/path_queue.cuh", "common/wavefront/stage_loop.cuh"]',
-        'shared = ["common/wavefront/path_queue.cuh"]'))
+        'shared = ["common/wavefront/queue_reserve.cuh", "common/wavefront/stage_loop.cuh"]',
+        'shared = ["common/wavefront/queue_reserve.cuh"]'))
     assert [p.split(":")[0] for p in cuda_disagreements(root)] == ["06-cuda-split"]

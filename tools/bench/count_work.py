@@ -41,15 +41,15 @@ def fail(message: str) -> None:
 
 
 def build(work: pathlib.Path) -> pathlib.Path:
-    tracer = (ROOT / "common" / "core" / "path_tracer.h").read_text()
+    tracer = (ROOT / "common" / "core" / "path_steps.h").read_text()
     for name, signature in QUERIES.items():
         if signature not in tracer:
-            fail(f"common/core/path_tracer.h no longer declares {name} as '{signature}'; "
+            fail(f"common/core/path_steps.h no longer declares {name} as '{signature}'; "
                  "update QUERIES")
         tracer = tracer.replace(signature, "__attribute__((noinline)) " +
                                 signature.replace("RT_HD inline ", ""))
     sources = {"render.cpp": (ROOT / "labs/01-serial/solution/render.cpp").read_text(),
-               "path_tracer.h": tracer}
+               "path_steps.h": tracer}
     # The Makefile's build, for a target valgrind can run (no AVX-512), with -g for
     # callgrind's line numbers, into a build folder of its own.
     opt = "-O3 -march=x86-64-v3 -g -ffp-contract=off -fno-math-errno -fno-trapping-math"

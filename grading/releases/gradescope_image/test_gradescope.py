@@ -6,7 +6,7 @@ kept as prt-debian-base:bookworm), the lab-01 bundle built into an image on it
 run in fresh containers with Docker's default seccomp profile and capabilities at 0.5 CPU and
 768 MB:
 
-    reference (render.cpp, path_tracer.h)           100
+    reference (render.cpp, path_steps.h)           100
     skeleton (as generated)                         at most 10
     a render.cpp including the solution, a link     at most 10, a complete results.json
 
@@ -140,11 +140,11 @@ def main() -> int:
         work.chmod(0o755)
         autograder_image(work)
         solution = (ROOT / "labs/01-serial/solution/render.cpp").read_text()
-        tracer = (ROOT / "common/core/path_tracer.h").read_text()
+        tracer = (ROOT / "common/core/path_steps.h").read_text()
         cases = [
             (
                 "reference",
-                {"render.cpp": solution, "path_tracer.h": tracer},
+                {"render.cpp": solution, "path_steps.h": tracer},
                 lambda s: s == 100,
                 "100",
             ),
@@ -154,7 +154,7 @@ def main() -> int:
                 {
                     "render.cpp":
                         '#include "/autograder/source/labs/01-serial/solution/render.cpp"\n',
-                    "path_tracer.h": '#include "/autograder/source/common/core/path_tracer.h"\n',
+                    "path_steps.h": '#include "/autograder/source/common/core/path_steps.h"\n',
                 },
                 lambda s: s <= 10,
                 "at most 10",
@@ -163,7 +163,7 @@ def main() -> int:
                 "links",
                 {
                     "render.cpp": solution,
-                    "path_tracer.h": pathlib.Path("/autograder/source/common/core/path_tracer.h"),
+                    "path_steps.h": pathlib.Path("/autograder/source/common/core/path_steps.h"),
                 },
                 lambda s: s <= 10,
                 "at most 10",

@@ -1,6 +1,7 @@
 // Lab 01: the serial renderer, the baseline every speedup in this course is measured against.
 // The loop nest of Algorithm 1: pixels here; samples in render_pixel, bounces in trace_path,
-// primitives in closest_hit (all in path_tracer.h).
+// primitives in closest_hit (render_pixel and closest_hit in path_steps.h, what you write;
+// trace_path in path_tracer.h).
 #include "lab.h"
 #include "path_tracer.h"
 #include "timer.h"

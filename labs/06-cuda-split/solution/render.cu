@@ -1,6 +1,6 @@
 // Lab 06: the path tracer as a wavefront of small kernels connected by queues of paths
 // (wavefront_kernels.cuh), the paths kept in a pool in device memory as an array of
-// structures (path_pool_aos.cuh). What students write: the queue's reserve (path_queue.cuh)
+// structures (path_pool_aos.cuh). What students write: the queue's reserve (queue_reserve.cuh)
 // and the stage loop (stage_loop.cuh). Lab 07 runs the same kernels on a structure of
 // arrays.
 #include <path_pool_aos.cuh>
