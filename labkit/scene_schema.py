@@ -23,7 +23,7 @@ from labkit import harness
 from labkit.harness import ROOT
 
 # The binary whose schema is read: built in the course repository and in every student
-# release (from the shipped solution, or prebuilt: grading/reference_bins.py). Every lab
+# release (from the shipped solution, or prebuilt: grading/releases/reference_bins.py). Every lab
 # binary prints the same schema, the kinds being common/core's; a reference is trusted, so
 # it runs outside the sandbox.
 BINARY = "lab01-ref"
