@@ -65,7 +65,7 @@ print-cuda-build-command:
 
 # $(1): binary stem (lab05), $(2): lab folder (05-cuda-mega), $(3): the shared GPU folders
 # the lab builds on besides common/cuda (common/wavefront), $(4): the files its students
-# write that stand in for shared ones (megakernel.cuh: the lab's `shared` in labs/labs.toml).
+# write that stand in for shared ones (render_kernel.cuh: the lab's `shared` in labs/labs.toml).
 # skeleton/ or solution/ comes first on the include path, then $(3), then CUDA_INCLUDES.
 define cuda_lab
 CUDA_LAB_FOLDERS += $(2)

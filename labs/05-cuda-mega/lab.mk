@@ -1,5 +1,6 @@
 # Lab 05 (CUDA megakernel): `make lab05` builds skeleton/, `make lab05-ref` solution/ (its
-# kernel is common/cuda/megakernel.cuh, which skeleton/megakernel.cuh stands in for), and
+# kernel's loops are common/cuda/render_kernel.cuh, which skeleton/render_kernel.cuh stands in
+# for), and
 #   make lab05-bench             the kernel shapes the handout measures (bench.cu)
 #   make lab05-bench-fast-math   the same built with --use_fast_math
 #   make lab05-ref-fast-math     the reference built with --use_fast_math (accuracy table)
@@ -8,7 +9,7 @@
 LAB05 := labs/05-cuda-mega
 LAB05_BUILD := $(BUILD)/$(LAB05)
 ifneq ($(HAVE_NVCC),)
-$(eval $(call cuda_lab,lab05,05-cuda-mega,,megakernel.cuh))
+$(eval $(call cuda_lab,lab05,05-cuda-mega,,render_kernel.cuh))
 
 # Variants of the reference and the benchmark: the same source under other flags, objects in
 # folders of their own. $(1): the variant's folder, $(2): the source, $(3): the flags.

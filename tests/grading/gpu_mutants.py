@@ -1,8 +1,8 @@
 """Broken lab-05 hand-ins for the GPU rubrics' tests: the reference hand-in (labs/05-cuda-mega/
-solution/ and the megakernel, common/cuda/megakernel.cuh) with one classic GPU bug each, built
-as `make cuda-variant` builds a student's folder. Each edit names the text it replaces, which
-must be in the solution exactly once, so a change to the solution that moves that text fails the
-build loudly instead of testing a mutant that is no longer broken.
+solution/ and the megakernel's loops, common/cuda/render_kernel.cuh) with one classic GPU bug
+each, built as `make cuda-variant` builds a student's folder. Each edit names the text it
+replaces, which must be in the solution exactly once, so a change to the solution that moves
+that text fails the build loudly instead of testing a mutant that is no longer broken.
 """
 from __future__ import annotations
 
@@ -62,7 +62,7 @@ MUTANTS = {
     # image comes out transposed.
     "swapped-index": Mutant(
         "wrong index arithmetic: x and y of the thread's pixel swapped",
-        "megakernel.cuh",
+        "render_kernel.cuh",
         (("    const int x = static_cast<int>(band_pixel % width);\n"
           "    const int y = args.first_row + static_cast<int>(band_pixel / width);\n",
           "    const int x = static_cast<int>(band_pixel / width);\n"

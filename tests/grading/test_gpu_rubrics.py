@@ -147,8 +147,8 @@ def test_a_gpu_submission_including_the_solution_is_refused(nvcc_and_sandbox, tm
     solution = ROOT / "labs" / GPU_LABS["05"] / "solution"
     (tmp_path / "render.cu").write_text(f'#include "{solution}/render.cu"\n')
     # The other file lab 05's students write: a hand-in without it does not build at all.
-    (tmp_path / "megakernel.cuh").write_text(
-        pristine_skeleton_sources(GPU_LABS["05"])["megakernel.cuh"]
+    (tmp_path / "render_kernel.cuh").write_text(
+        pristine_skeleton_sources(GPU_LABS["05"])["render_kernel.cuh"]
     )
     binary, errors = build_lab("05", tmp_path, trusted=False)
     assert binary is None and errors.startswith("refused: render.cu: #include"), errors

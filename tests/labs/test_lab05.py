@@ -106,7 +106,7 @@ def test_skeleton_in_sync():
     """The committed skeleton is exactly what labkit/skeletons.py makes from the solution."""
     from labkit.variants import pristine_skeleton_sources
     expected = pristine_skeleton_sources(LAB)
-    assert set(expected) == {"megakernel.cuh", "render.cu"}
+    assert set(expected) == {"render_kernel.cuh", "render.cu"}
     for name, text in expected.items():
         assert (ROOT / "labs" / LAB / "skeleton" / name).read_text() == text, name
 
@@ -200,13 +200,13 @@ def test_no_gpu_is_one_line(lab05_ref, tmp_path):
 
 def test_a_variant_needs_every_file_students_write(nvcc, tmp_path):
     """A CUDA lab built from a folder (a submission, the pristine skeleton) must hold each file
-    its students write: without megakernel.cuh the shared reference of that name
-    (common/cuda/megakernel.cuh) would be compiled in its place. One line, nothing built."""
+    its students write: without render_kernel.cuh the shared reference of that name
+    (common/cuda/render_kernel.cuh) would be compiled in its place. One line, nothing built."""
     from labkit.variants import pristine_skeleton_sources
     (tmp_path / "render.cu").write_text(pristine_skeleton_sources(LAB)["render.cu"])
     p = make("cuda-variant", f"VARIANT_LAB={LAB}", f"VARIANT={tmp_path}")
     assert p.returncode != 0
-    assert "has no megakernel.cuh" in p.stderr, p.stderr
+    assert "has no render_kernel.cuh" in p.stderr, p.stderr
     assert not (tmp_path / "lab").exists()
 
 

@@ -350,7 +350,7 @@ TEST(SceneLoader, KindsDoNotDependOnWhereTheSceneIs) {
             }
             moved.push_back(out + "]");
         }
-        char camera[160];  // moved with the quads: the camera's distance counts in the limits
+        char camera[256];  // moved with the quads: the camera's distance counts in the limits
         std::snprintf(camera, sizeof camera,
                       R"("position": [%.17g, %.17g, %.17g], "look_at": [%.17g, %.17g, %.17g])",
                       0.5 + shift, 0.5 - shift, 3 + 0.5 * shift, 0.5 + shift, 0.5 - shift,
