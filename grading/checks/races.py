@@ -33,8 +33,9 @@ ATTEMPTS = 3
 # ThreadSanitizer reports every race (not only the first) and exits with RACE_STATUS; Archer's
 # note about libomp's own uninstrumented code is followed (ignore_noninstrumented_modules).
 RACE_STATUS = 66
-TSAN_OPTIONS = (f"exitcode={RACE_STATUS} halt_on_error=0 ignore_noninstrumented_modules=1 "
-                f"history_size=2")
+# The one option a run at home needs too (the rerun line gives it).
+HOME_OPTIONS = "ignore_noninstrumented_modules=1"
+TSAN_OPTIONS = f"exitcode={RACE_STATUS} halt_on_error=0 {HOME_OPTIONS} history_size=2"
 # ThreadSanitizer reserves its shadow memory as address space, many times RLIMIT_AS's 4 GiB:
 # the run is limited by time, CPU and files as every run is, not by address space (as CUDA's).
 
@@ -76,10 +77,10 @@ def check_races(binary, threads=RACE_THREADS) -> CheckResult:
                               check=False)
             if run.returncode == RACE_STATUS or not run.thread_share >= SHARED:
                 break
-        races = SUMMARY.findall(run.stderr)
+        races = list(SUMMARY.finditer(run.stderr))
         if run.returncode == RACE_STATUS or races:
-            places = sorted({where(m) for m in SUMMARY.finditer(run.stderr)})
-            again = " ".join(["TSAN_OPTIONS=ignore_noninstrumented_modules=1", "./lab03-race",
+            places = sorted({where(m) for m in races})
+            again = " ".join([f"TSAN_OPTIONS={HOME_OPTIONS}", "./lab03-race",
                               "--threads", str(count),
                               *(f"--{k} {v}" for k, v in RACE_SETTINGS.items())])
             return CheckResult(

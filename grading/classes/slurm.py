@@ -40,9 +40,10 @@ from grading.grade import RUBRICS
 from labkit.harness import ROOT
 
 
-def count(submissions: pathlib.Path, out: pathlib.Path) -> int:
+def students(submissions: pathlib.Path, out: pathlib.Path) -> list[str]:
+    """The class's students in task order (what `--task K` of grading.batch grades)."""
     found = batch.submissions(submissions, out / ".unpacked")
-    return len(batch.by_export(found, batch.export_submitters(submissions)))
+    return list(batch.by_export(found, batch.export_submitters(submissions)))
 
 
 DEFAULT_TIME = "01:00:00"
@@ -58,10 +59,8 @@ def asked(partition: str | None, time_limit: str, mem: str, python: str) -> str:
             f"change them)")
 
 
-def flagged_tasks(submissions: pathlib.Path, out: pathlib.Path) -> list[int]:
+def flagged_tasks(found: list[str], out: pathlib.Path) -> list[int]:
     """The task numbers of the students an earlier run of REPORT flagged or never graded."""
-    found = batch.by_export(batch.submissions(submissions, out / ".unpacked"),
-                            batch.export_submitters(submissions))
     return [k for k, student in enumerate(found)
             if (row := batch.previous(out, student)) is None or batch.flagged(row)]
 
@@ -137,7 +136,8 @@ def main(argv=None) -> int:
         print(f"error: grade-slurm: {line}", file=sys.stderr)
         return 2
     batch.batch_secret(out)  # saved before any task starts: all of them read it
-    n = count(submissions, out)
+    found = students(submissions, out)
+    n = len(found)
     if n == 0:
         print(f"error: grade-slurm: no submissions in {submissions}", file=sys.stderr)
         return 2
@@ -147,7 +147,7 @@ def main(argv=None) -> int:
             print(f"error: grade-slurm: ONLY=flagged needs an earlier run's report in {out}",
                   file=sys.stderr)
             return 2
-        tasks = flagged_tasks(submissions, out)
+        tasks = flagged_tasks(found, out)
         if not tasks:
             print(f"no student of {out} is flagged: nothing to regrade")
             return 0
