@@ -17,6 +17,7 @@ import shutil
 import subprocess
 
 from grading.checks.check_result import CheckResult
+from labkit import sandbox
 from labkit.harness import ROOT, current_policy, policy, run_lab
 
 RUBRICS = {"openmp"}  # the rubric kinds whose labs are graded for races (lab 03's)
@@ -69,6 +70,14 @@ def check_races(binary, threads=RACE_THREADS) -> CheckResult:
     place in the hand-in's code, with the command to see the report at home."""
     launcher = ["/usr/bin/env", f"TSAN_OPTIONS={TSAN_OPTIONS}"]
     now = current_policy()
+    if not now.trusted and sandbox.isolation() == sandbox.USER:
+        # LLVM's OpenMP registers itself in a file of /dev/shm or /tmp at start-up and stops
+        # where it cannot (OMP Error #179); the user sandbox gives a run neither, as both are
+        # shared there. Where bubblewrap runs (a course machine) the check is made.
+        return CheckResult("no data race", True,
+                           "not run in the user sandbox, which gives a run no /dev/shm or /tmp "
+                           "that LLVM's OpenMP needs to start; marked for regrade where "
+                           "bubblewrap runs", regrade=True, credit=0.0, provisional=1.0)
     unbounded = dataclasses.replace(now, limits=dataclasses.replace(now.limits, memory_bytes=None))
     for count in threads:
         for _ in range(ATTEMPTS):

@@ -43,10 +43,15 @@ def built(tmp_path, sources: dict[str, str]):
     return binary
 
 
-def test_the_shared_index_is_a_race_named_by_its_line(tmp_path):
+def test_the_shared_index_is_a_race_named_by_its_line(tmp_path, mode):
+    """In bubblewrap; in the user sandbox (where namespaces are refused), which gives LLVM's
+    OpenMP no /dev/shm or /tmp to start with, the check is left to a regrade, never failed."""
     binary = built(tmp_path, shared_index_sources())
     with policy(UNTRUSTED):
         result = races.check_races(binary)
+    if mode == "user":
+        assert result.regrade and result.credit == 0 and result.provisional == 1, result
+        return
     assert not result.passed and result.credit == 0, result
     line = next(i + 1 for i, text in enumerate(shared_index_sources()["render.cpp"].splitlines())
                 if text == INNER.replace("int x = 0", "x = 0"))
