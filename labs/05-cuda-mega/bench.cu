@@ -16,7 +16,9 @@
 // one), the kinds compiled in, where the scene lives, how a thread traces its samples (path
 // regeneration, lanes kept together, samples claimed by the warp), the register cap, the
 // work split or the block. "plain" is the first kernel anyone writes (one thread per pixel calling
-// the core's render_pixel, 16x16 blocks, the scene in global memory, no register cap). A shape compiled for kinds the scene does not fit (DiffuseOnly on
+// the core's render_pixel, 16x16 blocks, the scene in global memory, no register cap). The "small"
+// shapes are small_scene.cuh's kernel for the scene's own counts (they run on a scene of one
+// sphere and five rectangles only). A shape compiled for kinds the scene does not fit (DiffuseOnly on
 // a scene with mirrors or glass, BoxGeometry on one with triangles) is left out; the first
 // shape run is the image the others are compared with, bit for bit where they render the
 // same primitives. The reference before the slabs (the core's exact rectangle test) is the
@@ -48,6 +50,7 @@
 #include <megakernel.cuh>
 #include <scene_constant.cuh>
 #include <scene_pool.cuh>
+#include <small_scene.cuh>
 #include <speed_targets.h>
 
 // The first kernel anyone writes: one thread per pixel, the whole pixel in one call.
@@ -79,6 +82,10 @@ struct Variant {
     bool (*fits)(const GeometryKinds&);  // whether those kinds render the scene in `form`
     const void* kernel;
     void (*launch)(const KernelArgs&, size_t shared_bytes);
+    // A small-scene kernel (small_scene.cuh): the scene's counts it is compiled for (-1: not
+    // one), and what copies the scene into its part of the constant bank.
+    int small_spheres = -1, small_rects = -1;
+    void (*prepare)(const SceneView&) = nullptr;
 };
 
 template <int kT, SceneMemory kM, int kB, PathLoop kLoop, int kMaxRegisters, class Materials,
@@ -88,6 +95,13 @@ void launch_megakernel(const KernelArgs& args, size_t shared_bytes) {
     const unsigned blocks = static_cast<unsigned>((threads + kB - 1) / kB);
     render_kernel<kT, kM, kB, kLoop, kMaxRegisters, Materials, Primitives, kSlabs>
         <<<blocks, kB, shared_bytes>>>(args);
+}
+
+template <int kS, int kR, int kB, int kMaxRegisters, bool kCull, bool kBySelects>
+void launch_small(const KernelArgs& args, size_t) {
+    const long long threads = static_cast<long long>(args.rows) * args.settings.width * 32;
+    const unsigned blocks = static_cast<unsigned>((threads + kB - 1) / kB);
+    small_scene_kernel<kS, kR, 32, kB, kMaxRegisters, kCull, kBySelects><<<blocks, kB>>>(args);
 }
 
 void launch_plain(const KernelArgs& args, size_t) {
@@ -117,6 +131,18 @@ bool fits(const GeometryKinds& kinds) {
 // The reference's shape with one change.
 #define SHAPE(name, change, t, m, b, loop, regs) \
     MEGA(name, change, t, m, b, loop, regs, DiffuseOnly, BoxGeometry, AsLoaded)
+
+// A small-scene kernel for the Cornell box's counts (one sphere, five rectangles): blocks of b,
+// a register cap, the shadow ray's rectangles culled or not, the hit's surface by selects or by
+// index.
+#define SMALL(name, change, b, regs, cull, selects)                                              \
+    Variant {                                                                                   \
+        name, change, 32, SceneMemory::Constant, b, PathLoop::WholePaths, regs, true, true,     \
+            GeometryForm::AsLoaded, "BoxGeometry", fits<BoxGeometry>,                           \
+            reinterpret_cast<const void*>(                                                      \
+                small_scene_kernel<1, 5, 32, b, regs, cull, selects>),                          \
+            launch_small<1, 5, b, regs, cull, selects>, 1, 5, upload_small_scene<1, 5>         \
+    }
 
 static const std::vector<Variant>& variants() {
     static const std::vector<Variant> all = {
@@ -155,6 +181,18 @@ static const std::vector<Variant>& variants() {
               Constant, 64, Claimed, 56),
         SHAPE("claimed-regs-64", "samples claimed by the warp's lanes, at most 64 registers", 32,
               Constant, 64, Claimed, 64),
+        // The scene's counts compiled in (small_scene.cuh).
+        SMALL("small", "small-scene kernel: counts compiled in, surface by selects, shadow "
+              "rays against the rectangles that can block them", 64, 56, true, true),
+        SMALL("small-no-cull", "small, the shadow ray against every rectangle", 64, 56, false,
+              true),
+        SMALL("small-indexed", "small, the surface loaded by the hit's index", 64, 56, true,
+              false),
+        SMALL("small-regs-48", "small, at most 48 registers", 64, 48, true, true),
+        SMALL("small-regs-64", "small, at most 64 registers", 64, 64, true, true),
+        SMALL("small-no-register-cap", "small, registers left to the compiler", 64, 255, true,
+              true),
+        SMALL("small-block-128", "small, blocks of 128", 128, 56, true, true),
         SHAPE("no-register-cap", "registers left to the compiler", 32, Constant, 64, WholePaths,
               255),
         SHAPE("regs-64", "at most 64 registers", 32, Constant, 64, WholePaths, 64),
@@ -317,7 +355,11 @@ static int run(int argc, char** argv) {
     // The image the others are compared with: the first shape the scene fits.
     const bool specular = has_specular_material(scene.view().materials, scene.view().num_materials);
     const auto runs_on_scene = [&](const Variant& v) {
-        return !(v.diffuse_only && specular) && v.fits(geometry_kinds(form_of(v.form).scene.view));
+        const SceneView view = form_of(v.form).scene.view;
+        if (v.small_spheres >= 0 && (view.of<Sphere>().count != v.small_spheres ||
+                                     view.of<AxisRect>().count != v.small_rects))
+            return false;
+        return !(v.diffuse_only && specular) && v.fits(geometry_kinds(view));
     };
     const char* image_reference = nullptr;
     for (const Variant& v : variants()) {
@@ -348,6 +390,7 @@ static int run(int argc, char** argv) {
             upload_to_constant(form.host_pool, form.layout);
             in_constant_bank = &form;
         }
+        if (v.prepare) v.prepare(form.scene.view);
         const KernelArgs args{form.layout, pool.data(),     camera,       settings,
                               0,           settings.height, pixels.data()};
         const size_t shared_bytes = v.memory == SceneMemory::Shared ? form.layout.bytes() : 0;

@@ -65,9 +65,12 @@ def parse(log: str) -> list[dict]:
 
 
 def block_threads(name: str) -> int:
-    """render_kernel<T, memory, BLOCK, ...>; the benchmark's plain kernel uses 16x16."""
+    """render_kernel<T, memory, BLOCK, ...>, small_scene_kernel<SPHERES, RECTS, T, BLOCK, ...>;
+    the benchmark's plain kernel uses 16x16."""
     if m := re.search(r"render_kernel<(\d+), [^,]+, (\d+),", name):
         return int(m[2])
+    if m := re.search(r"small_scene_kernel<\d+, \d+, \d+, (\d+),", name):
+        return int(m[1])
     return 256
 
 
