@@ -39,7 +39,7 @@ from grading.checks.golden import check_golden
 from grading.checks.layout import check_structure_of_arrays
 from grading.results import Results, Test
 from labkit import gpu, registry, sandbox
-from labkit.harness import ROOT, RunPolicy, available_cores, policy, rerun_as
+from labkit.harness import ROOT, RunPolicy, available_cores, make_in_root, policy, rerun_as
 from labkit.mpi import mpirun
 
 LAB01_REFERENCE = ROOT / "lab01-ref"
@@ -581,7 +581,6 @@ def build_lab(lab: str, sources: pathlib.Path | None = None, trusted: bool = Tru
     grading/compile.py says why); (binary, "") or (None, why: a one-line refusal or the
     compiler's first errors). `notes` receives what the grade should say about the hand-in
     (the expected files it lacked)."""
-    import subprocess
     if sources is not None:
         from grading.compile import build_in_sandbox
         target = "cuda-variant" if gpu.is_gpu_lab(lab) else "variant"
@@ -592,8 +591,7 @@ def build_lab(lab: str, sources: pathlib.Path | None = None, trusted: bool = Tru
         if binary is None and errors.startswith("refused: "):
             return None, errors
         return binary, first_errors(errors) if errors else ""
-    p = subprocess.run(["make", "-s", "-C", str(ROOT), f"lab{lab}"], capture_output=True,
-                       text=True, errors="replace")
+    p = make_in_root(f"lab{lab}", capture_output=True, text=True, errors="replace")
     if p.returncode == 0:
         warnings = build_warnings(p.stdout + p.stderr)
         if warnings and notes is not None:

@@ -10,10 +10,9 @@ is the machine's fault, never the submission's: the grade is refused, marked for
 from __future__ import annotations
 
 import pathlib
-import subprocess
 
 from labkit import gpu, registry
-from labkit.harness import ROOT, RunPolicy, policy, run_lab
+from labkit.harness import ROOT, RunPolicy, make_in_root, policy, run_lab
 
 
 def names(lab: str) -> list[str]:
@@ -31,8 +30,7 @@ def names(lab: str) -> list[str]:
 def build(lab: str) -> str | None:
     """`make` lab `lab`'s references (nothing is relinked while they are up to date); None,
     or make's last line of error in one line."""
-    p = subprocess.run(["make", "-s", "-C", str(ROOT), *names(lab)], capture_output=True,
-                       text=True, errors="replace")
+    p = make_in_root(*names(lab), capture_output=True, text=True, errors="replace")
     if p.returncode == 0:
         return None
     said = (p.stderr.strip() or p.stdout.strip()).splitlines()[-1:] or [f"status {p.returncode}"]

@@ -8,9 +8,8 @@ of the same name, because the folder comes first on the include path."""
 from __future__ import annotations
 
 import pathlib
-import subprocess
 
-from labkit.harness import ROOT
+from labkit.harness import ROOT, make_in_root
 
 
 def lab_sources(lab: str, source_dir: str = "solution") -> dict[str, str]:
@@ -29,8 +28,8 @@ def build_sources(variant_lab: str, workdir: pathlib.Path, sources: dict[str, st
     src.mkdir(parents=True, exist_ok=True)
     for name, text in sources.items():
         (src / name).write_text(text)
-    p = subprocess.run(["make", "-s", "-C", str(ROOT), target, f"VARIANT_LAB={variant_lab}",
-                        f"VARIANT={src}", *make_args], capture_output=True, text=True)
+    p = make_in_root(target, f"VARIANT_LAB={variant_lab}", f"VARIANT={src}", *make_args,
+                     capture_output=True, text=True)
     if p.returncode != 0:
         raise RuntimeError(
             f"building a {variant_lab} variant failed:\n{(p.stdout + p.stderr)[-2000:]}"

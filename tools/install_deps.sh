@@ -7,14 +7,14 @@
 # profile with it: tests/grading/no_namespaces.py), Slurm (`make grade-slurm`, tested on a one-node Slurm the test starts),
 # debootstrap (`make test-gradescope`'s base image), clang with LLVM's OpenMP (libomp-dev: its
 # Archer tool lets ThreadSanitizer follow OpenMP, for lab 03's race check: `make lab03-race`)
-# and the Python packages of
+# ccache (the tests compile the same sources many times: Makefile, TEST_ENV) and the Python packages of
 # tools/requirements.txt at their pinned versions (matplotlib: the plots of `make tradeoff`;
 # ruff and clang-format: `make lint`).
 set -euo pipefail
 
 debian_packages=(g++ make nlohmann-json3-dev libgtest-dev libbenchmark-dev openmpi-bin
                  libopenmpi-dev iproute2 bubblewrap util-linux python3-seccomp slurm-wlm
-                 debootstrap clang libomp-dev)
+                 debootstrap clang libomp-dev ccache)
 requirements="$(dirname "$0")/requirements.txt"
 [ -f "$requirements" ] || { echo "deps: $requirements is missing" >&2; exit 2; }
 

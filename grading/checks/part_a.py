@@ -10,10 +10,9 @@ from __future__ import annotations
 
 import os
 import pathlib
-import subprocess
 
 from grading import students_tree
-from labkit.harness import ROOT
+from labkit.harness import ROOT, make_in_root
 
 LABS = {"02"}  # the labs with a Part A
 HANDIN_NAME = "part-a/vec3.h"
@@ -45,8 +44,7 @@ def build(sources: pathlib.Path | None, trusted: bool,
           notes: list[str] | None = None) -> tuple[pathlib.Path | None, str]:
     """(Part A's binary, "") or (None, why): the compiler's first errors or a refusal."""
     if sources is None:
-        p = subprocess.run(["make", "-s", "-C", str(ROOT), "lab02a"], capture_output=True,
-                           text=True, errors="replace")
+        p = make_in_root("lab02a", capture_output=True, text=True, errors="replace")
         return (ROOT / "lab02a", "") if p.returncode == 0 else (None, p.stdout + p.stderr)
     from grading.compile import build_in_sandbox
     found = find(sources)

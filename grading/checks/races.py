@@ -14,11 +14,10 @@ import dataclasses
 import pathlib
 import re
 import shutil
-import subprocess
 
 from grading.checks.check_result import CheckResult
 from labkit import sandbox
-from labkit.harness import ROOT, current_policy, policy, run_lab
+from labkit.harness import ROOT, current_policy, make_in_root, policy, run_lab
 
 RUBRICS = {"openmp"}  # the rubric kinds whose labs are graded for races (lab 03's)
 
@@ -51,8 +50,7 @@ def build(lab_folder: str, sources: pathlib.Path | None,
     if shutil.which("clang++") is None:
         return None, "clang++ is missing on the grading machine (make deps installs it)"
     if sources is None:
-        p = subprocess.run(["make", "-s", "-C", str(ROOT), "lab03-race"], capture_output=True,
-                           text=True, errors="replace")
+        p = make_in_root("lab03-race", capture_output=True, text=True, errors="replace")
         return (ROOT / "lab03-race", "") if p.returncode == 0 else (None, p.stdout + p.stderr)
     from grading.compile import build_in_sandbox
     binary, errors, _ = build_in_sandbox(lab_folder, sources, "race-variant", trusted=trusted)

@@ -8,10 +8,9 @@ from __future__ import annotations
 
 import dataclasses
 import pathlib
-import subprocess
 
 from grading.releases.leaks import skeletons
-from labkit.harness import ROOT
+from labkit.harness import ROOT, make_in_root
 from labkit.variants import lab_sources
 
 LAB = "05-cuda-mega"
@@ -90,8 +89,8 @@ def build_cuda_folder(lab: str, folder: pathlib.Path, files: dict[str, str]) -> 
     folder.mkdir(parents=True, exist_ok=True)
     for name, text in files.items():
         (folder / name).write_text(text)
-    p = subprocess.run(["make", "-s", "-C", str(ROOT), "cuda-variant", f"VARIANT_LAB={lab}",
-                        f"VARIANT={folder}"], capture_output=True, text=True, timeout=900)
+    p = make_in_root("cuda-variant", f"VARIANT_LAB={lab}", f"VARIANT={folder}",
+                     capture_output=True, text=True, timeout=900)
     if p.returncode != 0:
         raise RuntimeError(f"building {folder} as {lab} failed:\n{(p.stdout + p.stderr)[-3000:]}")
     return folder / "lab"

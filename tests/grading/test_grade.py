@@ -92,6 +92,7 @@ def test_lab03_serial_hand_in_earns_nothing(lab01_ref, tmp_path):
     assert "not graded until the parallel speedup passes" in describe(results)
 
 
+@pytest.mark.timed
 def test_lab03_reference_gets_full_marks(tmp_path):
     from grading.checks import races
     race, errors = races.build("03-openmp", ROOT / "labs" / "03-openmp" / "solution",

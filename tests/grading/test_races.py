@@ -43,6 +43,7 @@ def built(tmp_path, sources: dict[str, str]):
     return binary
 
 
+@pytest.mark.timed
 def test_the_shared_index_is_a_race_named_by_its_line(tmp_path, mode):
     """In bubblewrap; in the user sandbox (where namespaces are refused), which gives LLVM's
     OpenMP no /dev/shm or /tmp to start with, the check is left to a regrade, never failed."""

@@ -13,6 +13,7 @@ from labkit.variants import build_pristine_skeleton
 LAB_FOLDERS = {"02": "02-simd"}
 
 
+@pytest.mark.timed
 @pytest.mark.parametrize("lab", sorted(LAB_FOLDERS))
 def test_skeleton_scores_at_most_ten_percent(lab, tmp_path):
     if lab == "02" and not cpu_has_avx2():

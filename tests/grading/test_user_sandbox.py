@@ -44,6 +44,7 @@ def test_namespaces_are_refused_under_the_filter():
     assert p.returncode != 0, p.stderr
 
 
+@pytest.mark.timed
 def test_reference_scores_100_without_namespaces(tmp_path):
     build("lab01-ref")
     status, results, stderr = grade_without_namespaces(sub.REFERENCE, tmp_path)

@@ -297,6 +297,7 @@ def test_missing_avx2_is_one_clear_line(binary, tmp_path):
     assert not out.exists() and list(tmp_path.iterdir()) == []
 
 
+@pytest.mark.timed
 @needs_avx2
 @pytest.mark.parametrize("binary", ["lab02-ref-avx2", "lab02-ref"])
 def test_part_b_faster_than_lab01(lab01_ref, binary):

@@ -128,10 +128,12 @@ def speedups(lab01_ref, lab03_ref, lab03_skeleton, lab03_ordered):
     return timing
 
 
+@pytest.mark.timed
 def test_reference_speedup(speedups):
     assert speedups.speedup("lab03-ref") >= speedups.required(), speedups.describe("lab03-ref")
 
 
+@pytest.mark.timed
 def test_skeleton_is_serial(speedups):
     """Correct but serial: the skeleton is no faster than lab 01 until the parallel loop is
     written (TODO(lab03) in labs/03-openmp/skeleton/render.cpp), so it fails the speedup test
@@ -141,6 +143,7 @@ def test_skeleton_is_serial(speedups):
     assert speedup < speedups.required(), speedups.describe("skeleton")
 
 
+@pytest.mark.timed
 def test_threads_taking_turns_stay_below_the_grader_s_turns_bar(speedups):
     """An ordered row loop, where the machine has room for a parallel program: no faster than
     the grader's bar for threads that ran one at a time (grading/checks/speed.py), while the

@@ -260,11 +260,13 @@ def speed(lab01_ref, lab04_ref):
     return Speed(capacity, min(base), min(ranks), min(hybrid), wrong)
 
 
+@pytest.mark.timed
 def test_two_ranks_faster_than_lab01(speed):
     """Two ranks against lab 01."""
     speed.check("2 ranks x 1 thread", speed.ranks)
 
 
+@pytest.mark.timed
 def test_hybrid_threads_speed_up_a_rank(speed):
     """One rank with two OpenMP threads: faster than lab 01 only if its pixel loop is shared."""
     speed.check("1 rank x 2 threads", speed.hybrid)
@@ -424,6 +426,7 @@ def test_grader_catches_the_missing_gather(lab04_pristine_skeleton, tmp_path):
     assert results["score"] <= 0.1 * results["max_score"] or regrade, detail
 
 
+@pytest.mark.timed
 def test_grader_gives_the_reference_full_marks(lab04_ref, tmp_path):
     from grading.grade import describe, grade, unmeasurable
     results = grade("04", lab04_ref, tmp_path)

@@ -16,7 +16,7 @@ import pytest
 from grading.checks import graded_scenes
 from grading.checks.renderer import CHECKS
 from labkit import harness, scenes
-from labkit.harness import ROOT, build, run_lab
+from labkit.harness import ROOT, build, make_in_root, run_lab
 
 
 @pytest.fixture(scope="module")
@@ -144,9 +144,9 @@ def test_mixing_double_and_float_objects_fails_to_link(tmp_path):
     with -DRT_DOUBLE) would read pixels of another layout: the link must fail instead."""
     (tmp_path / "render.cpp").write_text(
         (ROOT / "labs" / "01-serial" / "solution" / "render.cpp").read_text())
-    p = subprocess.run(["make", "-s", "-C", str(ROOT), "variant", "VARIANT_LAB=01-serial",
-                        f"VARIANT={tmp_path}", "VARIANT_FLAGS_01-serial=-DRT_DOUBLE"],
-                       capture_output=True, text=True, timeout=300)
+    p = make_in_root("variant", "VARIANT_LAB=01-serial", f"VARIANT={tmp_path}",
+                     "VARIANT_FLAGS_01-serial=-DRT_DOUBLE", capture_output=True, text=True,
+                     timeout=300)
     assert p.returncode != 0 and "undefined reference to `render(" in p.stderr, \
         p.stdout + p.stderr
     assert not (tmp_path / "lab").exists()

@@ -22,6 +22,7 @@ import subprocess
 from typing import Callable
 
 from labkit.cuda_env import missing_gpu as gpu_missing
+from labkit.harness import make_in_root
 from labkit.mpi import mpirun
 from labkit.variants import build_sources, lab_sources
 
@@ -65,7 +66,7 @@ def first_words(text: str) -> str:
 def make(target: str) -> str | None:
     """Builds `target`; returns None, or the last line of what make said when it failed that
     is not make's own "make: *** [...] Error 1" (which names no reason)."""
-    p = subprocess.run(["make", "-s", "-C", str(ROOT), target], capture_output=True, text=True)
+    p = make_in_root(target, capture_output=True, text=True)
     if p.returncode == 0:
         return None
     lines = [line for line in (p.stderr or p.stdout).strip().splitlines()
@@ -192,9 +193,7 @@ def build_variant(v: Variant, log=print) -> Series:
         return s
     if v.target:
         log(f"  building variant '{v.name}' (make {v.target}) ...")
-        p = subprocess.run(
-            ["make", "-s", "-C", str(ROOT), v.target], capture_output=True, text=True
-        )
+        p = make_in_root(v.target, capture_output=True, text=True)
         if p.returncode != 0:
             s.unavailable = f"does not build: {first_words(p.stderr or p.stdout)}"
         else:
