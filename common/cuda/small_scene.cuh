@@ -253,7 +253,8 @@ __device__ __forceinline__ bool small_occluded(const Ray& ray, real t_max) {
             const SlabRay slab_ray(ray);
 #pragma unroll
             for (int i = 0; i < kRects; ++i) {
-                if (mask & (1u << i)) blocked |= slab_hit(slab_span(slab_ray, scene.slabs[i]), t_max);
+                if (mask & (1u << i))
+                    blocked |= slab_hit(slab_span(slab_ray, scene.slabs[i]), t_max);
             }
         }
     }
@@ -272,8 +273,8 @@ __device__ inline SampleSum trace_samples_small(const SceneView& scene, const Ke
     const int bounces = args.settings.bounces;
     for (int s = first; s < args.settings.spp; s += stride) {
         const SampleStream rng = key.stream(static_cast<uint64_t>(s));
-        Ray ray = args.camera.ray_through(x + real(rng.at(kDimPixelX)),
-                                          y + real(rng.at(kDimPixelY)));
+        Ray ray =
+            args.camera.ray_through(x + real(rng.at(kDimPixelX)), y + real(rng.at(kDimPixelY)));
         Vec3 throughput(1.0f), radiance(0.0f);
         for (int bounce = 0; bounce < bounces; ++bounce) {
             const SmallHit hit = small_closest_hit<kSpheres, kRects>(ray);
@@ -282,8 +283,7 @@ __device__ inline SampleSum trace_samples_small(const SceneView& scene, const Ke
                 break;
             }
             const Vec3 position = ray.at(hit.t);
-            const SmallSurface surface =
-                small_surface<kSpheres, kRects, kBySelects>(hit, position);
+            const SmallSurface surface = small_surface<kSpheres, kRects, kBySelects>(hit, position);
             const Vec3 incoming = ray.direction;
             const bool entering = dot(incoming, surface.normal) < 0.0f;
             const Vec3 facing = entering ? surface.normal : -surface.normal;
@@ -322,9 +322,8 @@ __global__ void __launch_bounds__(kBlockThreads) __maxnreg__(kMaxRegisters)
     const uint64_t pixel = static_cast<uint64_t>(y) * width + x;
     SampleSum sum;
     if (inside) {
-        sum = trace_samples_small<kSpheres, kRects, kCull, kBySelects>(scene, args, x, y, pixel,
-                                                                       first_sample,
-                                                                       kThreadsPerPixel);
+        sum = trace_samples_small<kSpheres, kRects, kCull, kBySelects>(
+            scene, args, x, y, pixel, first_sample, kThreadsPerPixel);
     }
     sum = sum_across_lanes<kThreadsPerPixel>(sum);
     if (inside && first_sample == 0) args.pixels[band_pixel] = sum.mean(args.settings.spp);

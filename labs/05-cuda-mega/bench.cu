@@ -136,12 +136,11 @@ bool fits(const GeometryKinds& kinds) {
 // a register cap, the shadow ray's rectangles culled or not, the hit's surface by selects or by
 // index.
 #define SMALL(name, change, b, regs, cull, selects)                                              \
-    Variant {                                                                                   \
-        name, change, 32, SceneMemory::Constant, b, PathLoop::WholePaths, regs, true, true,     \
-            GeometryForm::AsLoaded, "BoxGeometry", fits<BoxGeometry>,                           \
-            reinterpret_cast<const void*>(                                                      \
-                small_scene_kernel<1, 5, 32, b, regs, cull, selects>),                          \
-            launch_small<1, 5, b, regs, cull, selects>, 1, 5, upload_small_scene<1, 5>         \
+    Variant {                                                                                    \
+        name, change, 32, SceneMemory::Constant, b, PathLoop::WholePaths, regs, true, true,      \
+            GeometryForm::AsLoaded, "BoxGeometry", fits<BoxGeometry>,                            \
+            reinterpret_cast<const void*>(small_scene_kernel<1, 5, 32, b, regs, cull, selects>), \
+            launch_small<1, 5, b, regs, cull, selects>, 1, 5, upload_small_scene<1, 5>           \
     }
 
 static const std::vector<Variant>& variants() {
@@ -182,12 +181,13 @@ static const std::vector<Variant>& variants() {
         SHAPE("claimed-regs-64", "samples claimed by the warp's lanes, at most 64 registers", 32,
               Constant, 64, Claimed, 64),
         // The scene's counts compiled in (small_scene.cuh).
-        SMALL("small", "small-scene kernel: counts compiled in, surface by selects, shadow "
-              "rays against the rectangles that can block them", 64, 56, true, true),
+        SMALL("small",
+              "small-scene kernel: counts compiled in, surface by selects, shadow "
+              "rays against the rectangles that can block them",
+              64, 56, true, true),
         SMALL("small-no-cull", "small, the shadow ray against every rectangle", 64, 56, false,
               true),
-        SMALL("small-indexed", "small, the surface loaded by the hit's index", 64, 56, true,
-              false),
+        SMALL("small-indexed", "small, the surface loaded by the hit's index", 64, 56, true, false),
         SMALL("small-regs-48", "small, at most 48 registers", 64, 48, true, true),
         SMALL("small-regs-64", "small, at most 64 registers", 64, 64, true, true),
         SMALL("small-no-register-cap", "small, registers left to the compiler", 64, 255, true,
