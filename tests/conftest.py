@@ -25,14 +25,15 @@ def lab01_pristine_skeleton(tmp_path_factory):
 
 # The files that take minutes, longest first: make test hands out whole files to the cores
 # (pytest-xdist's loadfile), so these start first and the short ones fill in around them.
-LONG_FILES = ["grading/test_release_commands.py", "tools/test_new_kind.py",
-              "grading/test_hostile.py", "grading/test_release.py", "tools/test_new_lab.py",
-              "labs/test_lab04.py", "grading/test_batch_slurm.py", "labs/test_properties.py"]
+LONG_FILES = ["tests/grading/test_release_commands.py", "tests/tools/test_new_kind.py",
+              "tests/grading/test_hostile.py", "tests/grading/test_release.py",
+              "tests/tools/test_new_lab.py", "tests/labs/test_lab04.py",
+              "tests/grading/test_batch_slurm.py", "tests/labs/test_properties.py"]
 
 
 def pytest_collection_modifyitems(session, config, items):
     def rank(item):
         path = item.path.as_posix()
-        return next((i for i, name in enumerate(LONG_FILES) if path.endswith(name)),
+        return next((i for i, name in enumerate(LONG_FILES) if path.endswith("/" + name)),
                     len(LONG_FILES))
     items.sort(key=rank)  # stable: each file keeps its own order
