@@ -1,9 +1,10 @@
 // A megakernel for small diffuse scenes of spheres and axis-aligned rectangles (the Cornell
 // box): the scene's counts are template parameters, so the primitive loops unroll and every
 // primitive's numbers are constant-bank operands at addresses known when the kernel is
-// compiled (no loop counter, no address arithmetic, no load by index). lab05-bench's
-// "small" shapes time it against the reference (render_kernel.cuh's whole paths); lab05-ref
-// does not choose it (yet).
+// compiled (no loop counter, no address arithmetic, no load by index). lab05-ref gives it every
+// scene it holds (is_small_scene; kernel_choice.cuh's with_small_scene_choice picks the counts),
+// the kinds kernel (render_kernel.cuh's whole paths) every other; lab05-bench times it as
+// "reference" against that kernel ("kinds-kernel") and in its "small-" shapes.
 //
 // What a path does is the core's (path_tracer.h's trace_path over path_steps.h's steps): the
 // same tests in the same order (each sphere, then each rectangle as a slab, rect_slabs.cuh),

@@ -19,10 +19,13 @@ $(LAB05_BUILD)/$(1)/$(basename $(notdir $(2))).o: $(2)
 	$$(NVCC) $$(NVCCFLAGS) $$(CUDA_ARCH) $(3) -I$(LAB05)/solution $$(CUDA_INCLUDES) \
 	    $$(INCLUDES) -MMD -MP -MF $$(@:.o=.d) -c $$< -o $$@
 endef
-$(eval $(call lab05_variant_object,fast-math,$(LAB05)/solution/render.cu,--use_fast_math))
+# nvcc defines no macro for --use_fast_math; RT_LAB05_FAST_MATH tells the sources (the
+# small-scene kernel's register cap, common/cuda/kernel_choice.cuh).
+LAB05_FAST_MATH := --use_fast_math -DRT_LAB05_FAST_MATH
+$(eval $(call lab05_variant_object,fast-math,$(LAB05)/solution/render.cu,$(LAB05_FAST_MATH)))
 $(eval $(call lab05_variant_object,no-fma,$(LAB05)/solution/render.cu,--fmad=false))
 $(eval $(call lab05_variant_object,double,$(LAB05)/solution/render.cu,-DRT_DOUBLE))
-$(eval $(call lab05_variant_object,fast-math,$(LAB05)/bench.cu,--use_fast_math $(GPU_BENCH_INCLUDES)))
+$(eval $(call lab05_variant_object,fast-math,$(LAB05)/bench.cu,$(LAB05_FAST_MATH) $(GPU_BENCH_INCLUDES)))
 lab05-ref-fast-math: $(LAB05_BUILD)/fast-math/render.o $(COMMON_OBJ)
 	$(NVCC) $(CUDA_ARCH) $^ $(INTO_TARGET)
 lab05-ref-no-fma: $(LAB05_BUILD)/no-fma/render.o $(COMMON_OBJ)

@@ -112,10 +112,12 @@ def test_skeleton_in_sync():
 
 
 def test_kernel_report(nvcc):
-    """The compiler's report lists the reference kernel (scene in the constant bank, whole
-    paths, at most 56 registers, compiled for the Cornell box's kinds: DiffuseOnly,
-    BoxGeometry) within its cap and with a small stack, every kernel lab05-ref chooses from,
-    the benchmark's uncapped shape with no spills and its other caps kept."""
+    """The compiler's report lists the kinds kernel (scene in the constant bank, whole paths,
+    at most 56 registers, compiled for the Cornell box's kinds: DiffuseOnly, BoxGeometry)
+    within its cap and with a small stack, every kernel lab05-ref chooses from (the kinds
+    kernels and a small-scene kernel for every pair of counts it holds, the surface by index,
+    within 56 registers), the benchmark's uncapped shapes with no spills and its other caps
+    kept."""
     p = make("kernel-report")
     assert p.returncode == 0, p.stderr
     report = (ROOT / "build" / "kernel-report.md").read_text()
@@ -134,9 +136,17 @@ def test_kernel_report(nvcc):
         for materials in ("DiffuseOnly", "AnyMaterial"):
             for primitives in ("BoxGeometry", "GeneralGeometry", "AnyGeometry"):
                 row(f"render_kernel<32, {memory}, 64, whole, 56, {materials}, {primitives}>")
-    registers, spilled, stack = row(
-        "render_kernel<32, constant, 64, whole, 255, DiffuseOnly, BoxGeometry>")
-    assert registers > 56 and spilled == 0 and stack == 0, (registers, spilled, stack)
+    # The small-scene kernels (small_scene.cuh): one per pair of counts, 0-2 spheres and 0-6
+    # rectangles (kSmallSceneMaxSpheres, kSmallSceneMaxRects), the IEEE build's cap.
+    for spheres in range(3):
+        for rects in range(7):
+            registers, _, stack = row(
+                f"small_scene_kernel<{spheres}, {rects}, 32, 64, 56, true, false>")
+            assert registers <= 56 and stack <= 256, (spheres, rects, registers, stack)
+    for kernel in ("render_kernel<32, constant, 64, whole, 255, DiffuseOnly, BoxGeometry>",
+                   "small_scene_kernel<1, 5, 32, 64, 255, true, false>"):
+        registers, spilled, stack = row(kernel)
+        assert registers > 56 and spilled == 0 and stack == 0, (kernel, registers, spilled, stack)
     for cap in (48, 64):
         registers, _, _ = row(reference.replace("whole, 56", f"whole, {cap}"))
         assert registers <= cap, (cap, registers)

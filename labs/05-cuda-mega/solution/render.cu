@@ -47,6 +47,15 @@ template <class Choice>
 constexpr auto kernel_for =
     render_kernel<kThreadsPerPixel, Choice::kMemory, kBlockThreads, kLoop, kMaxRegisters,
                   typename Choice::Materials, typename Choice::Primitives>;
+// BEGIN SOLUTION
+//! A scene the small-scene kernels hold (is_small_scene): the kernel for its counts, compiled
+//! as kernel_choice.cuh says (the surface by index, its own register cap), launched over the
+//! same grid (kThreadsPerPixel threads a pixel, blocks of kBlockThreads).
+template <int kSpheres, int kRects>
+constexpr auto kernel_for<SmallSceneChoice<kSpheres, kRects>> =
+    small_scene_kernel<kSpheres, kRects, kThreadsPerPixel, kBlockThreads, kSmallSceneMaxRegisters,
+                       true, kSmallSceneBySelects>;
+// END SOLUTION
 
 // The most bytes of device memory the image's pixels may take at once; more rows than that
 // are rendered in several bands. RT_LAB05_BAND_BYTES lowers it (the tests force bands so).
@@ -157,6 +166,17 @@ RenderStats render(const RenderJob& job, Image& image) {
 
     const KernelArgs args{layout, pool.data(), job.camera, job.settings, 0, 0, nullptr};
     const bool specular = has_specular_material(scene.view.materials, scene.view.num_materials);
+    // BEGIN SOLUTION
+    if (is_small_scene(scene.view, specular)) {
+        const double seconds = with_small_scene_choice(
+            scene.view.of<Sphere>().count, scene.view.of<AxisRect>().count, [&](auto choice) {
+                using Choice = decltype(choice);
+                upload_small_scene<Choice::kSphereCount, Choice::kRectCount>(scene.view);
+                return render_bands<Choice>(args, 0, image, job.progress);
+            });
+        return {seconds, describe(prop), kKernelTimeOnly};
+    }
+    // END SOLUTION
     const double seconds =
         with_kernel_choice(memory, specular, geometry_kinds(scene.view), [&](auto choice) {
             using Choice = decltype(choice);
