@@ -163,3 +163,68 @@ def test_the_record_names_no_machines_paths():
              for path in sorted(rec.RECORDS.glob("*/*.json"))}
     assert found and all(paths == [] for paths in found.values()), found
     assert absolute_paths({"scene": ["/work/scene.json"]}) == ["/work/scene.json"]
+
+
+def record_with_small_reference(folder):
+    """The H100 record as a record made since the small-scene kernel would be: its kinds kernel
+    renamed `kinds-kernel`, a made-up `reference` (the small-scene kernel) a quarter faster,
+    and a profile of that kernel beside the kinds kernel's."""
+    import json
+    for f in rec.record_of("h100").iterdir():
+        shutil.copy(f, folder / f.name)
+    for name, factor in (("bench-lab05.json", 0.75), ("bench-lab05-fast-math.json", 0.8)):
+        bench = json.loads((folder / name).read_text())
+        kinds = next(v for v in bench["variants"] if v["name"] == "reference")
+        kinds["name"] = "kinds-kernel"
+        small = dict(kinds, name="reference", max_registers=56, registers=56, local_bytes=116,
+                     best_ms=round(kinds["best_ms"] * factor, 3))
+        bench["variants"].insert(0, small)
+        (folder / name).write_text(json.dumps(bench))
+    check = json.loads((folder / "gpu-check.json").read_text())
+    row = next(r for r in check["ncu"] if r["run"] == "cornell"
+               and "Kinds<Sphere, AxisRect>, 1>" in r["Kernel Name"])
+    check["ncu"].append(dict(row, **{
+        "Kernel Name": "void small_scene_kernel<1, 5, 32, 64, 56, true, false>(KernelArgs)",
+        "smsp__thread_inst_executed_per_inst_executed.ratio": "27.5"}))
+    (folder / "gpu-check.json").write_text(json.dumps(check))
+    return rec.read(folder)
+
+
+def test_a_record_with_the_small_scene_reference_compares_shapes_with_the_kinds_kernel(tmp_path):
+    """Where the record has both kernels, the tables of the shapes that change the kinds kernel
+    compare them with `kinds-kernel`, not with the small-scene `reference`; the small-scene
+    table shows the gain; the prose's counters are the kinds kernel's."""
+    old = rec.read(rec.record_of("h100"))
+    r = record_with_small_reference(tmp_path)
+    kinds, small = r["lab05"]["kinds-kernel"]["best_ms"], r["lab05"]["reference"]["best_ms"]
+    assert kinds == old["lab05"]["reference"]["best_ms"] and small < kinds
+    assert r["ncu"]["reference"]["active"] == 27.5
+    assert r["ncu"]["kinds-kernel"] == old["ncu"]["reference"]
+    assert r["ncu"]["kinds-kernel, 1 bounce"] == old["ncu"]["reference, 1 bounce"]
+    for table in ("lab05-split", "lab05-scene-memory", "lab05-blocks", "lab05-registers",
+                  "lab05-materials", "lab05-geometry", "lab05-path-loops"):
+        text = figures.TABLES[table](r)
+        assert f"| {figures.ms(kinds)} |" in text, (table, text)
+        assert f"| {figures.ms(small)} |" not in text, (table, text)
+    for table in ("lab05-scene-memory", "lab05-registers", "lab05-materials", "lab05-path-loops"):
+        text = figures.TABLES[table](r)
+        assert "`kinds-kernel`" in text and "`reference`" not in text, (table, text)
+    divergence = figures.TABLES["lab05-divergence"](r)
+    assert "| `kinds-kernel` | Cornell, 4 | 23.3 |" in divergence, divergence
+    assert "| `reference` (the small-scene kernel) | Cornell, 4 | 27.5 |" in divergence
+    gain = figures.TABLES["lab05-small-scene"](r)
+    assert f"| {figures.ms(small)} | -25% |" in gain, gain
+    assert f"| {figures.ms(kinds)} | — |" in gain, gain
+    said = figures.figures(r)
+    assert said["kinds"] == figures.ms(kinds) and said["ref"] == figures.ms(small)
+    assert said["active"] == "23.3"
+    targets = figures.TABLES["lab05-targets"](r)
+    assert f"| `reference` (the small-scene kernel) | {figures.ms(small)} |" in targets
+    assert f"| `kinds-kernel` (the kernel you write) | {figures.ms(kinds)} |" in targets
+
+
+def test_a_record_before_the_small_scene_kernel_keeps_reference_as_the_kinds_kernel():
+    r = figures.read_card("h100")
+    assert "kinds-kernel" not in r["lab05"] and figures.kinds_shape(r) == "reference"
+    assert "kinds-kernel" not in r["ncu"] and "reference, 1 bounce" in r["ncu"]
+    assert "made before" in figures.TABLES["lab05-small-scene"](r)

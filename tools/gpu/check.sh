@@ -142,8 +142,10 @@ baseline=common/scenes/cornell.json
 if ! skipped bench && [ -x lab05-bench ]; then
     say "benchmark: lab05-bench --repeat 5 (the baseline)"
     ./lab05-bench --repeat 5 --scene "$baseline" > "$out/bench.json" 2>> "$log" && step[bench]=ok || step[bench]=failed
+    # The main shapes: the reference (the small-scene kernel, 64 registers in this build), the
+    # kinds kernel, and the small-scene shapes this build has (small-regs-64 is its reference).
     say "benchmark: lab05-bench-fast-math (--use_fast_math), the main shapes"
-    ./lab05-bench-fast-math --repeat 5 --scene "$baseline" --only "${GPU_CHECK_FAST_MATH_VARIANTS:-reference,general,all-materials,scene-shared,no-register-cap,plain}" \
+    ./lab05-bench-fast-math --repeat 5 --scene "$baseline" --only "${GPU_CHECK_FAST_MATH_VARIANTS:-reference,kinds-kernel,general,all-materials,scene-shared,no-register-cap,small-selects,small-no-cull,small-regs-56,small-no-register-cap,plain}" \
         > "$out/bench-fast-math.json" 2>> "$log" && step[bench_fast_math]=ok || step[bench_fast_math]=failed
 fi
 # The wavefront labs' references (and AoS with each thread storing its own record) and their
@@ -180,8 +182,12 @@ if ! skipped ncu && [ -n "$ncu_bin" ] && [ -x lab05-bench ]; then
         timeout 180 "$ncu_bin" --clock-control none --metrics "$metrics" --csv --page raw \
             ./lab05-bench --repeat 1 "$@" > "/tmp/gpu-check-ncu-$label.csv" 2>> "$log"
     }
-    ncu_run cornell --spp 64 --only "${GPU_CHECK_NCU_VARIANTS:-plain,reference,exact-rects,no-register-cap,triangles,quads,general,regenerate,together,claimed,scene-shared}" &&
-    ncu_run cornell-1-bounce --spp 64 --bounces 1 --only reference &&
+    # reference: the small-scene kernel (lab05-ref on the Cornell box); kinds-kernel: the kernel
+    # for the scene's kinds, which the other shapes change (tools/gpu/record.py's NCU_SHAPES).
+    # lab05-bench runs the first shape the scene fits besides those named, so the one-bounce
+    # run profiles both.
+    ncu_run cornell --spp 64 --only "${GPU_CHECK_NCU_VARIANTS:-plain,reference,kinds-kernel,exact-rects,no-register-cap,triangles,quads,general,regenerate,together,claimed,scene-shared}" &&
+    ncu_run cornell-1-bounce --spp 64 --bounces 1 --only reference,kinds-kernel &&
     ncu_run showcase --spp 64 --width 600 --height 600 --scene common/scenes/showcase.json --only reference &&
         step[ncu]=ok || step[ncu]=failed
 fi

@@ -72,6 +72,23 @@ def ncu_cells(r: dict, shape: str) -> list[str]:
 
 
 # ---- lab 05 -------------------------------------------------------------------------------
+# lab05-ref runs two kernels: on a scene the small-scene kernels hold (the Cornell box) the one
+# compiled for its counts (common/cuda/small_scene.cuh), lab05-bench's "reference"; on every
+# other the kernel for its kinds (render_kernel.cuh, the one the students write),
+# "kinds-kernel". Most shapes of lab05-bench change one thing of the kinds kernel, so the
+# tables of those compare them with it. A record made before the small-scene kernel has no
+# "kinds-kernel": its "reference" is the kinds kernel.
+def kinds_shape(r) -> str:
+    """The kinds kernel's shape in a record: "kinds-kernel" where its lab05-bench has that
+    shape, else "reference" (a record made before the small-scene kernel)."""
+    return "kinds-kernel" if "kinds-kernel" in r["lab05"] else "reference"
+
+
+def has_small_reference(r) -> bool:
+    """Whether the record's "reference" is the small-scene kernel (it has both kernels)."""
+    return kinds_shape(r) != "reference"
+
+
 def target_bar(r, config: str) -> str:
     """A lab 05 speed target as the record's benchmark printed it, without its card and scene."""
     bar = r["targets05"].get(config, {}).get("bar", "")
@@ -80,8 +97,12 @@ def target_bar(r, config: str) -> str:
 
 def lab05_targets(r):
     b = r["lab05"]
-    return rows(["shape", "kernel ms", "target"], ["---", "---:", "---"], [
-        ["`reference`", ms(b["reference"]["best_ms"]), target_bar(r, "reference")],
+    body = [["`reference`", ms(b["reference"]["best_ms"]), target_bar(r, "reference")]]
+    if has_small_reference(r):
+        body[0][0] = "`reference` (the small-scene kernel)"
+        body.append(["`kinds-kernel` (the kernel you write)", ms(b["kinds-kernel"]["best_ms"]),
+                     ""])
+    return rows(["shape", "kernel ms", "target"], ["---", "---:", "---"], body + [
         ["`general`", ms(b["general"]["best_ms"]), target_bar(r, "general")],
         ["`plain` (section 2)", ms(b["plain"]["best_ms"]), ""]])
 
@@ -90,14 +111,14 @@ def lab05_split(r):
     b, pixels = r["lab05"], r["baseline"]["width"] * r["baseline"]["height"]
     return rows(["threads per pixel", "threads in the grid", "kernel ms"], ["---:", "---:", "---:"],
                 [[n, grouped(n * pixels), ms(b[shape]["best_ms"])]
-                 for n, shape in ((1, "split-1"), (16, "split-16"), (32, "reference"))])
+                 for n, shape in ((1, "split-1"), (16, "split-16"), (32, kinds_shape(r)))])
 
 
 def lab05_scene_memory(r):
     b = r["lab05"]
     return rows(["shape", "scene in", "registers", "kernel ms"], ["---", "---", "---:", "---:"],
                 [[f"`{s}`", b[s]["scene_memory"], b[s]["registers"], ms(b[s]["best_ms"])]
-                 for s in ("reference", "scene-shared", "scene-global")])
+                 for s in (kinds_shape(r), "scene-shared", "scene-global")])
 
 
 def lab05_blocks(r):
@@ -105,7 +126,7 @@ def lab05_blocks(r):
     return rows(["threads per block", "registers", "occupancy", "kernel ms"],
                 ["---:", "---:", "---:", "---:"],
                 [[b[s]["block_threads"], b[s]["registers"], pct(b[s]["occupancy"]),
-                  ms(b[s]["best_ms"])] for s in ("block-32", "reference", "block-128")])
+                  ms(b[s]["best_ms"])] for s in ("block-32", kinds_shape(r), "block-128")])
 
 
 def lab05_registers(r):
@@ -116,23 +137,28 @@ def lab05_registers(r):
                 [[f"`{s}`", "none" if b[s]["max_registers"] >= 255 else b[s]["max_registers"],
                   b[s]["registers"], b[s]["local_bytes"], pct(b[s]["occupancy"]),
                   ms(b[s]["best_ms"]), *ncu_cells(r, s)]
-                 for s in ("no-register-cap", "regs-64", "reference", "regs-48")])
+                 for s in ("no-register-cap", "regs-64", kinds_shape(r), "regs-48")])
 
 
 def lab05_materials(r):
     b = r["lab05"]
     what = [("all-materials", "every material and primitive kind"),
-            ("reference", "diffuse only, spheres and rectangles")]
+            (kinds_shape(r), "diffuse only, spheres and rectangles")]
     return rows(["shape", "kernel compiled for", "registers", "kernel ms"],
                 ["---", "---", "---:", "---:"],
                 [[f"`{s}`", kinds, b[s]["registers"], ms(b[s]["best_ms"])] for s, kinds in what])
 
 
 def lab05_divergence(r):
+    k = kinds_shape(r)
     what = [("plain", "`plain` (`render_pixel` per pixel)", "Cornell, 4"),
-            ("reference", "`reference`", "Cornell, 4"),
-            ("reference, 1 bounce", "`reference`", "Cornell, **1**"),
-            ("showcase", "`reference`'s shape, every material", "showcase (mirror, glass)")]
+            (k, f"`{k}`", "Cornell, 4"),
+            (f"{k}, 1 bounce", f"`{k}`", "Cornell, **1**"),
+            ("showcase", f"`{k}`'s shape, every material", "showcase (mirror, glass)")]
+    if has_small_reference(r):  # the small-scene kernel, where the record profiled it
+        what += [(s, "`reference` (the small-scene kernel)", scene) for s, scene in
+                 (("reference", "Cornell, 4"), ("reference, 1 bounce", "Cornell, **1**"))
+                 if s in r["ncu"]]
     body = []
     for shape, label, scene in what:
         n = r["ncu"][shape]
@@ -148,14 +174,15 @@ def lab05_geometry(r):
     walls = {"triangles": "10 triangles", "triangles-shared": "10 triangles",
              "quads": "5 convex quads", "general": "5 convex quads",
              "exact-rects": "5 axis-aligned rectangles, the core's exact test",
-             "reference": "5 axis-aligned rectangles, slabs",
+             kinds_shape(r): "5 axis-aligned rectangles, slabs",
              "any-geometry": "5 axis-aligned rectangles, slabs"}
     walls = {s: w for s, w in walls.items() if s in b}
     kinds = {"SpheresAndTriangles": "spheres, triangles", "SpheresAndQuads": "spheres, quads",
              "GeneralGeometry": "every kind but rectangles (`GeneralGeometry`)",
              "BoxGeometry": "spheres, rectangles (`BoxGeometry`)",
              "AnyGeometry": "every kind (`AnyGeometry`)"}
-    body = [[f"**`{s}`**" if s == "reference" else f"`{s}`", walls[s], kinds[b[s]["primitives"]],
+    body = [[f"**`{s}`**" if s == kinds_shape(r) else f"`{s}`", walls[s],
+             kinds[b[s]["primitives"]],
              b[s]["scene_memory"], ms(b[s]["best_ms"]), *ncu_cells(r, s)] for s in walls]
     return rows(["shape", "the walls as", "kernel compiled for", "scene in", "kernel ms",
                  "active threads per warp", "thread instructions per path"],
@@ -164,7 +191,7 @@ def lab05_geometry(r):
 
 def lab05_path_loops(r):
     b = r["lab05"]
-    what = [("reference", "whole paths (`trace_samples`)"),
+    what = [(kinds_shape(r), "whole paths (`trace_samples`)"),
             ("regenerate", "path regeneration (`trace_samples_regenerating`)"),
             ("together", "lanes kept together (`trace_samples_together`)"),
             ("claimed", "samples claimed by the warp (`trace_samples_claimed`)"),
@@ -175,6 +202,45 @@ def lab05_path_loops(r):
                 ["---", "---", "---:", "---:", "---:", "---:", "---:"],
                 [[f"`{s}`", how, b[s]["registers"], b[s]["local_bytes"], ms(b[s]["best_ms"]),
                   *ncu_cells(r, s)] for s, how in what])
+
+
+SMALL_SHAPES = [("small-selects", "the hit's surface chosen by selects as the loop finds it"),
+                ("small-no-cull", "the shadow ray tested against every rectangle"),
+                ("small-regs-56", "at most 56 registers"),
+                ("small-regs-64", "at most 64 registers"),
+                ("small-no-register-cap", "registers left to the compiler")]
+
+
+def lab05_small_scene(r):
+    """The small-scene kernel (lab05-bench's "reference" since it was chosen) against the
+    kinds kernel ("kinds-kernel") and its own variations, with and without fast math; a record
+    made before it holds neither, and the table says so."""
+    if not has_small_reference(r):
+        return ("(This record was made before lab05-ref chose the small-scene kernel: its "
+                "`reference` is the kinds kernel, and it has no `kinds-kernel` or `small-` "
+                "shapes.)")
+    b, fast = r["lab05"], r["lab05_fast"]
+    kinds_ms = b["kinds-kernel"]["best_ms"]
+    what = [("kinds-kernel", "the kernel for the scene's kinds (`render_kernel`)"),
+            ("reference", "the small-scene kernel: the scene's counts compiled in")]
+    what += [(s, f"small-scene kernel, {how}") for s, how in SMALL_SHAPES if s in b or s in fast]
+
+    def cells(s):
+        if s not in b:
+            return ["", "", "", "not in this build", ""]
+        v = b[s]
+        return ["none" if v["max_registers"] >= 255 else v["max_registers"], v["registers"],
+                v["local_bytes"], ms(v["best_ms"]),
+                "—" if s == "kinds-kernel" else pct(v["best_ms"] / kinds_ms - 1)]
+
+    def fast_cell(s):
+        return ms(fast[s]["best_ms"]) if s in fast else ""
+
+    return rows(["shape", "kernel", "register cap", "registers", "local bytes", "kernel ms",
+                 "against `kinds-kernel`", "kernel ms, fast math"],
+                ["---", "---", "---:", "---:", "---:", "---:", "---:", "---:"],
+                [[f"**`{s}`**" if s == "reference" else f"`{s}`", how, *cells(s), fast_cell(s)]
+                 for s, how in what])
 
 
 def lab05_process(r):
@@ -324,7 +390,8 @@ def lab07_scenes(r):
 
 TABLES = {f.__name__.replace("_", "-"): f for f in (
     lab05_targets, lab05_split, lab05_scene_memory, lab05_blocks, lab05_registers,
-    lab05_materials, lab05_divergence, lab05_geometry, lab05_path_loops, lab05_process,
+    lab05_materials, lab05_divergence, lab05_geometry, lab05_path_loops, lab05_small_scene,
+    lab05_process,
     lab05_precision, lab05_fast_math, lab06_reserve, lab06_staged, lab06_popping, lab06_scenes,
     lab06_per_kernel, lab06_occupancy, lab06_queues, lab07_results, lab07_scenes)}
 
@@ -334,6 +401,7 @@ def figures(r: dict) -> dict:
     """The names PROSE's phrases use: the record's figures, formatted as the text quotes them."""
     b, l6, l7 = r["lab05"], r["lab06"], r["lab07"]
     fast, acc, n = r["lab05_fast"], r["accuracy"], r["ncu"]
+    k = kinds_shape(r)  # the kinds kernel, which section 7's counters and savings are of
     cornell, show16 = r["scenes"]["bench-cornell"], r["scenes"]["bench-showcase-16"]
     grade = {lab.number: lab.timed_spp for lab in registry.labs() if lab.gpu}
     slow_reserves = (cornell["AoS-atomic-each"], cornell["AoS-atomic-per-warp"])
@@ -347,18 +415,19 @@ def figures(r: dict) -> dict:
         "plain_regs": b["plain"]["registers"], "plain_occ": pct(b["plain"]["occupancy"]),
         "ref_target": target_bar(r, "reference"),
         "exact_rects": ms(b["exact-rects"]["best_ms"]) if "exact-rects" in b else "",
-        "slab_saving": (pct(1 - b["reference"]["best_ms"] / b["exact-rects"]["best_ms"])
+        "kinds": ms(b[k]["best_ms"]),
+        "slab_saving": (pct(1 - b[k]["best_ms"] / b["exact-rects"]["best_ms"])
                         if "exact-rects" in b else ""),
         "claimed": ms(b["claimed"]["best_ms"]) if "claimed" in b else "",
         "ref_regs": b["reference"]["registers"], "ref_occ": pct(b["reference"]["occupancy"]),
         "ref_blocks": b["reference"]["blocks_per_sm"],
-        "plain_saving": pct(1 - b["reference"]["best_ms"] / b["plain"]["best_ms"]),
-        "active": f"{n['reference']['active']:.1f}", "issue": f"{n['reference']['issue']:.0f}%",
-        "per_path": grouped(n["reference"]["per_path"]),
-        "active1": f"{n['reference, 1 bounce']['active']:.1f}",
+        "plain_saving": pct(1 - b[k]["best_ms"] / b["plain"]["best_ms"]),
+        "active": f"{n[k]['active']:.1f}", "issue": f"{n[k]['issue']:.0f}%",
+        "per_path": grouped(n[k]["per_path"]),
+        "active1": f"{n[f'{k}, 1 bounce']['active']:.1f}",
         "active_show": f"{n['showcase']['active']:.1f}",
         "per_path_show": grouped(n["showcase"]["per_path"]),
-        "integer": grouped(n["reference"]["integer"]),
+        "integer": grouped(n[k]["integer"]),
         "fast_ref": ms(fast["reference"]["best_ms"]),
         "fast_gain": pct(1 - fast["reference"]["best_ms"] / b["reference"]["best_ms"]),
         "no_fma": ms(1000 * acc["lab05-ref-no-fma"]["baseline_kernel_seconds_best"]),
@@ -403,11 +472,11 @@ PROSE = {
     "handouts/05-cuda-mega.md": [
         "takes **{plain} ms** for the baseline: {plain_gpaths} billion paths per second, "
         "{plain_regs} registers, {plain_occ} occupancy",
-        "the {plain_saving} that the reference takes off that",
+        "the {plain_saving} that the kinds kernel takes off that",
         "the kernel is bound by instruction issue, with about {active} of 32 lanes active",
-        "The reference takes **{ref} ms**, {slab_saving} less than the kernel before it (the "
-        "rectangles by the core's exact test, the `exact-rects` shape: {exact_rects} ms in the "
-        "same run), and still misses its target of {ref_target}",
+        "The kinds kernel takes **{kinds} ms**, {slab_saving} less than the kernel before it "
+        "(the rectangles by the core's exact test, the `exact-rects` shape: {exact_rects} ms in "
+        "the same run), and misses the target of {ref_target}",
         "With four bounces, {active} of 32 lanes are active. With one bounce, {active1}",
         "{active_show} active lanes",
         "Its schedulers issue in about {issue} of their cycles",

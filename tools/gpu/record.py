@@ -91,12 +91,15 @@ def load(name: str, record: pathlib.Path = RECORD) -> dict:
 @functools.lru_cache(maxsize=4)
 def read(record: pathlib.Path = RECORD) -> dict:
     """Every figure of the record, by where it comes from:
-    lab05[shape], lab05_fast[shape]: lab05-bench's variants (best_ms, registers, ...);
+    lab05[shape], lab05_fast[shape]: lab05-bench's variants (best_ms, registers, ...): since
+    the small-scene kernel, "reference" is it and "kinds-kernel" the kernel for the scene's
+    kinds; a record made before has no "kinds-kernel", and its "reference" is that kernel;
     lab06[config], lab07[config]: lab06-bench's and lab07-bench's, stage[kernel] each;
     scenes[bench][config]: measure.sh's best ms per scene (wavefront.md);
     accuracy[build], host_ms, process (list of process/kernel seconds), ncu[name], machine."""
     check = load("gpu-check.json", record)
     lab05, fast = load("bench-lab05.json", record), load("bench-lab05-fast-math.json", record)
+    kinds_is_reference = all(v["name"] != "kinds-kernel" for v in lab05["variants"])
     out = {
         "lab05": {v["name"]: v for v in lab05["variants"]},
         "lab05_fast": {v["name"]: v for v in fast["variants"]},
@@ -105,7 +108,7 @@ def read(record: pathlib.Path = RECORD) -> dict:
         "host_ms": lab05["host_ms"],
         "accuracy": check["accuracy"],
         "process": check["process_vs_kernel"],
-        "ncu": ncu_by_shape(check["ncu"]),
+        "ncu": ncu_by_shape(check["ncu"], kinds_is_reference),
         "scenes": wavefront_scenes((record / "wavefront.md").read_text()),
         "machine": (record / "machine.txt").read_text(),
     }
@@ -118,11 +121,24 @@ def read(record: pathlib.Path = RECORD) -> dict:
 
 # The Nsight Compute runs of tools/gpu/check.sh name a kernel, not a shape: which of
 # lab05-bench's shapes each kernel is, by the run and the kernel's template arguments
-# (threads a pixel, scene memory, block, path loop, register cap, materials, geometry).
+# (render_kernel: threads a pixel, scene memory, block, path loop, register cap, materials,
+# geometry, slabs; small_scene_kernel: spheres, rectangles, threads a pixel, block, register
+# cap, shadow rays culled, surface by selects).
 NCU_SHAPES = {
+    # The small-scene kernel for the Cornell box's counts (small_scene.cuh): lab05-ref's kernel
+    # on the baseline since it was chosen for small scenes, lab05-bench's "reference" (the
+    # IEEE build's: 56 registers, the surface by index), and its small- shapes.
+    ("cornell", "1, 5, 32, 64, 56, true, false"): "reference",
+    ("cornell-1-bounce", "1, 5, 32, 64, 56, true, false"): "reference, 1 bounce",
+    ("cornell", "1, 5, 32, 64, 56, true, true"): "small-selects",
+    ("cornell", "1, 5, 32, 64, 56, false, false"): "small-no-cull",
+    ("cornell", "1, 5, 32, 64, 64, true, false"): "small-regs-64",
+    ("cornell", "1, 5, 32, 64, 255, true, false"): "small-no-register-cap",
     # The kernels since the rectangles' slabs (render_kernel's last argument, slabs or not, as
-    # the demangler writes it: 1 or 0).
-    ("cornell", "32, 1, 64, 0, 56, Kinds<Diffuse>, Kinds<Sphere, AxisRect>, 1"): "reference",
+    # the demangler writes it: 1 or 0). The kernel for the Cornell box's kinds is
+    # "kinds-kernel": a record made before the small-scene kernel, whose lab05-bench has no
+    # such shape, calls it "reference" (read() renames it, KINDS_AS_REFERENCE).
+    ("cornell", "32, 1, 64, 0, 56, Kinds<Diffuse>, Kinds<Sphere, AxisRect>, 1"): "kinds-kernel",
     ("cornell", "32, 1, 64, 0, 56, Kinds<Diffuse>, Kinds<Sphere, AxisRect>, 0"):
         "exact-rects",
     ("cornell", "32, 1, 64, 0, 56, Kinds<Diffuse>, Kinds<Sphere, Triangle, ConvexQuad>, 1"):
@@ -136,7 +152,7 @@ NCU_SHAPES = {
     ("cornell", "32, 1, 64, 0, 255, Kinds<Diffuse>, Kinds<Sphere, AxisRect>, 1"):
         "no-register-cap",
     ("cornell-1-bounce", "32, 1, 64, 0, 56, Kinds<Diffuse>, Kinds<Sphere, AxisRect>, 1"):
-        "reference, 1 bounce",
+        "kinds-kernel, 1 bounce",
     ("showcase", "32, 1, 64, 0, 56, Kinds<Diffuse, Mirror, Glass>, "
                  "Kinds<Sphere, Triangle, ConvexQuad, AxisRect>, 1"): "showcase",
     # The kernels before (the H200's record).
@@ -155,6 +171,10 @@ NCU_SHAPES = {
                  "Kinds<Sphere, Triangle, ConvexQuad, AxisRect>"): "showcase",
 }
 NCU_PATHS = 600 * 600 * 64  # check.sh profiles the baseline's size at 64 spp
+# The kinds kernel's profiles under the name they had while it was lab05-ref's kernel on the
+# baseline: a record whose lab05-bench has no "kinds-kernel" shape (one made before the
+# small-scene kernel) names them so, as its bench-lab05.json does.
+KINDS_AS_REFERENCE = {"kinds-kernel": "reference", "kinds-kernel, 1 bounce": "reference, 1 bounce"}
 
 
 def number(text: str) -> float:
@@ -180,9 +200,11 @@ def kinds_spelling(args: str) -> str:
     return args
 
 
-def ncu_by_shape(rows: list) -> dict:
+def ncu_by_shape(rows: list, kinds_is_reference: bool = False) -> dict:
     """Per shape: active threads per warp, issue slots used (%), thread instructions per
-    path, and its integer and FP32 shares."""
+    path, and its integer and FP32 shares. kinds_is_reference: the record's lab05-bench
+    has no "kinds-kernel" shape, so its kinds kernel is its "reference" (KINDS_AS_REFERENCE)."""
+    rename = KINDS_AS_REFERENCE if kinds_is_reference else {}
     out = {}
     for r in rows:
         name = r["Kernel Name"]
@@ -191,6 +213,7 @@ def ncu_by_shape(rows: list) -> dict:
         shape = NCU_SHAPES.get((r["run"], args))
         if shape is None:
             continue
+        shape = rename.get(shape, shape)
         out[shape] = {
             "active": number(r["smsp__thread_inst_executed_per_inst_executed.ratio"]),
             "issue": number(r["smsp__issue_active.avg.pct_of_peak_sustained_active"]),
