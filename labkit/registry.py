@@ -53,6 +53,7 @@ class Lab:
     rubric: str
     try_command: str
     timed_spp: int | None = None
+    speed_bar: float | None = None  # a GPU lab's speed bar, where it is not the grader's
 
     @property
     def path(self) -> pathlib.Path:
@@ -75,7 +76,7 @@ class Lab:
 FIELDS = {"number": str, "folder": str, "kind": str, "student": list, "reference": list,
           "extras": list, "ships": list, "handin": list, "handin_kib": int, "shared": list,
           "rubric": str, "try": str}
-OPTIONAL = {"timed_spp": int}
+OPTIONAL = {"timed_spp": int, "speed_bar": float}
 TARGET = re.compile(r"^lab(\d\d)[a-z0-9-]*$")
 
 
@@ -147,6 +148,10 @@ def parse(text: str, where: str = "labs/labs.toml") -> tuple[Lab, ...]:
             raise RegistryError(f"{name}: a gpu rubric is for a gpu lab, and only for one")
         if entry["rubric"].startswith("gpu") and not isinstance(entry.get("timed_spp"), int):
             raise RegistryError(f"{name}: a gpu rubric needs timed_spp (int)")
+        bar = entry.get("speed_bar")
+        if bar is not None and not (entry["kind"] == "gpu" and isinstance(bar, float)
+                                    and 0 < bar <= 1):
+            raise RegistryError(f"{name}: speed_bar is a gpu lab's, a fraction in (0, 1]")
         targets = entry["student"] + entry["reference"] + entry["extras"]
         bad = [t for t in targets if not (m := TARGET.match(t)) or m.group(1) != number]
         if bad or not entry["student"] or not entry["reference"]:
@@ -165,7 +170,7 @@ def parse(text: str, where: str = "labs/labs.toml") -> tuple[Lab, ...]:
                         handin=tuple(entry["handin"]), handin_kib=entry["handin_kib"],
                         shared=tuple(entry["shared"]),
                         rubric=entry["rubric"], try_command=entry["try"],
-                        timed_spp=entry.get("timed_spp")))
+                        timed_spp=entry.get("timed_spp"), speed_bar=entry.get("speed_bar")))
     numbers = [lab.number for lab in labs]
     if numbers != sorted(set(numbers)):
         raise RegistryError(f"{where}: labs must be declared once each, in order ({numbers})")

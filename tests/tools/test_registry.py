@@ -207,6 +207,8 @@ def first_entry_with(old: str, new: str) -> str:
     (first_entry_with('handin = ["path_steps.h", "render.cpp"]\n', ""), "needs handin"),
     (first_entry_with('number = "01"', 'number = "01"\ncolour = "red"'), "unknown field"),
     (first_entry_with("timed_spp = 7936\n", ""), "timed_spp"),
+    (first_entry_with("speed_bar = 0.56", "speed_bar = 1.5"), "speed_bar"),
+    (first_entry_with('number = "01"', 'number = "01"\nspeed_bar = 0.5'), "speed_bar"),
     ("[[lab]\n", "not TOML"),
     ("", "[[lab]] tables"),
 ])
