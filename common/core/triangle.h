@@ -23,7 +23,8 @@ struct alignas(16) Triangle {
     Vec3 v1;
     int material;        // index into the scene's material table
     Vec3 v2;
-    real unused = 0;      // fills the last row (lab 02 reads 16 bytes at each vertex)
+    int cut_edges = 0;  // bit k: edge k (v_k to v_k+1) is a cut (step_off_cut_edge); it also
+                        // fills the last row (lab 02 reads 16 bytes at each vertex)
 };
 
 // Builds a triangle with its normal; a zero-area triangle gets a zero normal and is never hit.
@@ -78,6 +79,39 @@ RT_HD inline Vec3 step_off_edges(const Triangle& tri, Vec3 p, real margin) {
     step_off_edge(tri.normal, tri.v0, tri.v1, p, margin, step);
     step_off_edge(tri.normal, tri.v1, tri.v2, p, margin, step);
     step_off_edge(tri.normal, tri.v2, tri.v0, p, margin, step);
+    return step;
+}
+
+// A cut edge (the loader's, t_junctions.h) is one this face shares end to end with a piece of
+// its own plane, where a third face meets both: a wall cut along a ceiling's edge that lies
+// inside it. Near such an edge the inward step is wrong half the time: a ray from the room
+// below the ceiling that the rounding lets hit the wall's part above it (the ceiling and that
+// part are hit together there, at distances that differ by rounding) was stepped up into that
+// part, behind the ceiling, and left the room. So at a cut edge the step goes to the side the
+// ray came from (`direction` is the arriving ray's): inward when it travels toward the edge,
+// else 2 margins across it, so that p ends at least `margin` inside the partner. The side of
+// the edge the ray came from is the side of the third face's plane it came from where that
+// face is square to this one, as a room's ceiling is to its walls.
+RT_HD inline void step_off_cut_edge(Vec3 normal, Vec3 from, Vec3 to, Vec3 p, real margin,
+                                    Vec3 direction, Vec3& step) {
+    const Vec3 inward = cross(normal, to - from);
+    const real inward_length = length(inward);
+    const real depth = dot(p - from, inward);
+    if (depth >= margin * inward_length) return;  // NaN steps, as step_off_edge's does
+    const bool across = dot(direction, inward) > 0.0f;  // it came from the partner's side
+    step += inward * ((across ? real(-2) * margin : margin) / inward_length);
+}
+// step_off_edges with the arriving ray's direction, for the cut edges of cut_edges; the same
+// bits as step_off_edges where there are none.
+RT_HD inline Vec3 step_off_edges(const Triangle& tri, Vec3 p, real margin, Vec3 direction) {
+    if (tri.cut_edges == 0) return step_off_edges(tri, p, margin);
+    Vec3 step(0.0f);
+    const Vec3 v[3] = {tri.v0, tri.v1, tri.v2};
+    for (int k = 0; k < 3; ++k) {
+        if (tri.cut_edges & (1 << k))
+            step_off_cut_edge(tri.normal, v[k], v[(k + 1) % 3], p, margin, direction, step);
+        else step_off_edge(tri.normal, v[k], v[(k + 1) % 3], p, margin, step);
+    }
     return step;
 }
 
