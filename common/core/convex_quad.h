@@ -25,7 +25,8 @@ struct alignas(16) ConvexQuad {
     Vec3 v1;
     int material;  // index into the scene's material table
     Vec3 v2;
-    real unused2 = 0;  // fills the row (lab 02 reads 16 bytes at each vertex)
+    int cut_edges = 0;  // bit k: edge k (v_k to v_k+1) is a cut (triangle.h's step_off_cut_edge);
+        // it also fills the row (lab 02 reads 16 bytes at each vertex)
     Vec3 v3;
     real unused3 = 0;
 };
@@ -114,6 +115,18 @@ RT_HD inline Vec3 step_off_edges(const ConvexQuad& quad, Vec3 p, real margin) {
     step_off_edge(quad.normal, quad.v1, quad.v2, p, margin, step);
     step_off_edge(quad.normal, quad.v2, quad.v3, p, margin, step);
     step_off_edge(quad.normal, quad.v3, quad.v0, p, margin, step);
+    return step;
+}
+// With the arriving ray's direction, for the cut edges of cut_edges (triangle.h's).
+RT_HD inline Vec3 step_off_edges(const ConvexQuad& quad, Vec3 p, real margin, Vec3 direction) {
+    if (quad.cut_edges == 0) return step_off_edges(quad, p, margin);
+    Vec3 step(0.0f);
+    const Vec3 v[4] = {quad.v0, quad.v1, quad.v2, quad.v3};
+    for (int k = 0; k < 4; ++k) {
+        if (quad.cut_edges & (1 << k))
+            step_off_cut_edge(quad.normal, v[k], v[(k + 1) % 4], p, margin, direction, step);
+        else step_off_edge(quad.normal, v[k], v[(k + 1) % 4], p, margin, step);
+    }
     return step;
 }
 

@@ -49,13 +49,16 @@ RT_HD inline SurfacePoint surface_at(const SceneView& scene, const Ray& ray, con
 }
 
 // A specular path's step off the edges of the primitive it hit (each kind's step_off_edges:
-// zero on a sphere, which has none): an if-chain over the kinds of Kinds<K, Rest...>.
-template <class K, class... Rest>
+// zero on a sphere, which has none): an if-chain over the kinds of Kinds<K, Rest...>. Given
+// the arriving ray's direction, a cut edge's step takes the side the ray came from
+// (triangle.h's step_off_cut_edge); without it, every edge's step is inward.
+template <class K, class... Rest, class... Direction>
 RT_HD inline Vec3 step_off_edges_of(const SceneView& scene, const Hit& hit, Vec3 p, real margin,
-                                    Kinds<K, Rest...>) {
-    if (hit.kind == primitive_kind<K>) return step_off_edges(scene.of<K>()[hit.index], p, margin);
+                                    Kinds<K, Rest...>, Direction... direction) {
+    if (hit.kind == primitive_kind<K>)
+        return step_off_edges(scene.of<K>()[hit.index], p, margin, direction...);
     if constexpr (sizeof...(Rest) > 0) {
-        return step_off_edges_of(scene, hit, p, margin, Kinds<Rest...>{});
+        return step_off_edges_of(scene, hit, p, margin, Kinds<Rest...>{}, direction...);
     } else {
         return Vec3(0.0f);
     }
@@ -63,6 +66,11 @@ RT_HD inline Vec3 step_off_edges_of(const SceneView& scene, const Hit& hit, Vec3
 template <class Primitives = AnyGeometry>
 RT_HD inline Vec3 step_off_hit_edges(const SceneView& scene, const Hit& hit, Vec3 p, real margin) {
     return step_off_edges_of(scene, hit, p, margin, Primitives{});
+}
+template <class Primitives = AnyGeometry>
+RT_HD inline Vec3 step_off_hit_edges(const SceneView& scene, const Hit& hit, Vec3 p, real margin,
+                                     Vec3 direction) {
+    return step_off_edges_of(scene, hit, p, margin, Primitives{}, direction);
 }
 
 // One camera path between two closest-hit queries: all that the bounce step reads and writes.

@@ -180,9 +180,11 @@ RT_HD RT_FORCE_INLINE bool bounce_step(const SceneView& scene, const Hit& hit, c
     if constexpr (has_specular<Materials>) {
         if (!path.alive) return false;
         // A specular path may bounce 64 times inside a closed mirror or glass room, and must
-        // stay inside: its origin also steps off any edge of the primitive it hit.
+        // stay inside: its origin also steps off any edge of the primitive it hit (off a cut
+        // edge, to the side the path came from).
         const Vec3 off_edges = step_off_hit_edges<Primitives>(
-            scene, hit, surface.position, ray_offset(surface.position, hit.t, surface.extent));
+            scene, hit, surface.position, ray_offset(surface.position, hit.t, surface.extent),
+            incoming);
         scatter_of(
             material,
             {incoming, facing, entering, above, off_edges, surface.position, hit.t, surface.extent},

@@ -14,7 +14,9 @@
 //   occludes<kConverged>(ray, k, t_max)   whether it lies on the ray before t_max;
 //   normal_at(k, p)        the unit geometric normal at the hit point p (outward, or front);
 //   surface_extent(k)      its largest |coordinate|: what a hit's rounding error grows with;
-//   step_off_edges(k, p, margin)  a specular path's step off its edges (zero without edges).
+//   step_off_edges(k, p, margin)  a specular path's step off its edges (zero without edges);
+//   step_off_edges(k, p, margin, direction)  the same given the arriving ray's direction, for
+//                          kinds with cut edges (triangle.h); the template below for the others.
 #pragma once
 
 #include <axis_rect.h>
@@ -25,6 +27,13 @@
 #include <triangle.h>
 
 using AllPrimitives = Kinds<Sphere, Triangle, ConvexQuad, AxisRect>;
+
+// A kind without cut edges (triangle.h's step_off_cut_edge) steps off its edges whatever the
+// arriving ray's direction.
+template <class K>
+RT_HD inline Vec3 step_off_edges(const K& item, Vec3 p, real margin, Vec3) {
+    return step_off_edges(item, p, margin);
+}
 
 // Calls f(KindTag<K>{}) for every kind of AllPrimitives written as fields (file_fields.h), in
 // the list's order (host code: the loader, centring, limits).

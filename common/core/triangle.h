@@ -23,7 +23,8 @@ struct alignas(16) Triangle {
     Vec3 v1;
     int material;        // index into the scene's material table
     Vec3 v2;
-    real unused = 0;      // fills the last row (lab 02 reads 16 bytes at each vertex)
+    int cut_edges = 0;  // bit k: edge k (v_k to v_k+1) is a cut (step_off_cut_edge); it also
+                        // fills the last row (lab 02 reads 16 bytes at each vertex)
 };
 
 // Builds a triangle with its normal; a zero-area triangle gets a zero normal and is never hit.
@@ -81,11 +82,44 @@ RT_HD inline Vec3 step_off_edges(const Triangle& tri, Vec3 p, real margin) {
     return step;
 }
 
+// A cut edge (the loader's, t_junctions.h) is one this face shares end to end with a piece of
+// its own plane, where a third face meets both: a wall cut along a ceiling's edge that lies
+// inside it. Near such an edge the inward step is wrong half the time: a ray from the room
+// below the ceiling that the rounding lets hit the wall's part above it (the ceiling and that
+// part are hit together there, at distances that differ by rounding) was stepped up into that
+// part, behind the ceiling, and left the room. So at a cut edge the step goes to the side the
+// ray came from (`direction` is the arriving ray's): inward when it travels toward the edge,
+// else 2 margins across it, so that p ends at least `margin` inside the partner. The side of
+// the edge the ray came from is the side of the third face's plane it came from where that
+// face is square to this one, as a room's ceiling is to its walls.
+RT_HD inline void step_off_cut_edge(Vec3 normal, Vec3 from, Vec3 to, Vec3 p, real margin,
+                                    Vec3 direction, Vec3& step) {
+    const Vec3 inward = cross(normal, to - from);
+    const real inward_length = length(inward);
+    const real depth = dot(p - from, inward);
+    if (depth >= margin * inward_length) return;  // NaN steps, as step_off_edge's does
+    const bool across = dot(direction, inward) > 0.0f;  // it came from the partner's side
+    step += inward * ((across ? real(-2) * margin : margin) / inward_length);
+}
+// step_off_edges with the arriving ray's direction, for the cut edges of cut_edges; the same
+// bits as step_off_edges where there are none.
+RT_HD inline Vec3 step_off_edges(const Triangle& tri, Vec3 p, real margin, Vec3 direction) {
+    if (tri.cut_edges == 0) return step_off_edges(tri, p, margin);
+    Vec3 step(0.0f);
+    const Vec3 v[3] = {tri.v0, tri.v1, tri.v2};
+    for (int k = 0; k < 3; ++k) {
+        if (tri.cut_edges & (1 << k))
+            step_off_cut_edge(tri.normal, v[k], v[(k + 1) % 3], p, margin, direction, step);
+        else step_off_edge(tri.normal, v[k], v[(k + 1) % 3], p, margin, step);
+    }
+    return step;
+}
+
 // Per-ray constants of the watertight test: the axis permutation that makes the ray's
 // dominant axis z, and the shear that maps the ray onto +z.
 struct RayShear {
     int kx, ky, kz;  // permuted axes
-    real sx, sy, sz;  // shear constants
+    real sx, sy;     // shear constants: d[kx] / d[kz], d[ky] / d[kz]
 
     RT_HD explicit RayShear(Vec3 d) {
         const Vec3 a = abs(d);
@@ -97,15 +131,15 @@ struct RayShear {
             kx = ky;
             ky = tmp;
         }
-        sz = real(1) / d[kz];
+        const real sz = real(1) / d[kz];
         sx = d[kx] * sz;
         sy = d[ky] * sz;
     }
 };
 
 // A vertex in the ray's sheared space: relative to the origin, its axes permuted by the
-// RayShear and sheared so that the ray runs along +z. z is left unscaled: the tests scale the
-// distance by sz once. Triangles and quads that share a vertex get the same bits for it.
+// RayShear and sheared so that the ray runs along +z. z is left unscaled (the tests take the
+// distance from the plane). Triangles and quads that share a vertex get the same bits for it.
 struct ShearedVertex {
     real x, y, z;
 };
@@ -174,9 +208,17 @@ RT_HD inline double edge_function_exact(double px, double py, double qx, double 
     return (p1 - p2) + (e1 - e2);
 }
 
-// Watertight ray/triangle intersection (Woop, Benthin, Wald, JCGT 2013). Returns the
-// distance in (0, t_max), or t_max for a miss. Rays parallel to the triangle's plane and
-// degenerate triangles give det == 0 and miss; no division happens before that check.
+// Watertight ray/triangle intersection (Woop, Benthin, Wald, JCGT 2013) for whether the ray
+// passes inside; the distance is the plane's, num / denom of the cull, as the quad's
+// (convex_quad.h). Woop's own distance, the barycentric mix of the vertices' distances
+// (u az + v bz + w cz) / det, errs by the edge functions' rounding over det: about the
+// triangle's aspect ratio times an ulp of its extent. For a needle of a fan (10,000 around a
+// disk, aspect 1,600) that is several ray offsets (ray.h), so a hit point could land under the
+// surface, and its shadow ray hit the disk again (0.3% of such a disk's samples went dark, in
+// double as in float). The plane's distance errs by a few ulps of the plane's offset and the
+// origin, whatever the shape: across the plane, the hit point lies within the offset that
+// extent and |p| bound. Returns the distance in (0, t_max), or t_max for a miss. Rays parallel
+// to the triangle's plane and degenerate triangles give det == 0 (or denom == 0) and miss.
 template <bool kConverged = kConvergedTests>  // rt_hd.h
 RT_HD inline real intersect_triangle(const Ray& ray, const RayShear& shear, const Triangle& tri,
                                      real t_max) {
@@ -205,15 +247,9 @@ RT_HD inline real intersect_triangle(const Ray& ray, const RayShear& shear, cons
     if (!kConverged && outside) return t_max;
 
     const real det = u + v + w;  // 0 for a parallel ray or a degenerate triangle: a miss
-    const real t_scaled = u * (shear.sz * a.z) + v * (shear.sz * b.z) + w * (shear.sz * c.z);
-    // t = t_scaled / det must lie in (0, t_max); compare without dividing first.
-    const real sign = copysign_real(real(1), det);
-    const real t_signed = t_scaled * sign;
-    const real det_abs = det * sign;
-    const bool hit = !(culled | outside) & (det != 0.0f) & (t_signed > 0.0f) &
-                     (t_signed < t_max * det_abs);  // false for NaN
     // Divided before the select: written inside it, the division becomes a branch on a GPU.
-    const real t = t_scaled / det;
+    const real t = num / denom;
+    const bool hit = !(culled | outside) & (det != 0.0f) & (t > 0.0f) & (t < t_max);  // NaN fails
     return hit ? t : t_max;
 }
 

@@ -231,16 +231,20 @@ Scene centre_scene(Scene scene) {
     });
     for (size_t i = 0; i < scene.of<Triangle>().size(); ++i) {
         const WrittenPoint* v = &moved.triangle_vertices[3 * i];
+        const int cut_edges = scene.of<Triangle>()[i].cut_edges;  // the loader's (t_junctions.h)
         scene.of<Triangle>()[i] = make_triangle(rounded(v[0]), rounded(v[1]), rounded(v[2]),
                                                 scene.of<Triangle>()[i].material);
+        scene.of<Triangle>()[i].cut_edges = cut_edges;
     }
     // Each quad and rectangle keeps its kind: the loader chose it on these very points
     // (scene_loader.cpp), so a rectangle's corners still share their coordinates exactly.
     for (size_t i = 0; i < scene.of<ConvexQuad>().size(); ++i) {
         const WrittenPoint* v = &moved.quad_vertices[4 * i];
+        const int cut_edges = scene.of<ConvexQuad>()[i].cut_edges;
         scene.of<ConvexQuad>()[i] =
             make_convex_quad(rounded(v[0]), rounded(v[1]), rounded(v[2]), rounded(v[3]),
                              scene.of<ConvexQuad>()[i].material);
+        scene.of<ConvexQuad>()[i].cut_edges = cut_edges;
     }
     for (size_t i = 0; i < scene.of<AxisRect>().size(); ++i) {
         const WrittenPoint* v = &moved.rect_vertices[4 * i];

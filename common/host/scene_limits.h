@@ -4,11 +4,13 @@
 // where a scene sits never matters, only its sizes against each other and the range of the
 // type. The bounds, in float (double's follow the same reasoning with double's range and
 // spacing):
-//  - Coordinates and radii up to 1e9 in magnitude once centred (double: 1e30): the triangle
-//    test multiplies three coordinate differences (t_scaled in triangle.h), which stays far
-//    below FLT_MAX (3.4e38) there; past ~1e12 it overflows and triangles vanish.
-//  - Sizes (a radius, a triangle's longest edge) from 1e-9 (double: 1e-30): their cubes stay
-//    far above FLT_MIN (1.2e-38); a scene of size ~1e-13 underflows and vanishes.
+//  - Coordinates and radii up to 1e9 in magnitude once centred (double: 1e30): the tests
+//    multiply two coordinate differences (the edge functions, triangle.h; a sphere's squared
+//    lengths), far below FLT_MAX (3.4e38) there. The bound dates from when the triangle's
+//    distance multiplied three (it overflowed past ~1e12 and triangles vanished); it keeps
+//    that margin.
+//  - Sizes (a radius, a triangle's longest edge) from 1e-9 (double: 1e-30): their squares and
+//    cubes stay far above FLT_MIN (1.2e-38); a scene of size ~1e-13 underflowed and vanished.
 //  - A size at least 4 ray offsets of the primitive's extent (its largest |coordinate| once
 //    centred): 2^-18 in float, 2^-47 in double (ray offsets are 8 ulps, kRelativeOffset in
 //    ray.h), so such a primitive is at least a few offsets across.

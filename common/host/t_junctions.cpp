@@ -41,6 +41,12 @@ Vec3 rounded(const WrittenPoint& p) {
     return {static_cast<real>(p.x), static_cast<real>(p.y), static_cast<real>(p.z)};
 }
 bool same(Vec3 a, Vec3 b) { return a.x == b.x && a.y == b.y && a.z == b.z; }
+Vec3 lower(Vec3 a, Vec3 b) {
+    return {min_float(a.x, b.x), min_float(a.y, b.y), min_float(a.z, b.z)};
+}
+Vec3 upper(Vec3 a, Vec3 b) {
+    return {max_float(a.x, b.x), max_float(a.y, b.y), max_float(a.z, b.z)};
+}
 
 // Whether a triangle has no area as rendered: it is never hit, so nothing meets it.
 bool flat(const Piece& p) {
@@ -312,6 +318,17 @@ EdgeKey edge_key(Vec3 p, Vec3 q) {
     EdgeKey a{p.x, p.y, p.z, q.x, q.y, q.z}, b{q.x, q.y, q.z, p.x, p.y, p.z};
     return a < b ? a : b;
 }
+EdgeKey edge_of(const Vec3* corners, int count, int k) {
+    return edge_key(corners[k], corners[(k + 1) % count]);
+}
+
+// One edge of one primitive or piece; sorted by key, the holders of an edge come together.
+struct EdgeUse {
+    EdgeKey key;
+    size_t holder;
+    int edge;
+    bool operator<(const EdgeUse& o) const { return key < o.key; }
+};
 
 // classify_quads's rule on the pieces: a rectangle that shares an edge with a triangle or a
 // convex quad becomes a convex quad, and so in turn does every rectangle sharing an edge with
@@ -343,12 +360,380 @@ int demote_rects(std::vector<Piece>& pieces) {
     return demoted;
 }
 
-// One pass: every piece split where the scene's current vertices lie on its edges, then the
-// rectangles that now meet triangles or quads demoted. Returns whether anything changed.
+// ---- Edges that end inside faces ------------------------------------------------------------
+// A primitive's edge can lie in another's plane and run across its interior (a ceiling whose
+// edges lie inside walls that rise past it): no vertex lies on an edge there, so the splitting
+// above finds nothing, and a ray through the joint can pass between the ceiling and the wall
+// (the wall's face has no edge there for the watertight test to share). Such a face is cut
+// in two along the edge's line, from boundary to boundary; the edge's ends then lie on the
+// cut, and the splitting at T-junctions makes both share it end to end.
+
+// A piece's plane as rendered, and its corners in the two coordinates that remain when the
+// normal's largest axis is dropped, with the sign that makes the boundary counter-clockwise.
+struct FacePlane {
+    long double normal[3] = {0, 0, 0};
+    long double offset = 0;
+    long double extent = 0;  // largest |coordinate| of its corners
+    int u = 0, v = 1;  // the in-plane axes
+    long double orientation = 1;
+    bool ok = false;
+};
+
+FacePlane face_plane(const Piece& p) {
+    FacePlane f;
+    long double a[3], b[3];
+    for (int i = 0; i < 3; ++i) {
+        const long double r0 = p.rendered[0][i];
+        if (p.corners == 3) {
+            a[i] = static_cast<long double>(p.rendered[1][i]) - r0;
+            b[i] = static_cast<long double>(p.rendered[2][i]) - r0;
+        } else {  // the diagonals
+            a[i] = static_cast<long double>(p.rendered[2][i]) - r0;
+            b[i] = static_cast<long double>(p.rendered[3][i]) - p.rendered[1][i];
+        }
+    }
+    long double n[3] = {a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2],
+                        a[0] * b[1] - a[1] * b[0]};
+    const long double length = std::sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
+    if (!(length > 0)) return f;
+    int drop = 0;
+    for (int i = 0; i < 3; ++i) {
+        f.normal[i] = n[i] / length;
+        if (std::fabs(f.normal[i]) > std::fabs(f.normal[drop])) drop = i;
+    }
+    for (int k = 0; k < p.corners; ++k) {
+        for (int i = 0; i < 3; ++i) {
+            f.offset += f.normal[i] * p.rendered[k][i] / p.corners;
+            f.extent = std::max(f.extent, std::fabs(static_cast<long double>(p.rendered[k][i])));
+        }
+    }
+    f.u = drop == 0 ? 1 : 0;
+    f.v = drop == 2 ? 1 : 2;
+    // (u, v, drop) is a right-handed frame or a left-handed one; the normal's sign along drop
+    // says which way the boundary turns in it.
+    const bool right_handed = (drop == 0) || (drop == 2);  // (1,2,0), (0,1,2); (0,2,1) is not
+    f.orientation = ((f.normal[drop] > 0) == right_handed) ? 1 : -1;
+    f.ok = true;
+    return f;
+}
+
+// Where the line of edge p-q crosses the face's interior: the cut's ends as positions s along
+// p + s (q - p), each with the boundary edge it lies on; found is false when no part of the
+// segment p-q lies inside the face by more than rounding, or p-q is not in its plane.
+struct Chord {
+    bool found = false;
+    long double s[2] = {0, 0};
+    int edge[2] = {-1, -1};  // boundary edge k runs from corner k to corner k + 1
+};
+
+Chord chord_through(const Piece& face, const FacePlane& f, Vec3 p, Vec3 q) {
+    Chord chord;
+    long double scale = f.extent;
+    for (int i = 0; i < 3; ++i)
+        scale = std::max({scale, std::fabs(static_cast<long double>(p[i])),
+                          std::fabs(static_cast<long double>(q[i]))});
+    const long double tolerance = kCollinearUlps * kRealEpsilon * scale;
+    for (const Vec3& end : {p, q}) {
+        long double height = -f.offset;
+        for (int i = 0; i < 3; ++i) height += f.normal[i] * end[i];
+        if (!(std::fabs(height) <= tolerance)) return chord;
+    }
+    // Each boundary edge's signed distance, inward positive, is linear along the line:
+    // at + s * slope. The part deeper than `tolerance` inside every edge, within the segment,
+    // must be non-empty; the cut is where the line is inside every edge at all.
+    long double deep_lo = 0, deep_hi = 1;
+    long double lo = -INFINITY, hi = INFINITY;
+    int lo_edge = -1, hi_edge = -1;
+    for (int k = 0; k < face.corners; ++k) {
+        const Vec3 a = face.rendered[k], b = face.rendered[(k + 1) % face.corners];
+        const long double eu = static_cast<long double>(b[f.u]) - a[f.u];
+        const long double ev = static_cast<long double>(b[f.v]) - a[f.v];
+        const long double length = std::sqrt(eu * eu + ev * ev);
+        if (!(length > 0)) return chord;
+        const auto distance = [&](Vec3 x) {
+            return f.orientation *
+                   (eu * (static_cast<long double>(x[f.v]) - a[f.v]) -
+                    ev * (static_cast<long double>(x[f.u]) - a[f.u])) /
+                   length;
+        };
+        const long double at = distance(p), slope = distance(q) - at;
+        if (slope == 0) {
+            if (!(at > tolerance)) return chord;  // along or outside this edge: no cut
+            continue;
+        }
+        // at + s slope >= level  <=>  s >= (level - at) / slope (slope > 0), or <=.
+        const long double deep = (tolerance - at) / slope, edge_s = -at / slope;
+        if (slope > 0) {
+            deep_lo = std::max(deep_lo, deep);
+            if (edge_s > lo) lo = edge_s, lo_edge = k;
+        } else {
+            deep_hi = std::min(deep_hi, deep);
+            if (edge_s < hi) hi = edge_s, hi_edge = k;
+        }
+    }
+    if (!(deep_lo < deep_hi) || lo_edge < 0 || hi_edge < 0 || lo_edge == hi_edge) return chord;
+    chord.found = true;
+    chord.s[0] = lo, chord.s[1] = hi;
+    chord.edge[0] = lo_edge, chord.edge[1] = hi_edge;
+    return chord;
+}
+
+// The face's parts on either side of the chord, each in the face's winding: a point of the
+// cut is the edge's own end where it lies within 32 ulps of one, else the face's corner where
+// it lies within 32 ulps of one, else a new point on the line written in double. (Within 8,
+// the double build kept a second point 2 ulps from a ceiling's corner, whose slivers of
+// triangles let 60 of 4,000 paths out of a mirror cell.)
+std::vector<Piece> cut_along(const Piece& face, const Chord& chord, const Point& p, const Point& q,
+                             const WrittenPoint& centre) {
+    Point ends[2];
+    int corner_at[2] = {-1, -1};
+    for (int e = 0; e < 2; ++e) {
+        const long double s = chord.s[e];
+        WrittenPoint w;
+        for (int axis = 0; axis < 3; ++axis) {
+            const double a = coordinate(p.written, axis), b = coordinate(q.written, axis);
+            set_coordinate(w, axis, static_cast<double>(a + s * (static_cast<long double>(b) - a)));
+        }
+        ends[e] = {moved_to_centre(w, centre), w, false};
+        // Within rounding of a corner of the edge or of the face: that point itself.
+        long double extent = 0;
+        for (int axis = 0; axis < 3; ++axis)
+            extent = std::max(extent, std::fabs(static_cast<long double>(ends[e].rendered[axis])));
+        const long double tolerance = 4 * kCollinearUlps * kRealEpsilon * extent;
+        const auto near = [&](Vec3 x) {
+            for (int axis = 0; axis < 3; ++axis) {
+                if (!(std::fabs(static_cast<long double>(x[axis]) - ends[e].rendered[axis]) <=
+                      tolerance))
+                    return false;
+            }
+            return true;
+        };
+        if (near(p.rendered)) ends[e] = p;
+        else if (near(q.rendered)) ends[e] = q;
+        for (int k = 0; k < face.corners; ++k) {
+            if (near(face.rendered[k])) {
+                ends[e] = {face.rendered[k], face.written[k], false};
+                corner_at[e] = k;
+            }
+        }
+    }
+    if (same(ends[0].rendered, ends[1].rendered)) return {};
+    // The boundary with the cut's ends inserted on their edges (or standing for a corner).
+    std::vector<Point> boundary;
+    int at[2] = {-1, -1};
+    for (int k = 0; k < face.corners; ++k) {
+        boundary.push_back({face.rendered[k], face.written[k], false});
+        for (int e = 0; e < 2; ++e) {
+            if (corner_at[e] == k) at[e] = static_cast<int>(boundary.size()) - 1;
+        }
+        for (int e = 0; e < 2; ++e) {
+            if (corner_at[e] < 0 && chord.edge[e] == k) {
+                boundary.push_back(ends[e]);
+                at[e] = static_cast<int>(boundary.size()) - 1;
+            }
+        }
+    }
+    if (at[0] < 0 || at[1] < 0) return {};
+    const int m = static_cast<int>(boundary.size());
+    std::vector<Piece> parts;
+    for (int side = 0; side < 2; ++side) {
+        std::vector<Point> polygon;  // from one end of the cut round to the other
+        for (int k = at[side];; k = (k + 1) % m) {
+            polygon.push_back(boundary[k]);
+            if (k == at[1 - side]) break;
+        }
+        if (polygon.size() < 3) return {};  // the cut runs along the boundary: no cut
+        Piece part = face;
+        part.corners = static_cast<int>(polygon.size());
+        if (polygon.size() == 4) {
+            for (int k = 0; k < 4; ++k) part.written[k] = polygon[k].written;
+            for (int k = 0; k < 4; ++k) part.rendered[k] = polygon[k].rendered;
+            // A rectangle stays one where both parts are rectangles as written: the cut
+            // across it at one coordinate.
+            bool rect = face.kind == Kind::kRect;
+            for (int d : {rect_axis_u(face.axis), rect_axis_v(face.axis)}) {
+                if (!rect) break;
+                std::vector<double> values;
+                for (int k = 0; k < 4; ++k) values.push_back(coordinate(part.written[k], d));
+                std::sort(values.begin(), values.end());
+                rect = values[0] == values[1] && values[2] == values[3];
+            }
+            for (int k = 0; rect && k < 4; ++k)
+                rect = coordinate(part.written[k], face.axis) ==
+                       coordinate(face.written[0], face.axis);
+            Vec3 corners[4] = {part.rendered[0], part.rendered[1], part.rendered[2],
+                               part.rendered[3]};
+            if (rect) {
+                part.kind = Kind::kRect;
+                parts.push_back(part);
+                continue;
+            }
+            if (is_planar_convex_quad(corners)) {
+                part.kind = Kind::kQuad;
+                parts.push_back(part);
+                continue;
+            }
+        }
+        // A rectangle cut aslant is left whole: its parts would be quads, and so, through
+        // demote_rects, would every rectangle of its room (a floor under a triangle standing
+        // on it, as in the showcase scene).
+        if (face.kind == Kind::kRect) return {};
+        // Otherwise triangles, fanned from the polygon's first point (a cut's end).
+        for (size_t k = 1; k + 1 < polygon.size(); ++k) {
+            Piece t = face;
+            t.kind = Kind::kTriangle;
+            t.corners = 3;
+            const Point* corner[3] = {&polygon[0], &polygon[k], &polygon[k + 1]};
+            for (int c = 0; c < 3; ++c) {
+                t.written[c] = corner[c]->written;
+                t.rendered[c] = corner[c]->rendered;
+            }
+            parts.push_back(t);
+        }
+    }
+    return parts;
+}
+
+// The pieces in a uniform grid over their bounds (at most 32 cells a side), each in every
+// cell its box covers: an edge looks only at the faces whose boxes meet its own.
+class FaceIndex {
+public:
+    explicit FaceIndex(const std::vector<Piece>& pieces) : stamp_(pieces.size(), 0) {
+        if (pieces.empty()) return;
+        for (int axis = 0; axis < 3; ++axis) {
+            lo_[axis] = hi_[axis] = pieces[0].rendered[0][axis];
+            for (const Piece& p : pieces) {
+                for (int k = 0; k < p.corners; ++k) {
+                    lo_[axis] = std::min(lo_[axis], double(p.rendered[k][axis]));
+                    hi_[axis] = std::max(hi_[axis], double(p.rendered[k][axis]));
+                }
+            }
+        }
+        side_ = std::max(1, std::min(32, static_cast<int>(std::cbrt(double(pieces.size())))));
+        cells_.resize(size_t(side_) * side_ * side_);
+        for (size_t i = 0; i < pieces.size(); ++i) {
+            Vec3 a = pieces[i].rendered[0], b = a;
+            for (int k = 1; k < pieces[i].corners; ++k) {
+                a = lower(a, pieces[i].rendered[k]);
+                b = upper(b, pieces[i].rendered[k]);
+            }
+            visit_cells(a, b, [&](size_t c) { cells_[c].push_back(i); });
+        }
+    }
+
+    // Calls visit(i) once for each piece whose box may meet the box with corners a and b.
+    template <typename Visit>
+    void near_box(Vec3 a, Vec3 b, Visit visit) {
+        ++round_;
+        visit_cells(lower(a, b), upper(a, b), [&](size_t c) {
+            for (size_t i : cells_[c]) {
+                if (stamp_[i] == round_) continue;
+                stamp_[i] = round_;
+                visit(i);
+            }
+        });
+    }
+
+private:
+    template <typename Visit>
+    void visit_cells(Vec3 a, Vec3 b, Visit visit) const {
+        int from[3], to[3];
+        for (int axis = 0; axis < 3; ++axis) {
+            const double margin = 4 * kCollinearUlps * kRealEpsilon *
+                                  std::max(std::fabs(lo_[axis]), std::fabs(hi_[axis]));
+            from[axis] = cell(axis, a[axis] - margin);
+            to[axis] = cell(axis, b[axis] + margin);
+        }
+        for (int i = from[0]; i <= to[0]; ++i)
+            for (int j = from[1]; j <= to[1]; ++j)
+                for (int k = from[2]; k <= to[2]; ++k) visit((size_t(i) * side_ + j) * side_ + k);
+    }
+    int cell(int axis, double x) const {
+        const double extent = hi_[axis] - lo_[axis];
+        if (!(extent > 0)) return 0;
+        const double at = (x - lo_[axis]) / extent * side_;
+        return at <= 0 ? 0 : (at >= side_ - 1 ? side_ - 1 : static_cast<int>(at));
+    }
+
+    double lo_[3] = {0, 0, 0}, hi_[3] = {0, 0, 0};
+    int side_ = 1;
+    std::vector<std::vector<size_t>> cells_;
+    std::vector<unsigned> stamp_;
+    unsigned round_ = 0;
+};
+
+// One pass of cuts: every face that an edge of another piece, at an angle to it, crosses inside
+// (an edge no two pieces share: a mesh's inner edges run along their neighbours, not across
+// them) is cut once along that edge's line. Returns whether any was.
+bool cut_at_inner_edges(std::vector<Piece>& pieces, const WrittenPoint& centre) {
+    // The edges no two pieces share, as (piece, edge) pairs.
+    std::vector<EdgeUse> edges;
+    for (size_t i = 0; i < pieces.size(); ++i) {
+        if (flat(pieces[i])) continue;
+        for (int k = 0; k < pieces[i].corners; ++k)
+            edges.push_back({edge_of(pieces[i].rendered, pieces[i].corners, k), i, k});
+    }
+    std::sort(edges.begin(), edges.end());
+    std::vector<std::pair<size_t, int>> borders;
+    for (size_t a = 0, b; a < edges.size(); a = b) {
+        for (b = a + 1; b < edges.size() && edges[b].key == edges[a].key;) ++b;
+        if (b == a + 1) borders.push_back({edges[a].holder, edges[a].edge});
+    }
+    if (borders.empty()) return false;  // a closed mesh: nothing to look up
+    FaceIndex faces(pieces);
+    std::vector<FacePlane> planes(pieces.size());
+    std::vector<bool> planed(pieces.size(), false), planned(pieces.size(), false);
+    const auto plane = [&](size_t i) -> const FacePlane& {
+        if (!planed[i]) planes[i] = face_plane(pieces[i]), planed[i] = true;
+        return planes[i];
+    };
+    std::vector<std::vector<Piece>> parts(pieces.size());
+    bool cut = false;
+    for (const auto& [g, k] : borders) {
+        const Piece& owner = pieces[g];
+        const int next = (k + 1) % owner.corners;
+        const Vec3 p = owner.rendered[k], q = owner.rendered[next];
+        const Point pw{p, owner.written[k], false}, qw{q, owner.written[next], false};
+        faces.near_box(p, q, [&](size_t f) {
+            if (f == g || planned[f] || flat(pieces[f]) || !plane(f).ok) return;
+            // Pieces of one plane that overlap (a bow tie's halves) are left as they are:
+            // the faces to close are those that meet at an angle.
+            if (plane(g).ok && std::fabs(planes[f].normal[0] * planes[g].normal[0] +
+                                         planes[f].normal[1] * planes[g].normal[1] +
+                                         planes[f].normal[2] * planes[g].normal[2]) > 1 - 1e-6L)
+                return;
+            const Chord chord = chord_through(pieces[f], planes[f], p, q);
+            if (!chord.found) return;
+            std::vector<Piece> split = cut_along(pieces[f], chord, pw, qw, centre);
+            if (split.empty()) return;
+            parts[f] = std::move(split);
+            planned[f] = true;
+            cut = true;
+        });
+    }
+    if (!cut) return false;
+    std::vector<Piece> next;
+    for (size_t i = 0; i < pieces.size(); ++i) {
+        if (planned[i]) next.insert(next.end(), parts[i].begin(), parts[i].end());
+        else next.push_back(pieces[i]);
+    }
+    pieces = std::move(next);
+    return true;
+}
+
+// One pass: faces cut along edges that cross them (cut_at_inner_edges), every piece split where
+// the scene's current vertices lie on its edges, then the rectangles that now meet triangles or
+// quads demoted. Returns whether anything changed.
 bool split_once(std::vector<Piece>& pieces, const WrittenPoint& centre) {
+    bool changed = cut_at_inner_edges(pieces, centre);
+    if (changed) {
+        for (Piece& piece : pieces) {
+            for (int k = 0; k < piece.corners; ++k)
+                piece.rendered[k] = moved_to_centre(piece.written[k], centre);
+        }
+    }
     const PointIndex index(pieces);
     std::vector<Piece> next;
-    bool changed = false;
     for (const Piece& piece : pieces) {
         std::vector<Piece> parts;
         if (!flat(piece))
@@ -371,6 +756,58 @@ bool split_once(std::vector<Piece>& pieces, const WrittenPoint& centre) {
 // Enough for a chain of rectangles demoted one neighbour per pass; each pass of a scene
 // without T-junctions left changes nothing and ends the search.
 constexpr int kMaxPasses = 32;
+
+// Marks the cut edges of the scene's triangles and convex quads (cut_edges, triangle.h's
+// step_off_cut_edge): an edge that a piece of the same plane shares end to end, where a third
+// face meets them (three or more primitives hold it). Returns how many it marked.
+int mark_cut_edges(Scene& scene) {
+    // Every edge with its holder: triangles, then quads, then rectangles, by index.
+    std::vector<Triangle>& triangles = scene.of<Triangle>();
+    std::vector<ConvexQuad>& quads = scene.of<ConvexQuad>();
+    const std::vector<AxisRect>& rects = scene.of<AxisRect>();
+    std::vector<EdgeUse> edges;
+    std::vector<Vec3> normals;
+    for (const Triangle& t : triangles) {
+        const Vec3 v[3] = {t.v0, t.v1, t.v2};
+        for (int k = 0; k < 3; ++k) edges.push_back({edge_of(v, 3, k), normals.size(), k});
+        normals.push_back(t.normal);
+    }
+    for (const ConvexQuad& q : quads) {
+        const Vec3 v[4] = {q.v0, q.v1, q.v2, q.v3};
+        for (int k = 0; k < 4; ++k) edges.push_back({edge_of(v, 4, k), normals.size(), k});
+        normals.push_back(q.normal);
+    }
+    for (const AxisRect& r : rects) {
+        Vec3 v[4];
+        rect_corners(r, v);
+        for (int k = 0; k < 4; ++k) edges.push_back({edge_of(v, 4, k), normals.size(), k});
+        normals.push_back(along_axis(rect_axis(r), 1.0f));
+    }
+    for (Triangle& t : triangles) t.cut_edges = 0;
+    for (ConvexQuad& q : quads) q.cut_edges = 0;
+    std::sort(edges.begin(), edges.end());
+    const auto parallel = [](Vec3 m, Vec3 n) {
+        return std::fabs(double(m.x) * n.x + double(m.y) * n.y + double(m.z) * n.z) > 1 - 1e-6;
+    };
+    int marked = 0;
+    for (size_t a = 0, b; a < edges.size(); a = b) {
+        for (b = a + 1; b < edges.size() && edges[b].key == edges[a].key;) ++b;
+        if (b - a < 3) continue;  // no third face
+        for (size_t i = a; i < b; ++i) {
+            const size_t h = edges[i].holder;
+            if (h >= triangles.size() + quads.size()) continue;  // a rectangle: no mark
+            int coplanar = 0;  // this piece among them
+            for (size_t j = a; j < b; ++j)
+                coplanar += parallel(normals[h], normals[edges[j].holder]);
+            if (coplanar < 2) continue;
+            int& bits = h < triangles.size() ? triangles[h].cut_edges
+                                             : quads[h - triangles.size()].cut_edges;
+            if (bits == 0) ++marked;
+            bits |= 1 << edges[i].edge;
+        }
+    }
+    return marked;
+}
 
 }  // namespace
 
@@ -406,7 +843,10 @@ int split_t_junctions(Scene& scene) {
 
     bool changed = false;
     for (int pass = 0; pass < kMaxPasses && split_once(pieces, centre); ++pass) changed = true;
-    if (!changed) return 0;  // every bit as loaded
+    if (!changed) {
+        mark_cut_edges(scene);  // a file may hold such joints already cut
+        return 0;  // every other bit as loaded
+    }
 
     // Rebuilt from the written points, rounded once, as the loader builds the file's own.
     scene.of<Triangle>().clear();
@@ -430,5 +870,6 @@ int split_t_junctions(Scene& scene) {
             out.rect_vertices.insert(out.rect_vertices.end(), p.written, p.written + 4);
         }
     }
+    mark_cut_edges(scene);
     return static_cast<int>(pieces.size() - before);
 }

@@ -4,7 +4,9 @@
 // bottom edge, two collinear edges that partly overlap), a ray through that line can pass
 // between them. The loader therefore splits, once the file's quads are classified, every
 // primitive at each vertex of another that lies on its edge strictly between the ends, so
-// every overlap of edges becomes edges shared end to end.
+// every overlap of edges becomes edges shared end to end. An edge that runs inside another
+// face (a ceiling's edge on a wall that rises past it) first cuts that face along its line,
+// so that its ends lie on the cut and the splitting makes it shared end to end too.
 #pragma once
 
 #include <scene.h>
@@ -19,6 +21,11 @@
 // point of a triangle's or quad's into smaller rectangles (a rectangle's edge test depends on
 // the edge's line only, so points of other rectangles need no cut). A rectangle that then
 // shares an edge with a triangle or convex quad becomes a convex quad, as classify_quads does,
-// and the search repeats until nothing changes. Every new point is written in double
-// (Scene::written), so centring moves it as it moves the file's own.
+// and the search repeats until nothing changes. Each pass first cuts every face that an edge
+// no two primitives share crosses inside, at an angle to the edge's own piece, along the
+// edge's line (a rectangle only across one of its axes, so its parts stay rectangles). Every
+// new point is written in double (Scene::written), so centring moves it as it moves the
+// file's own. Finally, an edge that three primitives hold, two of them in one plane (a wall
+// cut under a ceiling), is marked on those two (cut_edges, triangle.h's step_off_cut_edge),
+// in every scene, split or not.
 int split_t_junctions(Scene& scene);

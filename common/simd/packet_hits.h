@@ -102,23 +102,21 @@ RT_PACKET_INLINE F intersect_triangle(const RayPacket<F>& ray, const RayShearN<F
     const Mask any_positive = (u > 0.0f) | (v > 0.0f) | (w > 0.0f);
     const Mask inside = and_not(candidates, any_negative & any_positive);
 
+    // The distance is the plane's, num / denom of the cull: exact enough for a needle too.
     const F det = u + v + w;
-    const F t_scaled = u * (shear.sz * az) + v * (shear.sz * bz) + w * (shear.sz * cz);
-    // t = t_scaled / det must lie in (0, t_max); compare without dividing first.
-    const F sign = copysign(F(1.0f), det);
-    const F t_signed = t_scaled * sign;
-    const F det_abs = det * sign;
-    const Mask hit = inside & (det != 0.0f) & (t_signed > 0.0f) & (t_signed < t_max * det_abs);
+    const F t = num / denom;
+    const Mask hit = inside & (det != 0.0f) & (t > 0.0f) & (t < t_max);
     // No early exit when no lane hits: a branch that goes either way costs more than the
     // few instructions it would skip (measured: 5%).
-    return select(hit, t_scaled / det, t_max);
+    return select(hit, t, t_max);
     // SKELETON
     //> // TODO(lab02): the watertight test of intersect_triangle (common/core/triangle.h) in all
     //> // lanes at once: the vertices relative to the origin in each lane's own axis order
     //> // (permuted(tri.v0, shear.kx) - shear.origin_k.x, ...), the shear (shear.sx ...),
     //> // the three edge functions as a product minus a product (never fused), the
     //> // double-precision redo for lanes where one of them is zero, the sign tests, det,
-    //> // and t_scaled / det in the lanes that hit. Every other lane returns its t_max.
+    //> // and the plane's t = num / denom in the lanes that hit (det != 0, t in (0, t_max)).
+    //> // Every other lane returns its t_max.
     //> // Until then: lane 0 only, with the scalar test, so 7 of every 8 samples miss
     //> // every triangle.
     //> (void)candidates;

@@ -304,7 +304,8 @@ inline Vec3xN<F> gather_vertex(const T& first, const Vec3& v, const HitPacket<F>
 }
 template <class F>
 inline Vec3xN<F> specular_edge_step(const SceneView& scene, const HitPacket<F>& hit,
-                                    const SurfacePacket<F>& surface, MaskOf<F> specular) {
+                                    const SurfacePacket<F>& surface, MaskOf<F> specular,
+                                    const Vec3xN<F>& direction) {
     using I = IntOf<F>;
     Vec3xN<F> step(Vec3(0.0f));
     const auto on_triangle = specular & hit.on(primitive_kind<Triangle>);
@@ -340,6 +341,16 @@ inline Vec3xN<F> specular_edge_step(const SceneView& scene, const HitPacket<F>& 
         step_off_edge(surface.normal, v1, v2, surface.position, margin, s);
         step_off_edge(surface.normal, v2, v0, surface.position, margin, s);
         step = select(on_triangle, s, step);
+        // A triangle with cut edges (triangle.h) steps by the arriving ray's direction: the
+        // scalar step, lane by lane (the loader marks few).
+        const auto cut = and_not(
+            on_triangle, gather(t0.cut_edges, stride_of<Triangle>(), hit.index, on_triangle) == 0);
+        if (any(cut)) {
+            step = vectors_from_lanes(cut, step, [&](int l) {
+                return step_off_edges(scene.of<Triangle>()[hit.index.lane(l)],
+                                      surface.position.lane(l), margin.lane(l), direction.lane(l));
+            });
+        }
     }
     if (any(on_quad)) {
         const ConvexQuad& q0 = scene.of<ConvexQuad>()[0];
@@ -353,6 +364,14 @@ inline Vec3xN<F> specular_edge_step(const SceneView& scene, const HitPacket<F>& 
         step_off_edge(surface.normal, v2, v3, surface.position, margin, s);
         step_off_edge(surface.normal, v3, v0, surface.position, margin, s);
         step = select(on_quad, s, step);
+        const auto cut = and_not(
+            on_quad, gather(q0.cut_edges, stride_of<ConvexQuad>(), hit.index, on_quad) == 0);
+        if (any(cut)) {  // as the triangles'
+            step = vectors_from_lanes(cut, step, [&](int l) {
+                return step_off_edges(scene.of<ConvexQuad>()[hit.index.lane(l)],
+                                      surface.position.lane(l), margin.lane(l), direction.lane(l));
+            });
+        }
     }
     if (any(on_rect)) {  // step_off_edges (axis_rect.h), lane by lane
         constexpr int kR = stride_of<AxisRect>();
@@ -504,7 +523,7 @@ RT_PACKET_INLINE MaskOf<F> bounce_step(const SceneView& scene, const HitPacket<F
     // reflected direction is renormalised.
     Vec3xN<F> off_edges(Vec3(0.0f));
     if (any(mirror | glass | other))
-        off_edges = specular_edge_step(scene, hit, surface, mirror | glass | other);
+        off_edges = specular_edge_step(scene, hit, surface, mirror | glass | other, ray.direction);
     if (any(mirror)) {
         path.throughput = select(mirror, path.throughput * albedo, path.throughput);
         next.origin = select(mirror, above + off_edges, next.origin);

@@ -30,7 +30,7 @@ inline F component(const Vec3xN<F>& v, IntOf<F> k) {
 template <class F>
 struct RayShearN {
     IntOf<F> kx, ky, kz;  // permuted axes, per lane
-    F sx, sy, sz;  // shear constants, per lane
+    F sx, sy;            // shear constants, per lane
     Vec3xN<F> origin_k;  // the ray origins permuted: (origin[kx], origin[ky], origin[kz])
 
     explicit RayShearN(const RayPacket<F>& ray) {
@@ -44,7 +44,7 @@ struct RayShearN {
         const I old_kx = kx;
         kx = select(flip, ky, kx);
         ky = select(flip, old_kx, ky);
-        sz = F(1.0f) / component(d, kz);
+        const F sz = F(1.0f) / component(d, kz);
         sx = component(d, kx) * sz;
         sy = component(d, ky) * sz;
         origin_k = {component(ray.origin, kx), component(ray.origin, ky),

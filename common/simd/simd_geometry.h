@@ -25,15 +25,14 @@ struct BroadcastRay {
     RayShear shear;      // axis permutation and shear (triangle.h)
     Vec3x8 origin;       // the same in every lane
     Vec3x8 direction;
-    Float8 sx, sy, sz;   // the shear constants
+    Float8 sx, sy;       // the shear constants
 
     explicit BroadcastRay(const Ray& r)
         : shear(r.direction),
           origin(r.origin),
           direction(r.direction),
           sx(shear.sx),
-          sy(shear.sy),
-          sz(shear.sz) {}
+          sy(shear.sy) {}
 };
 
 inline Vec3x8 load3(const float (&rows)[3][kSimdWidth]) {
@@ -91,14 +90,11 @@ inline Float8 intersect_triangles8(const BroadcastRay& r, const TrianglePacket& 
     const Mask8 any_negative = (u < 0.0f) | (v < 0.0f) | (w < 0.0f);
     const Mask8 any_positive = (u > 0.0f) | (v > 0.0f) | (w > 0.0f);
     const Float8 det = u + v + w;
-    const Float8 t_scaled = u * (r.sz * az) + v * (r.sz * bz) + w * (r.sz * cz);
-    const Float8 sign = copysign(1.0f, det);
-    const Float8 t_signed = t_scaled * sign;
-    const Float8 det_abs = det * sign;
-    const Mask8 hit = and_not(candidates, any_negative & any_positive) & (det != 0.0f) &
-                      (t_signed > 0.0f) & (t_signed < t_max * det_abs);
+    const Float8 t = num / denom;  // the plane's distance, as the scalar test
+    const Mask8 hit =
+        and_not(candidates, any_negative & any_positive) & (det != 0.0f) & (t > 0.0f) & (t < t_max);
     if (none(hit)) return t_max;
-    return select(hit, t_scaled / det, t_max);
+    return select(hit, t, t_max);
 }
 
 // The lane holding the smallest t among `hit_bits` (lanes outside hold t_max, larger than

@@ -176,6 +176,53 @@ def enclosure_image(binary, scene, tmp_path, bounces, width=48, height=48, spp=4
                    seed=11).image
 
 
+def ceiling_inside_rising_walls(kind, ulps=260, size=24):
+    """A closed mirror cell whose four walls rise past its ceiling to an open top, so that the
+    ceiling's edges run across the walls' faces, as convex quads or as triangles, turned about
+    a generic axis; background 1, no light. The camera looks from inside at a point of the
+    ceiling's edge through a view of `ulps` units of rounding of a unit direction a pixel
+    (float's narrowest, common/host/scene_limits.h), so many of its rays meet the joint
+    within rounding."""
+    lo, hi, top = -1.0, 1.0, 1.8
+
+    def corner(i, j, k):
+        return [(lo, hi)[i], (lo, hi)[j], (lo, hi)[k]]
+
+    def wall(face):
+        return [[x, top if y == hi else y, z] for x, y, z in face]
+
+    faces = [[corner(0, 0, 0), corner(0, 0, 1), corner(1, 0, 1), corner(1, 0, 0)],  # floor
+             [corner(0, 1, 0), corner(1, 1, 0), corner(1, 1, 1), corner(0, 1, 1)],  # ceiling
+             wall([corner(0, 0, 0), corner(0, 1, 0), corner(0, 1, 1), corner(0, 0, 1)]),
+             wall([corner(1, 0, 0), corner(1, 0, 1), corner(1, 1, 1), corner(1, 1, 0)]),
+             wall([corner(0, 0, 1), corner(0, 1, 1), corner(1, 1, 1), corner(1, 0, 1)]),
+             wall([corner(0, 0, 0), corner(1, 0, 0), corner(1, 1, 0), corner(0, 1, 0)])]
+    faces = [{"vertices": f, "material": "mirror"} for f in faces]
+    vfov = math.degrees(2 * math.atan(size / 2 * ulps * 2.0**-23))
+    cell = {"camera": {"position": [0.1234, -0.2345, 0.3456], "look_at": [hi, hi, -0.3],
+                       "up": [0, 1, 0], "vfov": vfov},
+            "background": [1, 1, 1],
+            "materials": {"mirror": {"type": "mirror", "albedo": [1, 1, 1]}}}
+    if kind == "triangles":
+        cell["triangles"] = as_triangles(faces)
+    else:
+        cell["quads"] = faces
+    return scenes.transformed(cell, rotation([0.3, 1.0, 0.2], 23.7), offset=[0.37, -0.21, 0.11])
+
+
+@pytest.mark.parametrize("kind", ["quads", "triangles"])
+def test_a_ceiling_inside_rising_walls_traps_every_path(renderer, tmp_path, kind):
+    """The loader cuts each wall along the ceiling's edge (common/host/t_junctions.h), and a
+    mirror path that meets the cut steps off it to the side it came from (triangle.h's
+    step_off_cut_edge). Before, paths aimed at the joint hit the wall just above the ceiling
+    and left through the open top: 2 pixels of 576 saw the background in float, for quads and
+    for triangles (none in double, whose rounding is far below a pixel of this view:
+    tests/unit/test_t_junctions.cpp aims at the joint within double's rounding)."""
+    image = enclosure_image(renderer, ceiling_inside_rising_walls(kind), tmp_path, 64,
+                            width=24, height=24, spp=64)
+    assert not image.any(), f"{int((image > 0).any(axis=2).sum())} pixels see the background"
+
+
 @pytest.mark.parametrize("bounces", [8, 16, 64])
 def test_mirror_sphere_traps_every_path(renderer, tmp_path, bounces):
     image = enclosure_image(renderer, mirror_sphere(), tmp_path, bounces)

@@ -140,7 +140,13 @@ TEST(Triangle, RandomRaysMatchDoubleReference) {
                 const double cos_angle = std::fabs(dot(ray.direction, tri.normal));
                 ASSERT_LT(std::fabs(t - ref) * cos_angle, 2e-6 * (8.0 * scale + ref))
                     << "scale " << scale << " ray " << i;
-                ASSERT_LT(std::fabs(t - ref), 1e-4 * ref) << "scale " << scale << " ray " << i;
+                // Along the ray, t is the plane's distance (num / denom): its error grows as
+                // 1/cos for grazing rays (up to 1.1e-3 of t at cos ~1e-3 here), which slides
+                // the hit point along the surface, not off it (the bound above). Rays steeper
+                // than 6 degrees: within 1e-4 (measured: 1.7e-5 at most).
+                if (cos_angle > 0.1) {
+                    ASSERT_LT(std::fabs(t - ref), 1e-4 * ref) << "scale " << scale << " ray " << i;
+                }
             } else if (clearly_outside) {
                 ASSERT_EQ(t, FLT_MAX) << "scale " << scale << " ray " << i;
             }
@@ -352,6 +358,46 @@ TEST(Triangle, WatertightFanAroundVertex) {
             EXPECT_EQ(leaks, 0) << "scale " << scale << " lift " << lift;
         }
     }
+}
+
+// The needles of a fan (10,000 triangles around a disk's centre, aspect 1,600), hit by rays
+// from a point above the disk and off its centre: every hit point lies within the ray offset
+// of the disk's plane (ray.h), so the next ray, offset toward the ray's side, starts in front
+// of the disk. Woop's barycentric distance put hit points up to 4.1 offsets off the plane here
+// (some under the surface, whose shadow rays then hit the disk: tests/labs/test_extremes.py);
+// the plane's distance, which intersect_triangle returns, 0.008.
+TEST(Triangle, NeedleHitsStayWithinTheOffset) {
+    const int count = 10000;
+    const float radius = 8.0f;
+    std::mt19937 gen(12);
+    std::uniform_real_distribution<float> u01(0.0f, 1.0f);
+    auto rim = [&](int k) {
+        const double phi = 2.0 * 3.14159265358979 * (k % count) / count;
+        return Vec3(float(radius * std::cos(phi)), 0.0f, float(radius * std::sin(phi)));
+    };
+    int hits = 0;
+    double worst = 0.0;
+    for (int i = 0; i < 20000; ++i) {
+        const int k = int(u01(gen) * count) % count;
+        const Triangle needle = make_triangle(Vec3(0.0f), rim(k + 1), rim(k), 0);
+        float a = u01(gen), b = u01(gen);  // a point inside, clear of the edges
+        if (a + b > 1) {
+            a = 1 - a;
+            b = 1 - b;
+        }
+        a = 0.02f + 0.96f * a;
+        b = 0.02f + 0.96f * b * (1 - a);
+        const Vec3 target = needle.v0 + (needle.v1 - needle.v0) * a + (needle.v2 - needle.v0) * b;
+        const Vec3 origin(0.3f * u01(gen), 1.0f, 0.3f * u01(gen));
+        const Ray ray{origin, normalize(target - origin)};
+        const float t = hit(ray, needle);
+        if (t == FLT_MAX) continue;  // rounding at an edge: the neighbour takes the ray
+        ++hits;
+        const Vec3 p = ray.at(t);
+        worst = std::max(worst, std::fabs(double(p.y)) / ray_offset(p, t, needle.extent));
+    }
+    EXPECT_GT(hits, 19000);
+    EXPECT_LT(worst, 0.5) << "a hit point lies " << worst << " ray offsets off the plane";
 }
 
 // A ray leaving a triangle from offset_ray_origin does not hit that triangle again, whether

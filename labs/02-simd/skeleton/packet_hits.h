@@ -49,7 +49,8 @@ RT_PACKET_INLINE F intersect_triangle(const RayPacket<F>& ray, const RayShearN<F
     // (permuted(tri.v0, shear.kx) - shear.origin_k.x, ...), the shear (shear.sx ...),
     // the three edge functions as a product minus a product (never fused), the
     // double-precision redo for lanes where one of them is zero, the sign tests, det,
-    // and t_scaled / det in the lanes that hit. Every other lane returns its t_max.
+    // and the plane's t = num / denom in the lanes that hit (det != 0, t in (0, t_max)).
+    // Every other lane returns its t_max.
     // Until then: lane 0 only, with the scalar test, so 7 of every 8 samples miss
     // every triangle.
     (void)candidates;
