@@ -216,10 +216,11 @@ test-unit:
 	$(BUILD)/unit_tests --gtest_brief=1
 
 # With pytest-xdist (make deps) on a machine of several cores, the tests run on every core, a
-# test file to a process, all but those marked `timed` (they measure speedups and the machine's
-# capacity, so they need the cores to themselves: tests/conftest.py), which run after, alone.
+# test file to a process (a group: tests/conftest.py), all but those marked `timed` (they
+# measure speedups and the machine's capacity, so they need the cores to themselves), which run
+# after, alone.
 XDIST := $(shell [ $(JOBS) -gt 1 ] && $(PYTHON) -c 'import xdist' 2>/dev/null && echo yes)
-PYTEST_PASSES := $(if $(XDIST),"-n $(JOBS) --dist loadfile -m 'not timed'" "-m timed","")
+PYTEST_PASSES := $(if $(XDIST),"-n $(JOBS) --dist loadgroup -m 'not timed'" "-m timed","")
 test-labs:
 	@$(TEST_ENV) $(MAKE) --no-print-directory $(PARALLEL) labs
 	@for pass in $(PYTEST_PASSES); do \
