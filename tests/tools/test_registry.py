@@ -167,7 +167,7 @@ def test_the_readers_agree_with_the_registry():
     assert any(i.id == "structure-of-arrays" for i in grade.RUBRICS["07"])
     assert not any(i.id == "structure-of-arrays" for i in grade.RUBRICS["06"])
     assert grade.GPU_TIMED_SPP.keys() == gpu.GPU_LABS
-    assert {"05": 7936, "06": 2816, "07": 3072}.items() <= grade.GPU_TIMED_SPP.items()
+    assert {"05": 10496, "06": 2816, "07": 3072}.items() <= grade.GPU_TIMED_SPP.items()
     readme = release.student_readme("02", registry.folders(), ["lab02-ref"])
     assert "make lab02a lab02" in readme and registry.lab("02").try_command in readme
 
@@ -206,7 +206,7 @@ def first_entry_with(old: str, new: str) -> str:
     (first_entry_with('folder = "01-serial"', 'folder = "1-serial"'), "two digits"),
     (first_entry_with('handin = ["path_steps.h", "render.cpp"]\n', ""), "needs handin"),
     (first_entry_with('number = "01"', 'number = "01"\ncolour = "red"'), "unknown field"),
-    (first_entry_with("timed_spp = 7936\n", ""), "timed_spp"),
+    (first_entry_with("timed_spp = 10496\n", ""), "timed_spp"),
     (first_entry_with("speed_bar = 0.56", "speed_bar = 1.5"), "speed_bar"),
     (first_entry_with('number = "01"', 'number = "01"\nspeed_bar = 0.5'), "speed_bar"),
     ("[[lab]\n", "not TOML"),
