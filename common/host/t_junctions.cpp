@@ -689,7 +689,11 @@ bool cut_at_inner_edges(std::vector<Piece>& pieces, const WrittenPoint& centre) 
     };
     std::vector<std::vector<Piece>> parts(pieces.size());
     bool cut = false;
-    for (const auto& [g, k] : borders) {
+    for (const auto& border : borders) {
+        // Named copies, not a structured binding: a lambda below uses them, and clang before
+        // 16 (the race check's compiler) cannot capture a structured binding.
+        const auto g = border.first;
+        const auto k = border.second;
         const Piece& owner = pieces[g];
         const int next = (k + 1) % owner.corners;
         const Vec3 p = owner.rendered[k], q = owner.rendered[next];

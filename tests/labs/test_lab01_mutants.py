@@ -90,11 +90,10 @@ MUTANTS = {
                           "float r = 0.0f, g = 0.0f, b = 0.0f;", ["millions"]),
     "no offset at all": ("ray.h", "return p + n * (scale * kRelativeOffset);",
                          "return p + n * (0.0f * scale);", ["cornell"]),
-    "offset ignores the primitive's extent": (
-        "ray.h", "const real scale = max_component(abs(p)) + distance_travelled + extent;",
-        "const real scale = max_component(abs(p)) + distance_travelled + 0.0f * extent;",
-        ["large"]),
 }
+# Not a mutant any more: the offset without the primitive's extent. Since triangles take their
+# hit distance from their plane (triangle.h), no kind's hit error grows with coordinates larger
+# than the hit point's in the large-primitive scenes, and check_large_primitives passes it.
 
 
 def build_mutant(name: str, workdir: pathlib.Path) -> pathlib.Path:
