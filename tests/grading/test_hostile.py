@@ -493,11 +493,13 @@ def test_serial_lab03_beside_a_cpu_burner_earns_nothing_and_is_final(tmp_path):
                                         "serial: the timed runs used at most")), describe(results)
 
 
+@pytest.mark.timed
 def test_the_lab03_reference_beside_a_cpu_burner_is_not_called_serial(tmp_path):
     """The lab 03 reference beside the same burner: its work is shared among its threads, so
     it is never called serial; its speed either earns points or waits for a regrade, never a
     final 0, and its correctness (bits and golden images, 60 points) counts once a speedup is
-    measured, else waits with the speed, shown apart."""
+    measured, else waits with the speed, shown apart: together everything a binary can earn
+    (the race check needs the sources' ThreadSanitizer build, so it is not graded here)."""
     from labkit.harness import build
     reference, = build("lab03-ref")
     with burning_one_core():
@@ -506,7 +508,10 @@ def test_the_lab03_reference_beside_a_cpu_burner_is_not_called_serial(tmp_path):
     assert not speed["output"].startswith("serial"), describe(results)
     assert speed["score"] > 0 or speed["extra_data"]["regrade"], describe(results)
     shown_apart = sum(t["extra_data"]["provisional"] for t in results["tests"])
-    assert results["score"] >= 60 or results["score"] + shown_apart >= 100, describe(results)
+    gradable = sum(t["max_score"] for t in results["tests"]
+                   if not t["output"].startswith("not graded"))
+    assert gradable >= 90, describe(results)
+    assert results["score"] >= 60 or results["score"] + shown_apart >= gradable, describe(results)
 
 
 def noisy_golden(spp: int):
