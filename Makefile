@@ -220,7 +220,7 @@ test-unit:
 # measure speedups and the machine's capacity, so they need the cores to themselves), which run
 # after, alone (a pass that finds no test of its kind, as in a release that has none, passes).
 XDIST := $(shell [ $(JOBS) -gt 1 ] && $(PYTHON) -c 'import xdist' 2>/dev/null && echo yes)
-PYTEST_PASSES := $(if $(XDIST),"-n $(JOBS) --dist loadgroup -m 'not timed'" "-m timed","")
+PYTEST_PASSES := $(if $(XDIST),"-n $(JOBS) -m 'not timed'" "-m timed","")
 test-labs:
 	@$(TEST_ENV) $(MAKE) --no-print-directory $(PARALLEL) labs
 	@for pass in $(PYTEST_PASSES); do \
