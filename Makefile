@@ -295,8 +295,8 @@ check-nvcc:
 	@for h in $(CORE_HEADERS); do \
 	    printf '#include <%s>\n' $$h > $(BUILD)/cuda/header_$${h%.h}.cu; \
 	    for precision in "" -DRT_DOUBLE; do \
-	        $(NVCC) -std=c++17 -Icommon/core -arch=sm_90 -Xcompiler -Wall,-Werror -Werror all-warnings \
-	            $$precision -c $(BUILD)/cuda/header_$${h%.h}.cu -o $(BUILD)/cuda/header_$${h%.h}.o || exit 1; \
+	        $(NVCC) -std=c++17 -Icommon/core -arch=sm_90 -Werror all-warnings \
+	            $$precision -ptx $(BUILD)/cuda/header_$${h%.h}.cu -o $(BUILD)/cuda/header_$${h%.h}.ptx || exit 1; \
 	    done; \
 	done
 	$(NVCC) -std=c++17 -O3 -Icommon/core -arch=sm_90 -Xcompiler -Wall,-Werror -Werror all-warnings \
