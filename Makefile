@@ -204,12 +204,14 @@ PARALLEL  = $(if $(findstring jobserver,$(MAKEFLAGS)),,-j$(JOBS))
 # The tests compile the same sources many times over: the repository, then each release, copy
 # of the repository and students' tree they make. So the test targets compile through ccache
 # where it is installed (make deps installs it): its compiler links first on PATH, its cache in
-# build/ccache (make clean removes it); nvcc through it too (NVCC, which the Makefile's `?=`
-# takes; without the working folder in the key, the copies elsewhere find what it compiled).
+# build/ccache (make clean removes it), or the one CCACHE_DIR names already (the tests' own
+# `make test` in a release they made: the release then finds what the course repository
+# compiled); nvcc through it too (NVCC, which the Makefile's `?=` takes; without the working
+# folder in the key, the copies elsewhere find what it compiled).
 # Only what the tests start sees it; the grader's sandbox builds a hand-in with a PATH and an
 # nvcc of its own, never through a cache a run could write.
 CCACHE_LINKS := $(wildcard /usr/lib/ccache)
-TEST_ENV := $(if $(CCACHE_LINKS),PATH="$(CCACHE_LINKS):$$PATH" CCACHE_DIR="$(CURDIR)/$(BUILD)/ccache" \
+TEST_ENV := $(if $(CCACHE_LINKS),PATH="$(CCACHE_LINKS):$$PATH" CCACHE_DIR="$${CCACHE_DIR:-$(CURDIR)/$(BUILD)/ccache}" \
     CCACHE_NOHASHDIR=1 $(if $(shell command -v nvcc),NVCC="ccache nvcc"))
 test-unit:
 	@$(TEST_ENV) $(MAKE) --no-print-directory $(PARALLEL) $(BUILD)/unit_tests
