@@ -116,7 +116,7 @@ cuda-variant: $(COMMON_OBJ)
 # Each shared GPU header compiles alone, for sm_90 with warnings as errors: it includes what
 # it uses, whichever file includes it first (make check-nvcc does the same for common/core).
 # To PTX: nvcc's front end reads the whole file and its device code is compiled; the host
-# compiler's pass, a quarter of the time, adds nothing the labs' own builds do not check.
+# compiler's pass, most of a full compile's time, adds nothing the labs' own builds do not check.
 GPU_HEADERS := $(wildcard common/cuda/*.h common/cuda/*.cuh common/wavefront/*.cuh \
                           bench/gpu/*.h bench/gpu/*.cuh)
 $(BUILD)/gpu-headers/%.ptx: %
