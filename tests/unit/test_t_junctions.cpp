@@ -167,62 +167,53 @@ Room ceiling_inside_rising_walls(CellKind kind) {
     return room;
 }
 
-// Paths from random points inside the cell toward points of the ceiling's edges, traced
-// through the mirrors for 64 bounces: the number that reach the background (the cell is
-// closed, so none should).
-int escaping_paths(const Room& room, int paths_per_line) {
-    const Scene scene = centre_scene(parse_scene(room.json(), "cell.json"));
-    const WrittenPoint centre = centring_centre(parse_scene(room.json(), "cell.json"));
-    const auto rendered = [&](Point p) {
-        p = room.placed(p);
-        return moved_to_centre({p[0], p[1], p[2]}, centre);
-    };
-    std::mt19937 gen(11);
-    std::uniform_real_distribution<double> inner(0.05, 0.95), along(0.0, 1.0);
-    int escaped = 0;
-    for (const auto& line : room.junctions) {
-        const Vec3 a = rendered(line[0]), b = rendered(line[1]);
-        for (int i = 0; i < paths_per_line; ++i) {
-            const Point inside{kX0 + kWidth * inner(gen), kY0 + kHeight * inner(gen),
-                               kZ0 + (kZ1 - kZ0) * inner(gen)};
-            const Vec3 target = a + (b - a) * static_cast<real>(along(gen));
-            const Vec3 origin = rendered(inside);
-            const Ray ray{origin, normalize(target - origin)};
-            escaped += !is_black(trace_path(scene.view(), ray, SampleStream(1, 2, 3), 64));
-        }
-    }
-    return escaped;
-}
-
-// Rays from random points inside the room to points of its junction lines (the rendered
-// points: the written ones moved as centring moves them, rounded once), ends included; the
-// number that hit nothing.
-int escaping_rays(const Room& room, int rays_per_line) {
-    const Scene loaded = parse_scene(room.json(), "room.json");
-    EXPECT_GT(loaded.t_junction_pieces, 0);
+// Rays from random points inside the room toward points of its junction lines (the rendered
+// points: the written ones moved as centring moves them, rounded once), `per_line` to a line,
+// the first two to its ends where `ends`; the number `escapes(scene, ray)` says got out.
+template <class Escapes>
+int count_escaping(const Room& room, const Scene& loaded, int per_line, unsigned seed, bool ends,
+                   Escapes escapes) {
     const WrittenPoint centre = centring_centre(loaded);
     const Scene scene = centre_scene(loaded);
     const auto rendered = [&](Point p) {
         p = room.placed(p);
         return moved_to_centre({p[0], p[1], p[2]}, centre);
     };
-    std::mt19937 gen(7);
+    std::mt19937 gen(seed);
     std::uniform_real_distribution<double> inner(0.05, 0.95), along(0.0, 1.0);
     int escaped = 0;
     for (const auto& line : room.junctions) {
         const Vec3 a = rendered(line[0]), b = rendered(line[1]);
-        for (int i = 0; i < rays_per_line; ++i) {
+        for (int i = 0; i < per_line; ++i) {
             const Point inside{kX0 + kWidth * inner(gen), kY0 + kHeight * inner(gen),
                                kZ0 + (kZ1 - kZ0) * inner(gen)};
             // A point of the segment in `real`: on it, or beside it by rounding only.
-            const real s = i == 0 ? real(0) : (i == 1 ? real(1) : static_cast<real>(along(gen)));
+            const real s = ends && i < 2 ? real(i) : static_cast<real>(along(gen));
             const Vec3 target = a + (b - a) * s;
             const Vec3 origin = rendered(inside);
-            const Ray ray{origin, normalize(target - origin)};
-            escaped += !closest_hit(scene.view(), ray).found();
+            escaped += escapes(scene, Ray{origin, normalize(target - origin)});
         }
     }
     return escaped;
+}
+
+// Paths toward points of the cell's ceiling edges, traced through the mirrors for 64 bounces:
+// the number that reach the background (the cell is closed, so none should).
+int escaping_paths(const Room& room, int paths_per_line) {
+    return count_escaping(
+        room, parse_scene(room.json(), "cell.json"), paths_per_line, 11, false,
+        [](const Scene& scene, const Ray& ray) {
+            return !is_black(trace_path(scene.view(), ray, SampleStream(1, 2, 3), 64));
+        });
+}
+
+// Rays toward points of the room's junction lines, ends included: the number that hit nothing.
+int escaping_rays(const Room& room, int rays_per_line) {
+    const Scene loaded = parse_scene(room.json(), "room.json");
+    EXPECT_GT(loaded.t_junction_pieces, 0);
+    return count_escaping(
+        room, loaded, rays_per_line, 7, true,
+        [](const Scene& scene, const Ray& ray) { return !closest_hit(scene.view(), ray).found(); });
 }
 
 }  // namespace
