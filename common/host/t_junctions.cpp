@@ -682,9 +682,9 @@ bool cut_at_inner_edges(std::vector<Piece>& pieces, const WrittenPoint& centre) 
     if (borders.empty()) return false;  // a closed mesh: nothing to look up
     FaceIndex faces(pieces);
     std::vector<FacePlane> planes(pieces.size());
-    std::vector<bool> planed(pieces.size(), false), planned(pieces.size(), false);
+    std::vector<bool> has_plane(pieces.size(), false), is_cut(pieces.size(), false);
     const auto plane = [&](size_t i) -> const FacePlane& {
-        if (!planed[i]) planes[i] = face_plane(pieces[i]), planed[i] = true;
+        if (!has_plane[i]) planes[i] = face_plane(pieces[i]), has_plane[i] = true;
         return planes[i];
     };
     std::vector<std::vector<Piece>> parts(pieces.size());
@@ -699,7 +699,7 @@ bool cut_at_inner_edges(std::vector<Piece>& pieces, const WrittenPoint& centre) 
         const Vec3 p = owner.rendered[k], q = owner.rendered[next];
         const Point pw{p, owner.written[k], false}, qw{q, owner.written[next], false};
         faces.near_box(p, q, [&](size_t f) {
-            if (f == g || planned[f] || flat(pieces[f]) || !plane(f).ok) return;
+            if (f == g || is_cut[f] || flat(pieces[f]) || !plane(f).ok) return;
             // Pieces of one plane that overlap (a bow tie's halves) are left as they are:
             // the faces to close are those that meet at an angle.
             if (plane(g).ok && std::fabs(planes[f].normal[0] * planes[g].normal[0] +
@@ -711,14 +711,14 @@ bool cut_at_inner_edges(std::vector<Piece>& pieces, const WrittenPoint& centre) 
             std::vector<Piece> split = cut_along(pieces[f], chord, pw, qw, centre);
             if (split.empty()) return;
             parts[f] = std::move(split);
-            planned[f] = true;
+            is_cut[f] = true;
             cut = true;
         });
     }
     if (!cut) return false;
     std::vector<Piece> next;
     for (size_t i = 0; i < pieces.size(); ++i) {
-        if (planned[i]) next.insert(next.end(), parts[i].begin(), parts[i].end());
+        if (is_cut[i]) next.insert(next.end(), parts[i].begin(), parts[i].end());
         else next.push_back(pieces[i]);
     }
     pieces = std::move(next);
@@ -729,13 +729,7 @@ bool cut_at_inner_edges(std::vector<Piece>& pieces, const WrittenPoint& centre) 
 // the scene's current vertices lie on its edges, then the rectangles that now meet triangles or
 // quads demoted. Returns whether anything changed.
 bool split_once(std::vector<Piece>& pieces, const WrittenPoint& centre) {
-    bool changed = cut_at_inner_edges(pieces, centre);
-    if (changed) {
-        for (Piece& piece : pieces) {
-            for (int k = 0; k < piece.corners; ++k)
-                piece.rendered[k] = moved_to_centre(piece.written[k], centre);
-        }
-    }
+    bool changed = cut_at_inner_edges(pieces, centre);  // its new points come rendered
     const PointIndex index(pieces);
     std::vector<Piece> next;
     for (const Piece& piece : pieces) {
