@@ -481,8 +481,8 @@ Chord chord_through(const Piece& face, const FacePlane& f, Vec3 p, Vec3 q) {
 // The face's parts on either side of the chord, each in the face's winding: a point of the
 // cut is the edge's own end where it lies within 32 ulps of one, else the face's corner where
 // it lies within 32 ulps of one, else a new point on the line written in double. (Within 8,
-// the double build kept a second point 2 ulps from a ceiling's corner, whose slivers of
-// triangles let 60 of 4,000 paths out of a mirror cell.)
+// the double build kept a second point 2 ulps from a ceiling's corner, and the slivers of
+// triangles beside it let paths out of a mirror cell.)
 std::vector<Piece> cut_along(const Piece& face, const Chord& chord, const Point& p, const Point& q,
                              const WrittenPoint& centre) {
     Point ends[2];

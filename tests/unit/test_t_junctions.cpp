@@ -271,8 +271,8 @@ TEST(TJunctions, ALoadedSceneHasNoneLeftAndOthersKeepEveryBit) {
 // cuts each wall along the ceiling's edge line, so the ceiling and the wall's parts share that
 // edge end to end, and marks it a cut edge on the wall's parts: a path that the rounding lets
 // hit the part above the ceiling steps off the edge to the side it came from (triangle.h's
-// step_off_cut_edge). Before: 366, 1369 and 1195 of 4000 paths left the cell in float (walls
-// as rectangles, convex quads, triangles), 460, 980 and 1007 in double.
+// step_off_cut_edge). Before, hundreds of the paths left the cell in either precision, the
+// walls as rectangles, convex quads or triangles (docs/extremes.md).
 TEST(TJunctions, ACeilingInsideRisingWallsLetsNoPathOut) {
     for (CellKind kind : {CellKind::kRects, CellKind::kConvexQuads, CellKind::kTriangles}) {
         EXPECT_EQ(escaping_paths(ceiling_inside_rising_walls(kind), 1000), 0)

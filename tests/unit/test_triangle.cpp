@@ -141,9 +141,8 @@ TEST(Triangle, RandomRaysMatchDoubleReference) {
                 ASSERT_LT(std::fabs(t - ref) * cos_angle, 2e-6 * (8.0 * scale + ref))
                     << "scale " << scale << " ray " << i;
                 // Along the ray, t is the plane's distance (num / denom): its error grows as
-                // 1/cos for grazing rays (up to 1.1e-3 of t at cos ~1e-3 here), which slides
-                // the hit point along the surface, not off it (the bound above). Rays steeper
-                // than 6 degrees: within 1e-4 (measured: 1.7e-5 at most).
+                // 1/cos for grazing rays, which slides the hit point along the surface, not
+                // off it (the bound above). Rays steeper than 6 degrees: within 1e-4.
                 if (cos_angle > 0.1) {
                     ASSERT_LT(std::fabs(t - ref), 1e-4 * ref) << "scale " << scale << " ray " << i;
                 }
@@ -363,9 +362,9 @@ TEST(Triangle, WatertightFanAroundVertex) {
 // The needles of a fan (10,000 triangles around a disk's centre, aspect 1,600), hit by rays
 // from a point above the disk and off its centre: every hit point lies within the ray offset
 // of the disk's plane (ray.h), so the next ray, offset toward the ray's side, starts in front
-// of the disk. Woop's barycentric distance put hit points up to 4.1 offsets off the plane here
+// of the disk. Woop's barycentric distance put hit points several offsets off the plane here
 // (some under the surface, whose shadow rays then hit the disk: tests/labs/test_extremes.py);
-// the plane's distance, which intersect_triangle returns, 0.008.
+// the plane's distance, which intersect_triangle returns, keeps them well within one.
 TEST(Triangle, NeedleHitsStayWithinTheOffset) {
     const int count = 10000;
     const float radius = 8.0f;
