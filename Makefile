@@ -13,7 +13,11 @@ WARN     := -Wall -Wextra -Wpedantic -Wshadow
 ifeq ($(CI),true)
 WARN     += -Werror
 endif
-CXXFLAGS := -std=c++17 $(OPT) $(WARN) -DRT_SOURCE_DIR='"$(CURDIR)"' -MMD -MP
+CXXFLAGS := -std=c++17 $(OPT) $(WARN) -MMD -MP
+# The source tree's location is compiled into one file (cli.cpp's source_tree_path: the default
+# scene, the unit tests' scenes), in every build folder, so that every other object is the same
+# wherever a copy of the tree lies (a release or a copy the tests make reuses them through ccache).
+%/common/host/cli.o: CXXFLAGS += -DRT_SOURCE_DIR='"$(CURDIR)"'
 # common/ in three layers: core/ (the scalar renderer, host and device), host/ (the driver),
 # simd/ (lab 02's AVX2 library, only for the builds that put it on the include path). Shared
 # headers include each other with <...>, so a folder earlier on the include path (a lab's

@@ -54,10 +54,15 @@ CUDA_INCLUDES := -Icommon/cuda
 # include path of the benchmarks only, never of a lab.
 GPU_BENCH_INCLUDES := -Ibench/gpu
 
-$(BUILD)/%.o: %.cu
+# Each object comes with the compiler's resource report of its kernels (ptxas -v: registers,
+# spills and stack per kernel and architecture) in $*.ptxas beside it, which make kernel-report
+# reads; what else nvcc says is shown as usual. (Both files are the one recipe's targets.)
+$(BUILD)/%.o $(BUILD)/%.ptxas: %.cu
 	@mkdir -p $(dir $@)
 	$(NVCC) $(NVCCFLAGS) $(CUDA_ARCH) $(CUDA_VARIANT_FLAGS) $(LAB_INCLUDES) $(CUDA_INCLUDES) \
-	    $(INCLUDES) -MMD -MP -MF $(@:.o=.d) -c $< -o $@
+	    $(INCLUDES) -Xptxas -v -MMD -MP -MF $(BUILD)/$*.d -c $< -o $(BUILD)/$*.o \
+	    2> $(BUILD)/$*.ptxas; status=$$?; \
+	    grep -v -e '^ptxas info' -e ' bytes stack frame, ' $(BUILD)/$*.ptxas >&2; exit $$status
 
 # The exact nvcc command lab objects are built with (tests build the pristine skeleton so).
 print-cuda-build-command:
@@ -71,8 +76,8 @@ define cuda_lab
 CUDA_LAB_FOLDERS += $(2)
 CUDA_SHARED_INCLUDES_$(2) := $(addprefix -I,$(3))
 CUDA_STUDENT_FILES_$(2) := $(4)
-$(BUILD)/labs/$(2)/skeleton/%.o: LAB_INCLUDES = -Ilabs/$(2)/skeleton $(addprefix -I,$(3))
-$(BUILD)/labs/$(2)/solution/%.o: LAB_INCLUDES = -Ilabs/$(2)/solution $(addprefix -I,$(3))
+$(BUILD)/labs/$(2)/skeleton/%: LAB_INCLUDES = -Ilabs/$(2)/skeleton $(addprefix -I,$(3))
+$(BUILD)/labs/$(2)/solution/%: LAB_INCLUDES = -Ilabs/$(2)/solution $(addprefix -I,$(3))
 $(1): $(patsubst %.cu,$(BUILD)/%.o,$(wildcard labs/$(2)/skeleton/*.cu)) $(COMMON_OBJ)
 	$(NVCC) $(CUDA_ARCH) $$^ $$(INTO_TARGET)
 $(1)-ref: $(patsubst %.cu,$(BUILD)/%.o,$(wildcard labs/$(2)/solution/*.cu)) $(COMMON_OBJ)
@@ -139,23 +144,18 @@ check-speed-targets: $(BUILD)/cuda/speed_targets_check
 # The compiler's resource report (ptxas -v) for every kernel of the GPU references (every
 # GPU lab of labs/labs.toml) and lab 05's benchmark (the course report's Table 1 for our
 # kernels), for one architecture: the GPU present, else sm_90. Writes build/kernel-report.md.
-# Each source gets the include path its own build uses.
+# It reads the reports the build wrote beside those objects, so it compiles nothing the build
+# has compiled; the build's architectures include this one unless CUDA_ARCH names others.
 KERNEL_REPORT_ARCH = $(if $(CUDA_GPU_CAPS),sm_$(firstword $(CUDA_GPU_CAPS)),sm_90)
-KERNEL_REPORT_NVCC = $(NVCC) -std=c++17 -O3 -arch=$(KERNEL_REPORT_ARCH) -Xptxas -v
 # A lab whose solution is not here (a student release) is reported from skeleton/: the
 # student's own kernels, compiled without a GPU.
 kernel_report_dir = $(if $(wildcard labs/$(1)/solution),solution,skeleton)
-kernel_report_compile = $(KERNEL_REPORT_NVCC) -Ilabs/$(1)/$(call kernel_report_dir,$(1)) \
-    $(CUDA_SHARED_INCLUDES_$(1)) $(GPU_BENCH_INCLUDES) $(CUDA_INCLUDES) $(INCLUDES) -c labs/$(1)/$(2) \
-    -o $(BUILD)/kernel-report/$(3).o
-kernel-report:
-	@mkdir -p $(BUILD)/kernel-report
-	@{ $(foreach n,$(GPU_LABS),\
-	       $(call kernel_report_compile,$(LAB_FOLDER_$(n)),$(call kernel_report_dir,$(LAB_FOLDER_$(n)))/render.cu,lab$(n)) &&) \
-	   $(if $(wildcard labs/05-cuda-mega/solution),$(call kernel_report_compile,05-cuda-mega,bench.cu,lab05-bench),true); \
-	 } > $(BUILD)/kernel-report/ptxas.log 2>&1 || { cat $(BUILD)/kernel-report/ptxas.log; exit 1; }
-	@$(PYTHON) labs/05-cuda-mega/kernel_report.py $(BUILD)/kernel-report/ptxas.log \
-	    --arch $(KERNEL_REPORT_ARCH) --out $(BUILD)/kernel-report.md
+KERNEL_REPORT_LOGS = $(foreach n,$(GPU_LABS),\
+    $(BUILD)/labs/$(LAB_FOLDER_$(n))/$(call kernel_report_dir,$(LAB_FOLDER_$(n)))/render.ptxas) \
+    $(if $(wildcard labs/05-cuda-mega/solution),$(BUILD)/labs/05-cuda-mega/bench.ptxas)
+kernel-report: $(KERNEL_REPORT_LOGS)
+	@$(PYTHON) labs/05-cuda-mega/kernel_report.py $^ --arch $(KERNEL_REPORT_ARCH) \
+	    --out $(BUILD)/kernel-report.md
 endif
 
 # Without a GPU of one's own: `make grade-gpu` grades lab LAB (`make grade` as here) and

@@ -5,14 +5,14 @@
 #include <string>
 #include <vector>
 
+#include "cli.h"
 #include "path_tracer.h"
 #include "scene_loader.h"
 
 namespace {
 
 const Scene& cornell() {
-    static const Scene scene =
-        load_scene(std::string(RT_SOURCE_DIR) + "/common/scenes/cornell.json");
+    static const Scene scene = load_scene(default_scene_path());
     return scene;
 }
 

@@ -12,9 +12,11 @@
 #define RT_SOURCE_DIR "."
 #endif
 
-std::string default_scene_path() {
-    return std::string(RT_SOURCE_DIR) + "/common/scenes/cornell.json";
+std::string source_tree_path(const std::string& relative) {
+    return std::string(RT_SOURCE_DIR) + "/" + relative;
 }
+
+std::string default_scene_path() { return source_tree_path("common/scenes/cornell.json"); }
 
 static void print_usage(const char* program) {
     std::printf(

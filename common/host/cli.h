@@ -17,6 +17,10 @@ struct Options {
     bool json = false;     // --json: one JSON object as the last line of stdout
 };
 
+// A file of the source tree the binary was built from, by its path there ("common/scenes/
+// cornell.json"): the one place that tree's location is compiled in.
+std::string source_tree_path(const std::string& relative);
+
 // The default scene, found relative to the source tree the binary was built from.
 std::string default_scene_path();
 

@@ -1,11 +1,12 @@
 #!/usr/bin/env python3
 """The compiler's resource report of the CUDA labs' kernels as a table (`make kernel-report`).
 
-Reads the log of `nvcc -Xptxas -v` (registers, stack frame, spills, shared and constant
-memory per kernel) and adds the theoretical occupancy each kernel's registers allow at its
-block size, for the architecture it was compiled for. Needs no GPU.
+Reads logs of `nvcc -Xptxas -v` (registers, stack frame, spills, shared and constant
+memory per kernel and architecture; the build keeps one beside each CUDA object) and lists
+the kernels compiled for one architecture, with the theoretical occupancy each kernel's
+registers allow at its block size there. Needs no GPU.
 
-    kernel_report.py PTXAS.LOG --arch sm_90 [--out REPORT.md] [--json REPORT.json]
+    kernel_report.py PTXAS.LOG... --arch sm_90 [--out REPORT.md] [--json REPORT.json]
 """
 from __future__ import annotations
 
@@ -129,14 +130,20 @@ def short(name: str) -> str:
 
 def main() -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("log")
+    parser.add_argument("logs", nargs="+", metavar="log")
     parser.add_argument("--arch", default="sm_90")
     parser.add_argument("--out")
     parser.add_argument("--json")
     args = parser.parse_args()
-    kernels = parse(open(args.log).read())
+    kernels = [k for log in args.logs for k in parse(open(log).read())]
     if not kernels:
-        print(f"kernel-report: no kernels found in {args.log}", file=sys.stderr)
+        print(f"kernel-report: no kernels found in {' '.join(args.logs)}", file=sys.stderr)
+        return 1
+    found = sorted({k["arch"] for k in kernels})
+    kernels = [k for k in kernels if k["arch"] == args.arch]
+    if not kernels:
+        print(f"kernel-report: the objects hold no {args.arch} code, only {', '.join(found)}: "
+              f"make kernel-report KERNEL_REPORT_ARCH={found[-1]}", file=sys.stderr)
         return 1
     arch = int(args.arch.removeprefix("sm_"))
     seen, rows = set(), []

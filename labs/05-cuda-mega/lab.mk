@@ -38,7 +38,7 @@ lab05-ref: $(BUILD)/twins/lab05-ref-double.o
 
 # The benchmark has its own main; it links the library part of common/host only. It runs the
 # reference kernel (common/cuda/megakernel.cuh) in every shape it measures.
-$(LAB05_BUILD)/bench.o: LAB_INCLUDES = $(GPU_BENCH_INCLUDES)
+$(LAB05_BUILD)/bench.%: LAB_INCLUDES = $(GPU_BENCH_INCLUDES)
 lab05-bench: $(LAB05_BUILD)/bench.o $(LIB_OBJ)
 	$(NVCC) $(CUDA_ARCH) $^ $(INTO_TARGET)
 lab05-bench-fast-math: $(LAB05_BUILD)/fast-math/bench.o $(LIB_OBJ)

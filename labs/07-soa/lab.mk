@@ -7,7 +7,7 @@ LAB07 := labs/07-soa
 ifneq ($(HAVE_NVCC),)
 $(eval $(call cuda_lab,lab07,07-soa,common/wavefront,path_pool_soa.cuh))
 
-$(BUILD)/$(LAB07)/bench.o: LAB_INCLUDES = $(GPU_BENCH_INCLUDES) -Icommon/wavefront
+$(BUILD)/$(LAB07)/bench.%: LAB_INCLUDES = $(GPU_BENCH_INCLUDES) -Icommon/wavefront
 lab07-bench: $(BUILD)/$(LAB07)/bench.o $(LIB_OBJ)
 	$(NVCC) $(CUDA_ARCH) $^ $(INTO_TARGET)
 endif

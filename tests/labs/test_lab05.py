@@ -157,6 +157,31 @@ def test_kernel_report(nvcc):
     assert any("WavefrontConfig<SoaPathPool, global, per block, " in n for n in names), names
 
 
+def test_kernel_report_keeps_one_architecture(tmp_path):
+    """The build's logs hold a kernel once per architecture compiled (a machine without a GPU
+    builds several): the report lists those of the architecture asked for only, and where the
+    objects hold none of it, says which they hold in one line. Made-up logs, so no nvcc."""
+    def entry(name, arch, registers):
+        return (f"ptxas info    : Compiling entry function '{name}' for '{arch}'\n"
+                f"ptxas info    : Function properties for {name}\n"
+                f"    0 bytes stack frame, 0 bytes spill stores, 0 bytes spill loads\n"
+                f"ptxas info    : Used {registers} registers, used 1 barriers, 400 bytes cmem[0]\n")
+    (tmp_path / "a.ptxas").write_text(entry("_Z1fv", "sm_75", 40) + entry("_Z1fv", "sm_90", 56))
+    (tmp_path / "b.ptxas").write_text(entry("_Z1gv", "sm_90", 32))
+    script = str(ROOT / "labs" / LAB / "kernel_report.py")
+    logs = [str(tmp_path / "a.ptxas"), str(tmp_path / "b.ptxas")]
+    p = subprocess.run(["python3", script, *logs, "--arch", "sm_90"], capture_output=True,
+                       text=True)
+    assert p.returncode == 0, p.stderr
+    rows = [ln for ln in p.stdout.splitlines() if ln.startswith("| `")]
+    assert [r.split("|")[1].strip() for r in rows] == ["`f()`", "`g()`"], rows
+    assert rows[0].split("|")[3].strip() == "56", rows
+    p = subprocess.run(["python3", script, *logs, "--arch", "sm_80"], capture_output=True,
+                       text=True)
+    assert p.returncode == 1 and p.stdout == "", p.stdout
+    assert p.stderr.count("\n") == 1 and "sm_75, sm_90" in p.stderr, p.stderr
+
+
 def test_loop_branches_reads_machine_code():
     """labs/05-cuda-mega/loop_branches.py finds a kernel's innermost loops in cuobjdump's
     listing and tells a branch that can split the warp from one that only guards the CALL of

@@ -43,7 +43,7 @@ void expect_bad(std::initializer_list<const char*> args, const std::string& flag
 
 TEST(Cli, Defaults) {
     const Options o = parse({});
-    EXPECT_EQ(o.scene_path, std::string(RT_SOURCE_DIR) + "/common/scenes/cornell.json");
+    EXPECT_EQ(o.scene_path, source_tree_path("common/scenes/cornell.json"));
     EXPECT_EQ(o.scene_path, default_scene_path());
     EXPECT_FALSE(o.width);
     EXPECT_FALSE(o.height);

@@ -8,6 +8,7 @@
 #include <string>
 
 #include "../../common/cuda/general_geometry.h"
+#include <cli.h>
 #include "path_tracer.h"
 #include "scene_centring.h"
 #include "scene_loader.h"
@@ -15,7 +16,7 @@
 namespace {
 
 Scene centred_cornell() {
-    return centre_scene(load_scene(std::string(RT_SOURCE_DIR) + "/common/scenes/cornell.json"));
+    return centre_scene(load_scene(source_tree_path("common/scenes/cornell.json")));
 }
 
 bool same_bits(real a, real b) { return a == b && std::signbit(a) == std::signbit(b); }

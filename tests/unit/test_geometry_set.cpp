@@ -7,12 +7,13 @@
 #include <random>
 #include <string>
 
+#include <cli.h>
 #include "path_tracer.h"
 #include "scene_loader.h"
 
 namespace {
 
-Scene cornell() { return load_scene(std::string(RT_SOURCE_DIR) + "/common/scenes/cornell.json"); }
+Scene cornell() { return load_scene(source_tree_path("common/scenes/cornell.json")); }
 
 }  // namespace
 
@@ -26,7 +27,7 @@ TEST(PrimitiveKinds, KindsOfTheShippedScenes) {
     EXPECT_TRUE(k.fits<BoxGeometry>());
     EXPECT_TRUE(k.fits<AnyGeometry>());
     EXPECT_FALSE((k.fits<Kinds<Sphere, Triangle, ConvexQuad>>()));  // no rectangles
-    const Scene showcase = load_scene(std::string(RT_SOURCE_DIR) + "/common/scenes/showcase.json");
+    const Scene showcase = load_scene(source_tree_path("common/scenes/showcase.json"));
     const GeometryKinds s = geometry_kinds(showcase.view());
     EXPECT_TRUE(s.has<Triangle>());
     EXPECT_FALSE(s.fits<BoxGeometry>());

@@ -6,6 +6,7 @@
 #include <cmath>
 #include <string>
 
+#include <cli.h>
 #include "path_tracer.h"
 #include "scene_loader.h"
 
@@ -392,7 +393,7 @@ TEST(PathTracer, RenderPixelAveragesOverThePixel) {
 // The Cornell box at 1e-4 and 1e5 times its size, with the light scaled by the square: the
 // same random numbers must give the same radiance (no fixed epsilon anywhere).
 TEST(PathTracer, ScaleInvariance) {
-    const Scene base = load_scene(std::string(RT_SOURCE_DIR) + "/common/scenes/cornell.json");
+    const Scene base = load_scene(source_tree_path("common/scenes/cornell.json"));
     RenderSettings rs;
     rs.width = rs.height = 12;
     rs.spp = 16;
@@ -520,7 +521,7 @@ TEST(PathTracer, SphereNormalIsUnitLength) {
 }
 
 TEST(PathTracer, CornellPixelsAreFiniteAndPlausible) {
-    const Scene scene = load_scene(std::string(RT_SOURCE_DIR) + "/common/scenes/cornell.json");
+    const Scene scene = load_scene(source_tree_path("common/scenes/cornell.json"));
     RenderSettings rs;
     rs.width = rs.height = 8;
     rs.spp = 8;

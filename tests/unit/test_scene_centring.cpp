@@ -4,12 +4,13 @@
 
 #include <string>
 
+#include <cli.h>
 #include "scene_centring.h"
 #include "scene_loader.h"
 
 namespace {
 
-Scene cornell() { return load_scene(std::string(RT_SOURCE_DIR) + "/common/scenes/cornell.json"); }
+Scene cornell() { return load_scene(source_tree_path("common/scenes/cornell.json")); }
 
 }  // namespace
 

@@ -15,6 +15,7 @@
 #include <string>
 #include <vector>
 
+#include <cli.h>
 #include "errors.h"
 #include "json_with_positions.h"
 #include "scene_centring.h"
@@ -98,7 +99,7 @@ const std::string kGoodSphere = "\"center\": [0, 0, 0], \"radius\": 1, \"materia
 // ---- valid scenes ------------------------------------------------------------------------
 
 TEST(SceneLoader, CornellLoads) {
-    const Scene s = load_scene(std::string(RT_SOURCE_DIR) + "/common/scenes/cornell.json");
+    const Scene s = load_scene(source_tree_path("common/scenes/cornell.json"));
     EXPECT_EQ(s.of<Sphere>().size(), 1u);
     EXPECT_EQ(s.of<Triangle>().size(), 0u);
     EXPECT_EQ(s.of<ConvexQuad>().size(), 0u);
@@ -137,7 +138,7 @@ TEST(SceneLoader, CornellLoads) {
 }
 
 TEST(SceneLoader, EveryShippedSceneLoads) {
-    const std::string dir = std::string(RT_SOURCE_DIR) + "/common/scenes";
+    const std::string dir = source_tree_path("common/scenes");
     int count = 0;
     for (const auto& entry : std::filesystem::directory_iterator(dir)) {
         if (entry.path().extension() != ".json") continue;
@@ -148,7 +149,7 @@ TEST(SceneLoader, EveryShippedSceneLoads) {
 }
 
 TEST(SceneLoader, MissingFileIsAnInputErrorNamingIt) {
-    const std::string path = std::string(RT_SOURCE_DIR) + "/no/such/scene.json";
+    const std::string path = source_tree_path("no/such/scene.json");
     try {
         load_scene(path);
         FAIL() << "no error";
@@ -395,7 +396,7 @@ TEST(SceneLoader, QuadAsTwoTrianglesKeepsItsHalves) {
 }
 
 TEST(SceneLoader, ViewMirrorsTheArrays) {
-    const Scene s = load_scene(std::string(RT_SOURCE_DIR) + "/common/scenes/cornell.json");
+    const Scene s = load_scene(source_tree_path("common/scenes/cornell.json"));
     const SceneView v = s.view();
     EXPECT_EQ(v.of<Sphere>().items, s.of<Sphere>().data());
     EXPECT_EQ(v.of<Sphere>().count, 1);

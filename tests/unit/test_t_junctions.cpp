@@ -15,6 +15,7 @@
 #include <string>
 #include <vector>
 
+#include <cli.h>
 #include <path_tracer.h>
 #include <scene_centring.h>
 #include <scene_loader.h>
@@ -247,8 +248,7 @@ TEST(TJunctions, ALoadedSceneHasNoneLeftAndOthersKeepEveryBit) {
         parse_scene(rectangle_floor_on_convex_quads().json(), "b"),
         parse_scene(two_triangles_overlapping_along_an_edge().json(), "c")};
     for (const char* name : {"cornell", "showcase"}) {
-        scenes.push_back(
-            load_scene(std::string(RT_SOURCE_DIR) + "/common/scenes/" + name + ".json"));
+        scenes.push_back(load_scene(source_tree_path("common/scenes/") + name + ".json"));
         EXPECT_EQ(scenes.back().t_junction_pieces, 0) << name;
     }
     for (const Scene& loaded : scenes) {
