@@ -22,8 +22,9 @@
 # newer GPUs compile when they load it. Under CI (CI=true) without a GPU, where nothing runs
 # the binaries, only the ends of that range: compute_75 PTX (the compiler's front end rejects
 # there what the oldest GPU lacks) and sm_90 machine code (what the kernel report and the
-# tests read); the three between add build minutes, not checks. Set CUDA_ARCH on the command
-# line to choose others, e.g. CUDA_ARCH='-arch=sm_90'.
+# tests read); the three between add build minutes, not checks; the benchmarks and variants
+# there get sm_90 alone (CUDA_TOOL_ARCH). Set CUDA_ARCH on the command line to choose others,
+# e.g. CUDA_ARCH='-arch=sm_90'.
 # Without nvcc every CUDA target says so in one line and fails; nothing else is affected.
 
 NVCC ?= nvcc
@@ -39,6 +40,13 @@ CUDA_CI_ARCH := -gencode arch=compute_75,code=compute_75 -gencode arch=compute_9
 CUDA_NO_GPU_ARCH := $(if $(filter true,$(CI)),$(CUDA_CI_ARCH),$(CUDA_FALLBACK_ARCH))
 CUDA_ARCH ?= $(if $(CUDA_GPU_CAPS),$(foreach c,$(CUDA_GPU_CAPS),\
     -gencode arch=compute_$(c),code=sm_$(c)),$(CUDA_NO_GPU_ARCH))
+# The benchmarks and lab 05's flag and precision variants are the labs' shared code under
+# other flags: under CI without a GPU, where nothing runs them, sm_90 machine code alone (what
+# the kernel report reads; the labs' own binaries put that code through compute_75's front
+# end); everywhere else the labs' architectures. An object's architectures: OBJECT_CUDA_ARCH.
+CUDA_TOOL_ARCH = $(if $(filter-out $(CUDA_CI_ARCH),$(CUDA_ARCH)),$(CUDA_ARCH),\
+    -gencode arch=compute_90,code=sm_90)
+OBJECT_CUDA_ARCH = $(CUDA_ARCH)
 
 # Warnings as errors under CI, for our host code (-Xcompiler) and for nvcc's own.
 CUDA_WARN := -Xcompiler -Wall
@@ -59,8 +67,8 @@ GPU_BENCH_INCLUDES := -Ibench/gpu
 # reads; what else nvcc says is shown as usual. (Both files are the one recipe's targets.)
 $(BUILD)/%.o $(BUILD)/%.ptxas: %.cu
 	@mkdir -p $(dir $@)
-	$(NVCC) $(NVCCFLAGS) $(CUDA_ARCH) $(CUDA_VARIANT_FLAGS) $(LAB_INCLUDES) $(CUDA_INCLUDES) \
-	    $(INCLUDES) -Xptxas -v -MMD -MP -MF $(BUILD)/$*.d -c $< -o $(BUILD)/$*.o \
+	$(NVCC) $(NVCCFLAGS) $(OBJECT_CUDA_ARCH) $(CUDA_VARIANT_FLAGS) $(LAB_INCLUDES) \
+	    $(CUDA_INCLUDES) $(INCLUDES) -Xptxas -v -MMD -MP -MF $(BUILD)/$*.d -c $< -o $(BUILD)/$*.o \
 	    2> $(BUILD)/$*.ptxas; status=$$?; \
 	    grep -v -e '^ptxas info' -e ' bytes stack frame, ' $(BUILD)/$*.ptxas >&2; exit $$status
 

@@ -16,7 +16,7 @@ $(eval $(call cuda_lab,lab05,05-cuda-mega,,render_kernel.cuh))
 define lab05_variant_object
 $(LAB05_BUILD)/$(1)/$(basename $(notdir $(2))).o: $(2)
 	@mkdir -p $$(dir $$@)
-	$$(NVCC) $$(NVCCFLAGS) $$(CUDA_ARCH) $(3) -I$(LAB05)/solution $$(CUDA_INCLUDES) \
+	$$(NVCC) $$(NVCCFLAGS) $$(CUDA_TOOL_ARCH) $(3) -I$(LAB05)/solution $$(CUDA_INCLUDES) \
 	    $$(INCLUDES) -MMD -MP -MF $$(@:.o=.d) -c $$< -o $$@
 endef
 # nvcc defines no macro for --use_fast_math; RT_LAB05_FAST_MATH tells the sources (the
@@ -27,20 +27,21 @@ $(eval $(call lab05_variant_object,no-fma,$(LAB05)/solution/render.cu,--fmad=fal
 $(eval $(call lab05_variant_object,double,$(LAB05)/solution/render.cu,-DRT_DOUBLE))
 $(eval $(call lab05_variant_object,fast-math,$(LAB05)/bench.cu,$(LAB05_FAST_MATH) $(GPU_BENCH_INCLUDES)))
 lab05-ref-fast-math: $(LAB05_BUILD)/fast-math/render.o $(COMMON_OBJ)
-	$(NVCC) $(CUDA_ARCH) $^ $(INTO_TARGET)
+	$(NVCC) $(CUDA_TOOL_ARCH) $^ $(INTO_TARGET)
 lab05-ref-no-fma: $(LAB05_BUILD)/no-fma/render.o $(COMMON_OBJ)
-	$(NVCC) $(CUDA_ARCH) $^ $(INTO_TARGET)
+	$(NVCC) $(CUDA_TOOL_ARCH) $^ $(INTO_TARGET)
 # The reference in double: linked with the double build's host objects (Makefile).
 lab05-ref-double: $(LAB05_BUILD)/double/render.o $(DOUBLE_COMMON_OBJ)
-	$(NVCC) $(CUDA_ARCH) $^ $(INTO_TARGET)
+	$(NVCC) $(CUDA_TOOL_ARCH) $^ $(INTO_TARGET)
 # lab05-ref carries it and hands it a scene float cannot place (common/host/double_twin.h).
 lab05-ref: $(BUILD)/twins/lab05-ref-double.o
 
 # The benchmark has its own main; it links the library part of common/host only. It runs the
 # reference kernel (common/cuda/megakernel.cuh) in every shape it measures.
 $(LAB05_BUILD)/bench.%: LAB_INCLUDES = $(GPU_BENCH_INCLUDES)
+$(LAB05_BUILD)/bench.%: OBJECT_CUDA_ARCH = $(CUDA_TOOL_ARCH)
 lab05-bench: $(LAB05_BUILD)/bench.o $(LIB_OBJ)
-	$(NVCC) $(CUDA_ARCH) $^ $(INTO_TARGET)
+	$(NVCC) $(CUDA_TOOL_ARCH) $^ $(INTO_TARGET)
 lab05-bench-fast-math: $(LAB05_BUILD)/fast-math/bench.o $(LIB_OBJ)
-	$(NVCC) $(CUDA_ARCH) $^ $(INTO_TARGET)
+	$(NVCC) $(CUDA_TOOL_ARCH) $^ $(INTO_TARGET)
 endif

@@ -10,6 +10,7 @@ $(eval $(call cuda_lab,lab06,06-cuda-split,common/wavefront,queue_reserve.cuh st
 # The benchmark has its own main and links the library part of common/host only. It runs
 # the reference wavefront (common/wavefront/) and lab 05's reference megakernel.
 $(BUILD)/$(LAB06)/bench.%: LAB_INCLUDES = $(GPU_BENCH_INCLUDES) -Icommon/wavefront
+$(BUILD)/$(LAB06)/bench.%: OBJECT_CUDA_ARCH = $(CUDA_TOOL_ARCH)
 lab06-bench: $(BUILD)/$(LAB06)/bench.o $(LIB_OBJ)
-	$(NVCC) $(CUDA_ARCH) $^ $(INTO_TARGET)
+	$(NVCC) $(CUDA_TOOL_ARCH) $^ $(INTO_TARGET)
 endif

@@ -8,6 +8,7 @@ ifneq ($(HAVE_NVCC),)
 $(eval $(call cuda_lab,lab07,07-soa,common/wavefront,path_pool_soa.cuh))
 
 $(BUILD)/$(LAB07)/bench.%: LAB_INCLUDES = $(GPU_BENCH_INCLUDES) -Icommon/wavefront
+$(BUILD)/$(LAB07)/bench.%: OBJECT_CUDA_ARCH = $(CUDA_TOOL_ARCH)
 lab07-bench: $(BUILD)/$(LAB07)/bench.o $(LIB_OBJ)
-	$(NVCC) $(CUDA_ARCH) $^ $(INTO_TARGET)
+	$(NVCC) $(CUDA_TOOL_ARCH) $^ $(INTO_TARGET)
 endif

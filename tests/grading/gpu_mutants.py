@@ -9,7 +9,9 @@ from __future__ import annotations
 import dataclasses
 import pathlib
 
+from grading.compile import COMPILE_CHECK_ARCH
 from grading.releases.leaks import skeletons
+from labkit import gpu
 from labkit.harness import ROOT, make_in_root
 from labkit.variants import lab_sources
 
@@ -89,8 +91,10 @@ def build_cuda_folder(lab: str, folder: pathlib.Path, files: dict[str, str]) -> 
     folder.mkdir(parents=True, exist_ok=True)
     for name, text in files.items():
         (folder / name).write_text(text)
+    # The grader's architectures: the GPU present, else sm_90 alone (grading/compile.py).
+    arch = gpu.cuda_arch_flags() or COMPILE_CHECK_ARCH
     p = make_in_root("cuda-variant", f"VARIANT_LAB={lab}", f"VARIANT={folder}",
-                     capture_output=True, text=True, timeout=900)
+                     f"CUDA_ARCH={arch}", capture_output=True, text=True, timeout=900)
     if p.returncode != 0:
         raise RuntimeError(f"building {folder} as {lab} failed:\n{(p.stdout + p.stderr)[-3000:]}")
     return folder / "lab"

@@ -54,7 +54,8 @@ def test_targets_build_with_nvcc(lab05_ref, lab05):
 
 def test_architectures(nvcc):
     """Machine code for the GPU present, or for sm_75..sm_90 plus PTX where there is none;
-    under CI without a GPU only the range's ends (compute_75 PTX, sm_90 machine code)."""
+    under CI without a GPU only the range's ends (compute_75 PTX, sm_90 machine code) for the
+    labs, and sm_90 alone for the benchmarks and variants."""
     def codes_of(*args):
         command = make("print-cuda-build-command", *args).stdout
         return set(re.findall(r"code=(sm_\d+|compute_\d+)", command)), command
@@ -63,6 +64,13 @@ def test_architectures(nvcc):
         assert codes == {"sm_75", "sm_80", "sm_86", "sm_89", "sm_90", "compute_90"}, command
         codes, command = codes_of("CI=true")
         assert codes == {"compute_75", "sm_90"}, command
+        # The benchmarks and lab 05's variants, which nothing runs there: sm_90 alone.
+        p = make("-n", "-B", "CI=true", "lab05-bench", "lab06-bench", "lab05-ref-fast-math")
+        compiles = [c for c in p.stdout.replace("\\\n", " ").splitlines()
+                    if " -c " in c and "nvcc" in c]
+        assert len(compiles) == 3, p.stdout + p.stderr
+        for c in compiles:
+            assert set(re.findall(r"code=(sm_\d+|compute_\d+)", c)) == {"sm_90"}, c
     else:
         caps = subprocess.run(["nvidia-smi", "--query-gpu=compute_cap", "--format=csv,noheader"],
                               capture_output=True, text=True).stdout.split()
