@@ -59,11 +59,11 @@ auto with_kernel_choice(SceneMemory memory, bool specular, const GeometryKinds& 
 // How lab05-ref compiles it, each choice measured with lab05-bench on the Cornell baseline
 // (docs/gpu-tuning.md): the hit's surface loaded by the hit's index (one load whose address
 // the warp's lanes share or nearly) rather than chosen by selects; at most 56 registers, or
-// 64 when built with --use_fast_math. Fast math's approximations let the compiler keep far
-// more values live (110 registers uncapped against 74), and held to 56 it spills them inside
-// the loop: slower than the IEEE build, where 64 is the fastest cap. nvcc defines no macro
-// for --use_fast_math, so the builds that pass it (labs/05-cuda-mega/lab.mk) define
-// RT_LAB05_FAST_MATH beside it.
+// 64 when built with --use_fast_math. Fast math's approximations let ptxas keep far more
+// values live, and held to 56 they spill inside the loop; the fast-math build also passes
+// -Xptxas --register-usage-level=3, so that ptxas fits the loop in 64 without spilling.
+// nvcc defines no macro for --use_fast_math, so the builds that pass it
+// (labs/05-cuda-mega/lab.mk) define RT_LAB05_FAST_MATH beside it.
 constexpr bool kSmallSceneBySelects = false;
 #ifdef RT_LAB05_FAST_MATH
 constexpr int kSmallSceneMaxRegisters = 64;
