@@ -135,7 +135,8 @@ def main() -> int:
     parser.add_argument("--out")
     parser.add_argument("--json")
     args = parser.parse_args()
-    kernels = [k for log in args.logs for k in parse(open(log).read())]
+    # One text, so the names are demangled in one call (each log starts with its first entry).
+    kernels = parse("\n".join(open(log).read() for log in args.logs))
     if not kernels:
         print(f"kernel-report: no kernels found in {' '.join(args.logs)}", file=sys.stderr)
         return 1
