@@ -134,13 +134,27 @@ def test_reference_speedup(speedups):
 
 
 @pytest.mark.timed
-def test_skeleton_is_serial(speedups):
-    """Correct but serial: the skeleton is no faster than lab 01 until the parallel loop is
-    written (TODO(lab03) in labs/03-openmp/skeleton/render.cpp), so it fails the speedup test
-    above."""
-    speedup = speedups.speedup("skeleton")
-    assert speedup < 1.3, speedups.describe("skeleton") + ": expected ~1x"
-    assert speedup < speedups.required(), speedups.describe("skeleton")
+def test_skeleton_fails_the_speedup_bar(speedups):
+    """Correct but serial: until the parallel loop is written (TODO(lab03) in
+    labs/03-openmp/skeleton/render.cpp) the skeleton fails the speedup test above. How much
+    faster or slower than lab01-ref it runs is not asserted: the two are different binaries,
+    and on a busy machine one serial program timed against another differs by up to the noise
+    floor that required() never goes below."""
+    assert speedups.speedup("skeleton") < speedups.required(), speedups.describe("skeleton")
+
+
+def test_skeleton_runs_on_one_thread(lab03_skeleton, lab03_ref):
+    """What makes the skeleton serial, told apart from the machine's load as the grader tells
+    it (grading/checks/speed.py): one thread does the whole render, whatever --threads says,
+    while the reference's busiest thread does about half of it on two threads."""
+    from grading.checks.speed import ONE_THREAD
+    render = dict(TIMED, spp=8)
+    skeleton = run_lab(lab03_skeleton, threads=2, **render)
+    assert skeleton.thread_share >= ONE_THREAD, \
+        f"the skeleton's busiest thread did {skeleton.thread_share:.0%} of its CPU time"
+    reference = run_lab(lab03_ref, threads=2, **render)
+    assert reference.thread_share < ONE_THREAD, \
+        f"the reference's busiest thread did {reference.thread_share:.0%} of its CPU time"
 
 
 @pytest.mark.timed
