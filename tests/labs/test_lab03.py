@@ -161,9 +161,9 @@ def test_skeleton_runs_on_one_thread(lab03_skeleton, lab03_ref):
 def test_threads_taking_turns_stay_below_the_grader_s_turns_bar(speedups):
     """An ordered row loop, where the machine has room for a parallel program: over the same
     lab's serial build (the skeleton, timed in the same rounds: the same code but the loop, so
-    neither another binary's code nor its noise sits in the ratio) no faster than the grader's
-    bar for threads that ran one at a time (grading/checks/speed.py), while the reference, in
-    the same rounds, is well above that bar over lab01-ref."""
+    the ratio is the loop's alone) no faster than the grader's bar for threads that ran one at
+    a time (grading/checks/speed.py), while the reference, in the same rounds, is well above
+    that bar over lab01-ref."""
     from grading.checks.speed import TURNS_SPEEDUP
     over_serial = speedups.best["skeleton"] / speedups.best["ordered"]
     assert over_serial <= TURNS_SPEEDUP, \
