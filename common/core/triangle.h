@@ -216,8 +216,9 @@ RT_HD inline double edge_function_exact(double px, double py, double qx, double 
 // that is several ray offsets (ray.h), so a hit point could land under the surface, and its
 // shadow ray hit the disk again, in double as in float (docs/extremes.md). The plane's
 // distance errs by a few ulps of the plane's offset and the origin, whatever the shape: across
-// the plane, the hit point lies within the offset that extent and |p| bound. Returns the distance in (0, t_max), or t_max for a miss. Rays parallel
-// to the triangle's plane and degenerate triangles give det == 0 (or denom == 0) and miss.
+// the plane, the hit point lies within the offset that extent and |p| bound. Returns the
+// distance in (0, t_max), or t_max for a miss. Rays parallel to the triangle's plane and
+// degenerate triangles give det == 0 (or denom == 0) and miss.
 template <bool kConverged = kConvergedTests>  // rt_hd.h
 RT_HD inline real intersect_triangle(const Ray& ray, const RayShear& shear, const Triangle& tri,
                                      real t_max) {

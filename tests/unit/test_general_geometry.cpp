@@ -8,7 +8,7 @@
 #include <string>
 
 #include "../../common/cuda/general_geometry.h"
-#include <cli.h>
+#include "cli.h"
 #include "path_tracer.h"
 #include "scene_centring.h"
 #include "scene_loader.h"

@@ -7,7 +7,7 @@
 #include <random>
 #include <string>
 
-#include <cli.h>
+#include "cli.h"
 #include "path_tracer.h"
 #include "scene_loader.h"
 

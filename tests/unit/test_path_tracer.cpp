@@ -6,7 +6,7 @@
 #include <cmath>
 #include <string>
 
-#include <cli.h>
+#include "cli.h"
 #include "path_tracer.h"
 #include "scene_loader.h"
 

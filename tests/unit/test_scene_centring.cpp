@@ -4,7 +4,7 @@
 
 #include <string>
 
-#include <cli.h>
+#include "cli.h"
 #include "scene_centring.h"
 #include "scene_loader.h"
 

@@ -15,7 +15,7 @@
 #include <string>
 #include <vector>
 
-#include <cli.h>
+#include "cli.h"
 #include "errors.h"
 #include "json_with_positions.h"
 #include "scene_centring.h"
